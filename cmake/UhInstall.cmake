@@ -1,0 +1,25 @@
+# Install rules and the CMake package config, so that another project can
+#   find_package(UnrealHaptics REQUIRED)
+#   target_link_libraries(app PRIVATE uh::haptico)
+include(CMakePackageConfigHelpers)
+
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/uh DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(TARGETS uh_core uh_collette uh_forcecomp uh_haptico uh_readerwriterqueue
+        EXPORT UnrealHapticsTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+if(TARGET uh_cli)
+  install(TARGETS uh_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
+install(EXPORT UnrealHapticsTargets NAMESPACE uh::
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/UnrealHaptics)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/UnrealHapticsConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/UnrealHapticsConfig.cmake
+  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/UnrealHaptics)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/UnrealHapticsConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/UnrealHapticsConfig.cmake
+              ${PROJECT_BINARY_DIR}/UnrealHapticsConfigVersion.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/UnrealHaptics)

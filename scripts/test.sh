@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The whole test suite, three builds in separate directories:
+#   1. Release: every test (unit, integration, the installed-package consumer);
+#   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test;
+#   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions).
+# Ends with one summary line: "tests: N passed, N failed".
+set -uo pipefail
+source "$(dirname "$0")/common.sh"
+bash "$uh_root/scripts/install-deps.sh" || exit 1
+
+passed=0
+failed=0
+status=0
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
+
+run_ctest() {
+  local name=$1 dir=$2; shift 2
+  echo "== ctest ($name) =="
+  local log="$uh_root/$dir/ctest.log"
+  (cd "$uh_root/$dir" && ctest --output-on-failure --timeout 900 "$@") 2>&1 | tee "$log"
+  local line
+  line=$(grep -E "tests passed, [0-9]+ tests? failed out of" "$log" | tail -n 1)
+  if [ -z "$line" ]; then echo "test: no ctest summary for $name"; status=1; return; fi
+  local total fail
+  total=$(sed -E 's/.*out of ([0-9]+).*/\1/' <<<"$line")
+  fail=$(sed -E 's/.*tests passed, ([0-9]+) tests? failed.*/\1/' <<<"$line")
+  passed=$((passed + total - fail))
+  failed=$((failed + fail))
+  [ "$fail" -eq 0 ] || status=1
+}
+
+echo "== build (Release) =="
+if uh_build build/release -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=ON -DUH_BUILD_BENCHMARKS=ON; then
+  run_ctest release build/release
+else
+  echo "test: Release build failed"; status=1; failed=$((failed + 1))
+fi
+
+echo "== build (AddressSanitizer + UndefinedBehaviorSanitizer) =="
+if uh_build build/asan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=address,undefined -DUH_BUILD_BENCHMARKS=OFF; then
+  run_ctest asan+ubsan build/asan -LE no_sanitizer
+else
+  echo "test: sanitizer build failed"; status=1; failed=$((failed + 1))
+fi
+
+echo "== build (ThreadSanitizer) =="
+if uh_build build/tsan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=thread -DUH_BUILD_BENCHMARKS=OFF; then
+  run_ctest tsan build/tsan -L threads
+else
+  echo "test: ThreadSanitizer build failed"; status=1; failed=$((failed + 1))
+fi
+
+echo "tests: $passed passed, $failed failed"
+exit $status
