@@ -1,0 +1,3 @@
+# mesh import, validation, distance fields, sphere packing, previews
+list(APPEND UH_COLLETTE_SOURCES
+)

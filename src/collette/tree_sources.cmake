@@ -1,0 +1,3 @@
+# sphere trees, .ist files, queries, collision world
+list(APPEND UH_COLLETTE_SOURCES
+)
