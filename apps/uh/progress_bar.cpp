@@ -1,0 +1,47 @@
+#include "progress_bar.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+
+namespace uh::cli {
+
+ProgressBar::ProgressBar(std::string label)
+    : label_(std::move(label)), start_(std::chrono::steady_clock::now()), last_draw_(start_) {
+  const char* ci = std::getenv("CI");
+  interactive_ = isatty(STDERR_FILENO) == 1 && (ci == nullptr || std::string(ci).empty());
+}
+
+ProgressBar::~ProgressBar() { finish(); }
+
+void ProgressBar::update(double fraction) {
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const auto now = std::chrono::steady_clock::now();
+  if (!interactive_ || finished_) return;
+  if (now - last_draw_ < std::chrono::milliseconds(100) && fraction < 1.0) return;
+  last_draw_ = now;
+  draw(fraction);
+}
+
+void ProgressBar::draw(double fraction) {
+  constexpr int kWidth = 30;
+  const int filled = static_cast<int>(fraction * kWidth + 0.5);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::string bar(static_cast<std::size_t>(filled), '#');
+  bar.resize(kWidth, '.');
+  std::fprintf(stderr, "\r%s [%s] %3.0f%%  %.1f s", label_.c_str(), bar.c_str(), fraction * 100.0, seconds);
+  std::fflush(stderr);
+  last_fraction_ = fraction;
+}
+
+void ProgressBar::finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (!interactive_) return;
+  draw(1.0);
+  std::fputc('\n', stderr);
+}
+
+}  // namespace uh::cli

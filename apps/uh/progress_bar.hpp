@@ -1,0 +1,35 @@
+#pragma once
+/// \file
+/// A one-line terminal progress bar for long work (sphere packing, .ist builds). Writes to stderr,
+/// redraws at most every 100 ms, and prints nothing when stderr is not a terminal or CI is set
+/// (logs stay clean), except the final line.
+
+#include <chrono>
+#include <string>
+
+namespace uh::cli {
+
+class ProgressBar {
+ public:
+  explicit ProgressBar(std::string label);
+  ~ProgressBar();
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+  /// fraction in [0, 1]; values outside are clamped. Call from one thread.
+  void update(double fraction);
+  /// Draws 100% and ends the line (idempotent).
+  void finish();
+
+ private:
+  void draw(double fraction);
+
+  std::string label_;
+  bool interactive_ = false;
+  bool finished_ = false;
+  double last_fraction_ = -1.0;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_;
+};
+
+}  // namespace uh::cli
