@@ -1,0 +1,36 @@
+#pragma once
+/// \file
+/// Physical parameters of one object taking part in force computation (ForceComp).
+
+#include "uh/core/math.hpp"
+
+namespace uh::forcecomp {
+
+/// Which forces a ForceComponent computes.
+enum class ForceMode {
+  k3Dof,  ///< force only; the torque of every result is zero (point-like tool)
+  k6Dof,  ///< force and torque about the tool's centre of mass
+};
+
+/// Which object of a ContactFrame (A or B) the forces are computed for. Collette writes each
+/// pair's normal from a's centre towards b's centre, so the force on B is +normal, on A -normal.
+enum class ContactSide {
+  kA,
+  kB,
+};
+
+/// Physical parameters of one object (options aggregate, b2DefaultBodyDef style).
+///
+/// Units: L is the length unit of the contact data (metres when meshes are in metres). The
+/// volumetric force is eps_c * overlap volume, so `force_scale` is in N / L^3; `damping` is an
+/// ordinary linear damping coefficient in N s / L (see penalty_force.hpp for why).
+struct ForceParams {
+  double mass_kg = 0.1;                 ///< mass [kg], > 0; used by simulated tools (VirtualCoupling proxy)
+  Vec3 center_of_mass_body{};           ///< centre of mass in the body (mesh) frame [L]; torques are about it
+  double force_scale = 2.0e5;           ///< eps_c [N / L^3], >= 0
+  double damping = 0.0;                 ///< eps_d [N s / L], >= 0; total damping along a common normal
+  double max_force_n = 10.0;            ///< |force| limit [N], > 0
+  double max_torque_nm = 0.5;           ///< |torque| limit [N m], > 0
+};
+
+}  // namespace uh::forcecomp

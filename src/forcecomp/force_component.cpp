@@ -1,0 +1,43 @@
+#include "uh/forcecomp/force_component.hpp"
+
+#include "uh/forcecomp/held_contact_set.hpp"
+
+namespace uh::forcecomp {
+
+BodyMotion ForceComponent::body_motion(const Pose& world_from_body, const Vec3& origin_velocity_world,
+                                       const Vec3& angular_velocity_world) const {
+  BodyMotion m;
+  m.center_of_mass_world = transform_point(world_from_body, options_.params.center_of_mass_body);
+  m.linear_velocity_world =
+      origin_velocity_world + cross(angular_velocity_world, m.center_of_mass_world - world_from_body.position);
+  m.angular_velocity_world = angular_velocity_world;
+  return m;
+}
+
+PenaltyInput ForceComponent::penalty_input(const BodyMotion& self, const BodyMotion& other) const {
+  PenaltyInput in;
+  in.force_scale = options_.params.force_scale;
+  in.damping = options_.params.damping;
+  in.mode = options_.mode;
+  in.tool_side = options_.side;
+  in.tool = self;
+  in.other = other;
+  return in;
+}
+
+PenaltyResult ForceComponent::evaluate(std::span<const SpherePairContact> pairs, const BodyMotion& self,
+                                       const BodyMotion& other) const {
+  return evaluate_penalty(pairs, penalty_input(self, other));
+}
+
+PenaltyResult ForceComponent::evaluate(const ContactFrame& frame, const BodyMotion& self,
+                                       const BodyMotion& other) const {
+  return evaluate_penalty(frame, penalty_input(self, other));
+}
+
+PenaltyResult ForceComponent::evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
+                                       const BodyMotion& self, const BodyMotion& other) const {
+  return evaluate_penalty(held.reevaluate(world_from_a, world_from_b), penalty_input(self, other));
+}
+
+}  // namespace uh::forcecomp

@@ -1,0 +1,63 @@
+#include "uh/forcecomp/force_safety.hpp"
+
+#include <cmath>
+
+namespace uh::forcecomp {
+
+namespace {
+
+void bump(std::atomic<std::uint64_t>& counter) {
+  // single writer (the haptic thread): a relaxed load and store is enough and never locks
+  counter.store(counter.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
+}  // namespace
+
+bool clamp_norm(Vec3& v, double limit) {
+  const double n = norm(v);
+  if (n <= limit) return false;
+  v = limit > 0.0 ? v * (limit / n) : Vec3{};
+  return true;
+}
+
+Wrench ForceSafety::apply(const Wrench& raw, double now_s, double data_time_s) {
+  bump(ticks_);
+  if (resume_requested_.exchange(false, std::memory_order_acq_rel)) watchdog_.reset(0.0);
+
+  Wrench w = raw;
+  if (!is_finite(w.force) || !is_finite(w.torque)) {
+    // a NaN anywhere means the whole computation is suspect: drop both parts
+    bump(nonfinite_);
+    w = Wrench{};
+  }
+  const double gain = watchdog_.update(now_s, data_time_s);
+  if (watchdog_.stale()) bump(stale_ticks_);
+  w.force *= gain;
+  w.torque *= gain;
+  if (clamp_norm(w.force, options_.max_force_n)) bump(force_clamped_);
+  if (clamp_norm(w.torque, options_.max_torque_nm)) bump(torque_clamped_);
+  if (stopped_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire)) {
+    bump(zeroed_ticks_);
+    return Wrench{};
+  }
+  return w;
+}
+
+void ForceSafety::resume() {
+  faulted_.store(false, std::memory_order_release);
+  resume_requested_.store(true, std::memory_order_release);
+  stopped_.store(false, std::memory_order_release);
+}
+
+ForceSafetyCounters ForceSafety::counters() const {
+  ForceSafetyCounters c;
+  c.ticks = ticks_.load(std::memory_order_relaxed);
+  c.force_clamped = force_clamped_.load(std::memory_order_relaxed);
+  c.torque_clamped = torque_clamped_.load(std::memory_order_relaxed);
+  c.nonfinite = nonfinite_.load(std::memory_order_relaxed);
+  c.stale_ticks = stale_ticks_.load(std::memory_order_relaxed);
+  c.zeroed_ticks = zeroed_ticks_.load(std::memory_order_relaxed);
+  return c;
+}
+
+}  // namespace uh::forcecomp

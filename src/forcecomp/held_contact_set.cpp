@@ -1,0 +1,88 @@
+#include "uh/forcecomp/held_contact_set.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "uh/core/sphere_overlap.hpp"
+
+namespace uh::forcecomp {
+
+namespace {
+
+Vec3 centre(const Sphere& s) {
+  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+}
+
+void store(float (&out)[3], const Vec3& v) {
+  out[0] = static_cast<float>(v.x);
+  out[1] = static_cast<float>(v.y);
+  out[2] = static_cast<float>(v.z);
+}
+
+}  // namespace
+
+HeldContactSet::HeldContactSet(std::int32_t capacity)
+    : capacity_(capacity),
+      held_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
+      normal_a_local_(new Vec3[static_cast<std::size_t>(std::max(capacity, 1))]),
+      scratch_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]) {
+  assert(capacity > 0 && "uh::forcecomp::HeldContactSet::HeldContactSet(): capacity must be positive");
+}
+
+void HeldContactSet::hold(const ContactFrame& frame) {
+  const auto count = static_cast<std::size_t>(std::clamp(frame.pair_count, 0, ContactFrame::kMaxPairs));
+  hold(std::span<const SpherePairContact>(frame.pairs.data(), count), frame.sequence, frame.time_s);
+  // the frame knows its poses: express the normals in A's frame for the coincident-centre case
+  const Quat a_from_world = conjugate(frame.world_from_a.rotation);
+  for (std::int32_t i = 0; i < size_; ++i) {
+    const float* n = held_[static_cast<std::size_t>(i)].normal_world;
+    normal_a_local_[static_cast<std::size_t>(i)] =
+        rotate(a_from_world, Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]), static_cast<double>(n[2])});
+  }
+}
+
+void HeldContactSet::hold(std::span<const SpherePairContact> pairs, std::uint64_t sequence, double time_s) {
+  const std::size_t n = std::min(pairs.size(), static_cast<std::size_t>(capacity_));
+  dropped_pairs_ += pairs.size() - n;
+  std::copy_n(pairs.begin(), n, held_.get());
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* nw = held_[i].normal_world;
+    // without poses the world normal is the best guess for A's frame (exact when A is unrotated)
+    normal_a_local_[i] = {static_cast<double>(nw[0]), static_cast<double>(nw[1]), static_cast<double>(nw[2])};
+  }
+  size_ = static_cast<std::int32_t>(n);
+  sequence_ = sequence;
+  time_s_ = time_s;
+}
+
+void HeldContactSet::clear() {
+  size_ = 0;
+  sequence_ = 0;
+  time_s_ = 0.0;
+}
+
+std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_from_a, const Pose& world_from_b) {
+  for (std::int32_t k = 0; k < size_; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const SpherePairContact& in = held_[i];
+    SpherePairContact& out = scratch_[i];
+    out = in;
+    const Vec3 ca = transform_point(world_from_a, centre(in.sphere_a_local));
+    const Vec3 cb = transform_point(world_from_b, centre(in.sphere_b_local));
+    const double ra = static_cast<double>(in.sphere_a_local.radius);
+    const double rb = static_cast<double>(in.sphere_b_local.radius);
+    const Vec3 delta = cb - ca;
+    const double d = norm(delta);
+    const double volume = lens_volume(d, ra, rb);
+    // coincident centres leave the centre line undefined: keep the held normal, turned with A
+    const Vec3 u = d > 1e-12 * (ra + rb) ? delta / d : rotate(world_from_a.rotation, normal_a_local_[i]);
+    const Vec3 centroid = ca + lens_centroid_offset(d, ra, rb) * u;
+    out.volume = static_cast<float>(volume);
+    store(out.normal_world, u);
+    store(out.centroid_world, centroid);
+  }
+  return {scratch_.get(), static_cast<std::size_t>(size_)};
+}
+
+}  // namespace uh::forcecomp
