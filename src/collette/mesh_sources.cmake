@@ -1,3 +1,7 @@
 # mesh import, validation, distance fields, sphere packing, previews
 list(APPEND UH_COLLETTE_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/triangle_mesh.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/triangle_bvh.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mesh_import.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mesh_inside.cpp
 )

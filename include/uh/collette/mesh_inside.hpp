@@ -1,0 +1,44 @@
+#pragma once
+/// \file
+/// MeshInside: exact point-to-surface distance and a robust inside test for a triangle mesh.
+
+#include <memory>
+
+#include "uh/collette/triangle_mesh.hpp"
+
+namespace uh::collette {
+
+/// Point queries against one mesh, accelerated by a triangle BVH built in the constructor.
+///
+/// contains() uses ray parity with three axis rays and a majority vote for closed meshes
+/// (robust when a ray grazes an edge or vertex), and the generalised winding number
+/// (> 0.5 means inside) for meshes accepted with report.assumed_open. distance() is the exact
+/// Euclidean distance to the nearest triangle. Keeps its own copy of the geometry. Const queries
+/// are thread-safe and allocation-free, but not bounded-time: keep them off the haptic thread.
+class MeshInside {
+ public:
+  explicit MeshInside(const TriangleMesh& mesh);
+  ~MeshInside();
+  MeshInside(MeshInside&&) noexcept;
+  MeshInside& operator=(MeshInside&&) noexcept;
+  MeshInside(const MeshInside&) = delete;
+  MeshInside& operator=(const MeshInside&) = delete;
+
+  /// True when p lies strictly inside the closed surface (points on the surface may go either way).
+  bool contains(const Vec3& p) const;
+  /// Generalised winding number at p: 1 inside and 0 outside a closed outward-oriented mesh,
+  /// fractional near holes of an open one. Exact sum over all triangles: O(triangles).
+  double winding_number(const Vec3& p) const;
+  /// Unsigned distance from p to the nearest point of any triangle [length unit of the mesh].
+  double distance(const Vec3& p) const;
+  /// Signed distance: negative inside, positive outside.
+  double signed_distance(const Vec3& p) const;
+  /// Nearest point on the surface to p.
+  Vec3 closest_point(const Vec3& p) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uh::collette

@@ -1,0 +1,288 @@
+#include "uh/collette/mesh_import.hpp"
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <cmath>
+#include <cstdint>
+#include <fmt/format.h>
+#include <numeric>
+#include <system_error>
+#include <unordered_map>
+
+namespace uh::collette {
+namespace {
+
+double bbox_diagonal(const std::vector<Vec3>& vertices) {
+  if (vertices.empty()) return 0.0;
+  Vec3 lo = vertices.front();
+  Vec3 hi = lo;
+  for (const Vec3& v : vertices) {
+    lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
+    hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
+  }
+  return norm(hi - lo);
+}
+
+struct CellKey {
+  std::int64_t x, y, z;
+  bool operator==(const CellKey&) const = default;
+};
+struct CellHash {
+  std::size_t operator()(const CellKey& k) const {
+    const auto h = static_cast<std::uint64_t>(k.x) * 73856093ULL ^ static_cast<std::uint64_t>(k.y) * 19349663ULL ^
+                   static_cast<std::uint64_t>(k.z) * 83492791ULL;
+    return static_cast<std::size_t>(h);
+  }
+};
+
+// Maps every vertex to the lowest-index vertex within `tol` that was itself kept (first come,
+// first kept), so the result does not depend on hash-table order.
+std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
+  std::vector<std::int32_t> map(v.size());
+  if (tol <= 0.0) {
+    std::vector<std::int32_t> order(v.size());
+    std::iota(order.begin(), order.end(), 0);
+    auto less = [&](std::int32_t a, std::int32_t b) {
+      const Vec3& p = v[static_cast<std::size_t>(a)];
+      const Vec3& q = v[static_cast<std::size_t>(b)];
+      if (p.x != q.x) return p.x < q.x;
+      if (p.y != q.y) return p.y < q.y;
+      if (p.z != q.z) return p.z < q.z;
+      return a < b;
+    };
+    std::sort(order.begin(), order.end(), less);
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const auto cur = static_cast<std::size_t>(order[i]);
+      if (i > 0 && v[static_cast<std::size_t>(order[i - 1])] == v[cur]) {
+        map[cur] = map[static_cast<std::size_t>(order[i - 1])];
+      } else {
+        map[cur] = order[i];
+      }
+    }
+    return map;
+  }
+  std::unordered_map<CellKey, std::vector<std::int32_t>, CellHash> cells;
+  cells.reserve(v.size());
+  const double tol2 = tol * tol;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const CellKey k{static_cast<std::int64_t>(std::floor(v[i].x / tol)), static_cast<std::int64_t>(std::floor(v[i].y / tol)),
+                    static_cast<std::int64_t>(std::floor(v[i].z / tol))};
+    std::int32_t found = -1;
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto it = cells.find({k.x + dx, k.y + dy, k.z + dz});
+          if (it == cells.end()) continue;
+          for (const std::int32_t j : it->second) {
+            if (squared_norm(v[static_cast<std::size_t>(j)] - v[i]) <= tol2 && (found < 0 || j < found)) found = j;
+          }
+        }
+      }
+    }
+    if (found >= 0) {
+      map[i] = found;
+    } else {
+      map[i] = static_cast<std::int32_t>(i);
+      cells[k].push_back(static_cast<std::int32_t>(i));
+    }
+  }
+  return map;
+}
+
+std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    i = parent[static_cast<std::size_t>(i)];
+  }
+  return i;
+}
+
+}  // namespace
+
+Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& options) {
+  const std::string& name = mesh.source_name;
+  MeshReport report{};
+  report.input_vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
+  if (mesh.triangles.empty() || mesh.vertices.empty()) {
+    return Error{fmt::format("{}: mesh is empty: {} vertices, {} triangles (a closed triangle mesh is required)", name,
+                             mesh.vertices.size(), mesh.triangles.size())};
+  }
+  for (const auto& t : mesh.triangles) {
+    for (const std::int32_t i : t) {
+      if (i < 0 || static_cast<std::size_t>(i) >= mesh.vertices.size()) {
+        return Error{fmt::format("{}: triangle refers to vertex {} but the mesh has {} vertices", name, i,
+                                 mesh.vertices.size())};
+      }
+    }
+  }
+  for (const Vec3& v : mesh.vertices) {
+    if (!is_finite(v)) return Error{fmt::format("{}: mesh has a vertex with a non-finite coordinate", name)};
+  }
+  const double diag = bbox_diagonal(mesh.vertices);
+
+  // weld, then drop vertices no triangle uses
+  const std::vector<std::int32_t> map = weld_map(mesh.vertices, options.weld_tolerance * diag);
+  std::vector<std::int32_t> compact(mesh.vertices.size(), -1);
+  std::vector<Vec3> vertices;
+  for (auto& t : mesh.triangles) {
+    for (std::int32_t& i : t) {
+      const auto root = static_cast<std::size_t>(map[static_cast<std::size_t>(i)]);
+      if (compact[root] < 0) {
+        compact[root] = static_cast<std::int32_t>(vertices.size());
+        vertices.push_back(mesh.vertices[root]);
+      }
+      i = compact[root];
+    }
+  }
+  std::int64_t distinct_inputs = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) distinct_inputs += (map[i] == static_cast<std::int32_t>(i)) ? 1 : 0;
+  report.welded_vertices = report.input_vertex_count - distinct_inputs;
+  mesh.vertices = std::move(vertices);
+
+  // degenerate faces: repeated vertices after welding, or (near) zero area
+  std::vector<std::array<std::int32_t, 3>> kept;
+  kept.reserve(mesh.triangles.size());
+  std::vector<char> repeated(mesh.triangles.size(), 0);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    const Vec3& a = mesh.vertices[static_cast<std::size_t>(t[0])];
+    const Vec3& b = mesh.vertices[static_cast<std::size_t>(t[1])];
+    const Vec3& c = mesh.vertices[static_cast<std::size_t>(t[2])];
+    const bool rep = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+    const bool tiny = norm(cross(b - a, c - a)) <= options.degenerate_area_tolerance * diag * diag;
+    if (rep || tiny) {
+      ++report.degenerate_faces;
+      repeated[f] = rep ? 1 : 0;
+      if (options.drop_degenerate) continue;
+    }
+    kept.push_back(t);
+  }
+  if (options.drop_degenerate) mesh.triangles = std::move(kept);
+  report.triangle_count = static_cast<std::int64_t>(mesh.triangles.size());
+  report.vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
+  if (mesh.triangles.empty()) {
+    return Error{fmt::format("{}: mesh is empty after dropping {} degenerate faces", name, report.degenerate_faces)};
+  }
+
+  // edge use counts and directions, by sorting (deterministic, no hashing)
+  struct EdgeUse {
+    std::uint64_t key;
+    std::int32_t face;
+    bool forward;
+  };
+  std::vector<EdgeUse> uses;
+  uses.reserve(mesh.triangles.size() * 3);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    if (!options.drop_degenerate && repeated[f] != 0) continue;
+    for (int e = 0; e < 3; ++e) {
+      const std::int32_t a = t[static_cast<std::size_t>(e)];
+      const std::int32_t b = t[static_cast<std::size_t>((e + 1) % 3)];
+      const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+      const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+      uses.push_back({(lo << 32) | hi, static_cast<std::int32_t>(f), a < b});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.key < y.key || (x.key == y.key && x.face < y.face);
+  });
+  std::vector<std::int32_t> parent(mesh.triangles.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    const std::size_t n = j - i;
+    if (n == 1) ++report.boundary_edges;
+    if (n >= 3) ++report.non_manifold_edges;
+    if (n == 2 && uses[i].forward == uses[i + 1].forward) ++report.inconsistent_edges;
+    const std::int32_t first_face = uses[i].face;
+    for (auto it = uses.begin() + static_cast<std::ptrdiff_t>(i) + 1; it != uses.begin() + static_cast<std::ptrdiff_t>(j); ++it) {
+      const std::int32_t ra = find_root(parent, first_face);
+      const std::int32_t rb = find_root(parent, it->face);
+      if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    }
+    i = j;
+  }
+  for (std::size_t f = 0; f < parent.size(); ++f) {
+    report.components += (find_root(parent, static_cast<std::int32_t>(f)) == static_cast<std::int32_t>(f)) ? 1 : 0;
+  }
+
+  const bool open_ok = options.allow_open && report.boundary_edges <= options.max_open_boundary_edges;
+  const bool degenerate_bad = report.degenerate_faces > 0 && !options.drop_degenerate;
+  if ((report.boundary_edges > 0 && !open_ok) || report.non_manifold_edges > 0 || degenerate_bad) {
+    const char* what = report.non_manifold_edges > 0 ? "mesh is not 2-manifold"
+                       : report.boundary_edges > 0   ? "mesh is not closed"
+                                                     : "mesh has degenerate faces";
+    std::string hint;
+    if (report.boundary_edges > 0 && report.non_manifold_edges == 0) {
+      hint += options.allow_open
+                  ? fmt::format("; allow_open accepts at most {} boundary edges", options.max_open_boundary_edges)
+                  : std::string("; MeshLoadOptions{.allow_open = true} accepts slightly open meshes");
+    }
+    if (degenerate_bad) hint += "; MeshLoadOptions{.drop_degenerate = true} drops degenerate faces";
+    return Error{fmt::format("{}: {}: {} boundary edges, {} non-manifold edges, {} degenerate faces "
+                             "(a closed 2-manifold mesh is required{})",
+                             name, what, report.boundary_edges, report.non_manifold_edges, report.degenerate_faces, hint)};
+  }
+  if (report.inconsistent_edges > 0) {
+    return Error{fmt::format("{}: mesh orientation is inconsistent: {} edges where neighbouring triangles run the "
+                             "same way (their normals disagree); fix the winding in a modelling tool",
+                             name, report.inconsistent_edges)};
+  }
+  report.assumed_open = report.boundary_edges > 0;
+
+  double volume = mesh_volume(mesh);
+  if (volume < 0.0) {
+    for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+    volume = -volume;
+    report.winding_flipped = true;
+  }
+  if (!(volume > 0.0)) {
+    return Error{fmt::format("{}: mesh encloses no volume ({})", name, volume)};
+  }
+  report.volume = volume;
+  mesh.report = report;
+  return mesh;
+}
+
+Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options) {
+  const std::string name = path.filename().string();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    return Error{fmt::format("{}: file not found (looked for '{}')", name, path.string())};
+  }
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return Error{fmt::format("{}: not a regular file ('{}')", name, path.string())};
+  }
+  if (std::filesystem::file_size(path, ec) == 0) {
+    return Error{fmt::format("{}: file is empty, no mesh to read", name)};
+  }
+  Assimp::Importer importer;
+  // no JoinIdenticalVertices: it also compares normals, so STL stays unwelded; we weld ourselves
+  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices);
+  if (scene == nullptr) {
+    return Error{fmt::format("{}: cannot read mesh: {}", name, importer.GetErrorString())};
+  }
+  TriangleMesh mesh;
+  mesh.source_name = name;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    const auto base = static_cast<std::int32_t>(mesh.vertices.size());
+    for (unsigned i = 0; i < am->mNumVertices; ++i) {
+      const aiVector3D& v = am->mVertices[i];
+      mesh.vertices.push_back({static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)});
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
+      mesh.triangles.push_back({base + static_cast<std::int32_t>(face.mIndices[0]),
+                                base + static_cast<std::int32_t>(face.mIndices[1]),
+                                base + static_cast<std::int32_t>(face.mIndices[2])});
+    }
+  }
+  return validate_mesh(std::move(mesh), options);
+}
+
+}  // namespace uh::collette

@@ -1,0 +1,233 @@
+#include "triangle_bvh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace uh::collette::detail {
+namespace {
+
+constexpr int kLeafSize = 4;
+
+double box_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
+  const double dy = std::max({lo.y - p.y, 0.0, p.y - hi.y});
+  const double dz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+  return dx * dx + dy * dy + dz * dz;
+}
+
+double component(const Vec3& v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
+
+}  // namespace
+
+Vec3 closest_point_on_triangle(const Vec3& p, const Triangle& t) {
+  const Vec3 ab = t.b - t.a;
+  const Vec3 ac = t.c - t.a;
+  const Vec3 ap = p - t.a;
+  const double d1 = dot(ab, ap);
+  const double d2 = dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return t.a;
+  const Vec3 bp = p - t.b;
+  const double d3 = dot(ab, bp);
+  const double d4 = dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return t.b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return t.a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - t.c;
+  const double d5 = dot(ab, cp);
+  const double d6 = dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return t.c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return t.a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    return t.b + (t.c - t.b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  }
+  const double denom = va + vb + vc;
+  if (!(denom > 0.0)) return t.a;  // degenerate triangle: fall back to a vertex
+  return t.a + ab * (vb / denom) + ac * (vc / denom);
+}
+
+double triangle_winding(const Vec3& p, const Triangle& t) {
+  const Vec3 a = t.a - p;
+  const Vec3 b = t.b - p;
+  const Vec3 c = t.c - p;
+  const double la = norm(a);
+  const double lb = norm(b);
+  const double lc = norm(c);
+  const double num = dot(a, cross(b, c));
+  const double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+  return std::atan2(num, den) / (2.0 * kPi);
+}
+
+TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices,
+                         const std::vector<std::array<std::int32_t, 3>>& triangles) {
+  tris_.reserve(triangles.size());
+  for (const auto& t : triangles) {
+    tris_.push_back({vertices[static_cast<std::size_t>(t[0])], vertices[static_cast<std::size_t>(t[1])],
+                     vertices[static_cast<std::size_t>(t[2])]});
+  }
+  if (tris_.empty()) return;
+  std::vector<Vec3> centroids(tris_.size());
+  for (std::size_t i = 0; i < tris_.size(); ++i) centroids[i] = (tris_[i].a + tris_[i].b + tris_[i].c) / 3.0;
+  nodes_.reserve(2 * tris_.size() / kLeafSize + 2);
+  nodes_.push_back({});
+  build(0, 0, static_cast<std::int32_t>(tris_.size()), centroids);
+}
+
+void TriangleBvh::build(std::int32_t node, std::int32_t first, std::int32_t count, std::vector<Vec3>& centroids) {
+  Vec3 lo{1e300, 1e300, 1e300};
+  Vec3 hi{-1e300, -1e300, -1e300};
+  Vec3 clo = lo;
+  Vec3 chi = hi;
+  for (std::int32_t i = first; i < first + count; ++i) {
+    const Triangle& t = tris_[static_cast<std::size_t>(i)];
+    for (const Vec3& v : {t.a, t.b, t.c}) {
+      lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
+      hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
+    }
+    const Vec3& c = centroids[static_cast<std::size_t>(i)];
+    clo = {std::min(clo.x, c.x), std::min(clo.y, c.y), std::min(clo.z, c.z)};
+    chi = {std::max(chi.x, c.x), std::max(chi.y, c.y), std::max(chi.z, c.z)};
+  }
+  nodes_[static_cast<std::size_t>(node)].lo = lo;
+  nodes_[static_cast<std::size_t>(node)].hi = hi;
+  if (count <= kLeafSize) {
+    nodes_[static_cast<std::size_t>(node)].first = first;
+    nodes_[static_cast<std::size_t>(node)].count = count;
+    return;
+  }
+  const Vec3 ext = chi - clo;
+  const int axis = (ext.x >= ext.y && ext.x >= ext.z) ? 0 : (ext.y >= ext.z ? 1 : 2);
+  // median split on the longest centroid axis: balanced depth, deterministic (ties by index)
+  std::vector<std::int32_t> order(static_cast<std::size_t>(count));
+  std::iota(order.begin(), order.end(), first);
+  const std::int32_t half = count / 2;
+  std::nth_element(order.begin(), order.begin() + half, order.end(), [&](std::int32_t a, std::int32_t b) {
+    const double ca = component(centroids[static_cast<std::size_t>(a)], axis);
+    const double cb = component(centroids[static_cast<std::size_t>(b)], axis);
+    return ca < cb || (ca == cb && a < b);
+  });
+  std::vector<Triangle> tmp_t(static_cast<std::size_t>(count));
+  std::vector<Vec3> tmp_c(static_cast<std::size_t>(count));
+  for (std::int32_t i = 0; i < count; ++i) {
+    tmp_t[static_cast<std::size_t>(i)] = tris_[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    tmp_c[static_cast<std::size_t>(i)] = centroids[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+  }
+  std::copy(tmp_t.begin(), tmp_t.end(), tris_.begin() + first);
+  std::copy(tmp_c.begin(), tmp_c.end(), centroids.begin() + first);
+  const auto left = static_cast<std::int32_t>(nodes_.size());
+  nodes_.push_back({});
+  nodes_.push_back({});
+  nodes_[static_cast<std::size_t>(node)].first = left;
+  nodes_[static_cast<std::size_t>(node)].count = 0;
+  build(left, first, half, centroids);
+  build(left + 1, first + half, count - half, centroids);
+}
+
+double TriangleBvh::closest(const Vec3& p, Vec3* nearest, double max_d2) const {
+  double best = max_d2;
+  Vec3 best_point{};
+  if (tris_.empty()) return best;
+  std::int32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const BvhNode& n = nodes_[static_cast<std::size_t>(stack[--top])];
+    if (box_distance2(p, n.lo, n.hi) >= best) continue;
+    if (n.count > 0) {
+      for (std::int32_t i = n.first; i < n.first + n.count; ++i) {
+        const Vec3 q = closest_point_on_triangle(p, tris_[static_cast<std::size_t>(i)]);
+        const double d2 = squared_norm(q - p);
+        if (d2 < best) {
+          best = d2;
+          best_point = q;
+        }
+      }
+      continue;
+    }
+    // visit the nearer child first so that the far one is usually pruned
+    const BvhNode& l = nodes_[static_cast<std::size_t>(n.first)];
+    const BvhNode& r = nodes_[static_cast<std::size_t>(n.first + 1)];
+    const double dl = box_distance2(p, l.lo, l.hi);
+    const double dr = box_distance2(p, r.lo, r.hi);
+    if (dl <= dr) {
+      if (dr < best) stack[top++] = n.first + 1;
+      if (dl < best) stack[top++] = n.first;
+    } else {
+      if (dl < best) stack[top++] = n.first;
+      if (dr < best) stack[top++] = n.first + 1;
+    }
+  }
+  if (nearest != nullptr) *nearest = best_point;
+  return best;
+}
+
+template <typename Visit>
+void TriangleBvh::ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& visit) const {
+  if (tris_.empty()) return;
+  const Vec3 inv{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
+  std::int32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const BvhNode& n = nodes_[static_cast<std::size_t>(stack[--top])];
+    // slab test; infinities from zero direction components behave correctly except 0 * inf,
+    // which the max/min with the current interval tolerates because NaN comparisons are false
+    double t0 = 0.0;
+    double t1 = t_max;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double oa = component(o, axis);
+      const double ia = component(inv, axis);
+      double ta = (component(n.lo, axis) - oa) * ia;
+      double tb = (component(n.hi, axis) - oa) * ia;
+      if (std::isnan(ta) || std::isnan(tb)) continue;
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+    }
+    if (t0 > t1) continue;
+    if (n.count > 0) {
+      for (std::int32_t i = n.first; i < n.first + n.count; ++i) {
+        const Triangle& t = tris_[static_cast<std::size_t>(i)];
+        // Moller-Trumbore; hits exactly on an edge count for both triangles, which the callers
+        // detect (coincident parameters) or outvote (three rays)
+        const Vec3 e1 = t.b - t.a;
+        const Vec3 e2 = t.c - t.a;
+        const Vec3 pv = cross(d, e2);
+        const double det = dot(e1, pv);
+        if (det == 0.0) continue;
+        const double inv_det = 1.0 / det;
+        const Vec3 tv = o - t.a;
+        const double u = dot(tv, pv) * inv_det;
+        if (u < 0.0 || u > 1.0) continue;
+        const Vec3 qv = cross(tv, e1);
+        const double v = dot(d, qv) * inv_det;
+        if (v < 0.0 || u + v > 1.0) continue;
+        const double tt = dot(e2, qv) * inv_det;
+        if (tt > 0.0 && tt < t_max) visit(tt);
+      }
+      continue;
+    }
+    stack[top++] = n.first;
+    stack[top++] = n.first + 1;
+  }
+}
+
+void TriangleBvh::ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<double>& hits) const {
+  ray_visit(o, d, t_max, [&](double t) { hits.push_back(t); });
+}
+
+int TriangleBvh::ray_crossings(const Vec3& o, const Vec3& d) const {
+  int n = 0;
+  ray_visit(o, d, 1e300, [&](double) { ++n; });
+  return n;
+}
+
+double TriangleBvh::winding_number(const Vec3& p) const {
+  double w = 0.0;
+  for (const Triangle& t : tris_) w += triangle_winding(p, t);
+  return w;
+}
+
+}  // namespace uh::collette::detail

@@ -1,0 +1,55 @@
+#pragma once
+// Private: a binary BVH over a triangle mesh for exact closest-point and ray-crossing queries.
+// Used by MeshInside, the sphere packer and the mesh validation; not part of the public API.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "uh/core/math.hpp"
+
+namespace uh::collette::detail {
+
+struct Triangle {
+  Vec3 a, b, c;
+};
+
+/// Closest point to p on triangle t (Ericson, Real-Time Collision Detection, 5.1.5).
+Vec3 closest_point_on_triangle(const Vec3& p, const Triangle& t);
+
+/// Solid angle of triangle t seen from p, divided by 4 pi (Van Oosterom & Strackee).
+double triangle_winding(const Vec3& p, const Triangle& t);
+
+struct BvhNode {
+  Vec3 lo, hi;
+  std::int32_t first = 0;  // leaf: first triangle in the permuted order; inner: left child index
+  std::int32_t count = 0;  // leaf: triangle count (> 0); inner: 0 (right child = left + 1)
+};
+
+class TriangleBvh {
+ public:
+  TriangleBvh() = default;
+  TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<std::array<std::int32_t, 3>>& triangles);
+
+  bool empty() const { return tris_.empty(); }
+  /// Squared distance to the nearest triangle, with the nearest point; `max_d2` prunes the search.
+  double closest(const Vec3& p, Vec3* nearest = nullptr, double max_d2 = 1e300) const;
+  /// Ray parameters t in (0, t_max) where the ray o + t d crosses a triangle, appended to hits.
+  void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<double>& hits) const;
+  /// Number of crossings of the ray o + t d, t > 0 (no allocation).
+  int ray_crossings(const Vec3& o, const Vec3& d) const;
+  /// Exact generalised winding number (sum over all triangles).
+  double winding_number(const Vec3& p) const;
+
+  const std::vector<Triangle>& triangles() const { return tris_; }
+
+ private:
+  void build(std::int32_t node, std::int32_t first, std::int32_t count, std::vector<Vec3>& centroids);
+  template <typename Visit>
+  void ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& visit) const;
+
+  std::vector<Triangle> tris_;
+  std::vector<BvhNode> nodes_;
+};
+
+}  // namespace uh::collette::detail
