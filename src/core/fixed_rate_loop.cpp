@@ -1,0 +1,215 @@
+#include "uh/core/fixed_rate_loop.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/prctl.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <string>
+#include <utility>
+
+#include "uh/core/log.hpp"
+
+namespace uh {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Nanos = std::chrono::nanoseconds;
+
+// the longest single sleep, so that request_stop() is noticed even at very low rates
+constexpr Nanos kMaxSleepChunk = std::chrono::milliseconds(10);
+
+std::int64_t to_ns(Clock::time_point t) { return std::chrono::duration_cast<Nanos>(t.time_since_epoch()).count(); }
+
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
+// libstdc++'s steady_clock is CLOCK_MONOTONIC, so an absolute clock_nanosleep on that clock
+// wakes at the steady_clock time asked for (plus the OS wake-up latency)
+void sleep_until(Clock::time_point t) {
+  const std::int64_t ns = to_ns(t);
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(ns % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+std::uint64_t abs_ns(std::int64_t v) { return static_cast<std::uint64_t>(v < 0 ? -v : v); }
+
+}  // namespace
+
+FixedRateLoop::FixedRateLoop(FixedRateLoopOptions options) : options_(std::move(options)) {}
+
+FixedRateLoop::~FixedRateLoop() { stop(); }
+
+Status FixedRateLoop::start(Callback callback) {
+  if (running_.load(std::memory_order_acquire)) {
+    return Error{"FixedRateLoop::start(): loop '" + options_.name + "' is already running"};
+  }
+  if (!callback) return Error{"FixedRateLoop::start(): the callback is empty"};
+  if (!std::isfinite(options_.rate_hz) || options_.rate_hz <= 0.0 || options_.rate_hz > 100'000.0) {
+    return Error{"FixedRateLoop::start(): rate_hz = " + std::to_string(options_.rate_hz) +
+                 " is out of range (expected 0 < rate_hz <= 100000)"};
+  }
+  if (!std::isfinite(options_.spin_us) || options_.spin_us < 0.0) {
+    return Error{"FixedRateLoop::start(): spin_us = " + std::to_string(options_.spin_us) +
+                 " is invalid (expected a finite value >= 0)"};
+  }
+  if (options_.raise_priority && (options_.fifo_priority < 1 || options_.fifo_priority > 99)) {
+    return Error{"FixedRateLoop::start(): fifo_priority = " + std::to_string(options_.fifo_priority) +
+                 " is out of range (expected 1..99)"};
+  }
+  // a loop that ended through request_stop() still has a thread to join
+  if (thread_.joinable()) thread_.join();
+
+  stop_requested_.store(false, std::memory_order_relaxed);
+  priority_raised_.store(false, std::memory_order_relaxed);
+  ticks_.store(0, std::memory_order_relaxed);
+  missed_deadlines_.store(0, std::memory_order_relaxed);
+  skipped_ticks_.store(0, std::memory_order_relaxed);
+  first_start_ns_.store(0, std::memory_order_relaxed);
+  last_start_ns_.store(0, std::memory_order_relaxed);
+  period_error_.reset();
+  lateness_.reset();
+  callback_duration_.reset();
+
+  running_.store(true, std::memory_order_release);
+  try {
+    thread_ = std::thread([this, cb = std::move(callback)]() mutable { run(std::move(cb)); });
+  } catch (const std::exception& e) {
+    running_.store(false, std::memory_order_release);
+    return Error{std::string("FixedRateLoop::start(): cannot create the loop thread: ") + e.what()};
+  }
+  return Ok{};
+}
+
+void FixedRateLoop::stop() {
+  stop_requested_.store(true, std::memory_order_release);
+  if (thread_.joinable()) {
+    assert(thread_.get_id() != std::this_thread::get_id() &&
+           "uh::FixedRateLoop::stop(): called from the loop's own callback; use request_stop()");
+    thread_.join();
+  }
+}
+
+void FixedRateLoop::request_stop() { stop_requested_.store(true, std::memory_order_release); }
+
+bool FixedRateLoop::running() const { return running_.load(std::memory_order_acquire); }
+
+FixedRateLoopStats FixedRateLoop::stats() const {
+  FixedRateLoopStats s;
+  s.ticks = ticks_.load(std::memory_order_acquire);
+  s.missed_deadlines = missed_deadlines_.load(std::memory_order_relaxed);
+  s.skipped_ticks = skipped_ticks_.load(std::memory_order_relaxed);
+  s.rate_hz = options_.rate_hz;
+  const std::int64_t first = first_start_ns_.load(std::memory_order_relaxed);
+  const std::int64_t last = last_start_ns_.load(std::memory_order_relaxed);
+  // ticks and the last start are two atomics: recount ticks from the same reading is not
+  // possible, so the rate may be off by one tick while the loop runs
+  if (s.ticks >= 2 && last > first) {
+    s.elapsed_s = static_cast<double>(last - first) * 1e-9;
+    s.achieved_rate_hz = static_cast<double>(s.ticks - 1) / s.elapsed_s;
+  }
+  s.period_error = period_error_.summary();
+  s.lateness = lateness_.summary();
+  s.callback_duration = callback_duration_.summary();
+  s.running = running();
+  s.priority_raised = priority_raised_.load(std::memory_order_relaxed);
+  return s;
+}
+
+void FixedRateLoop::run(Callback callback) {
+  {
+    const std::string short_name = options_.name.substr(0, 15);
+    pthread_setname_np(pthread_self(), short_name.c_str());
+  }
+  // the default timer slack (50 us) would add up to 50 us to every wake-up
+  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  if (options_.raise_priority) {
+    sched_param param{};
+    param.sched_priority = options_.fifo_priority;
+    const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+    priority_raised_.store(rc == 0, std::memory_order_relaxed);
+  }
+
+  const Nanos period(static_cast<std::int64_t>(std::llround(1e9 / options_.rate_hz)));
+  const Nanos spin(static_cast<std::int64_t>(std::llround(options_.spin_us * 1e3)));
+  const Clock::time_point origin = Clock::now();
+  std::uint64_t grid = 1;
+  Clock::time_point scheduled = origin + period;
+  Clock::time_point previous_start{};
+  std::uint64_t index = 0;
+
+  TickInfo info;
+  info.period_s = static_cast<double>(period.count()) * 1e-9;
+
+  try {
+    while (!stop_requested_.load(std::memory_order_acquire)) {
+      // sleep in chunks (so that a stop request is seen), then spin the last stretch
+      const Clock::time_point wake = scheduled - spin;
+      for (Clock::time_point now = Clock::now(); now < wake; now = Clock::now()) {
+        sleep_until(std::min(wake, now + kMaxSleepChunk));
+        if (stop_requested_.load(std::memory_order_acquire)) break;
+      }
+      if (stop_requested_.load(std::memory_order_acquire)) break;
+      Clock::time_point now = Clock::now();
+      while (now < scheduled) {
+        cpu_relax();
+        now = Clock::now();
+      }
+
+      // re-anchor instead of bursting: skip the grid points that are more than a period past
+      const Nanos late = now - scheduled;
+      if (late > period) {
+        const std::int64_t skipped = late.count() / period.count();
+        grid += static_cast<std::uint64_t>(skipped);
+        scheduled += period * skipped;
+        missed_deadlines_.fetch_add(1, std::memory_order_relaxed);
+        skipped_ticks_.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
+      }
+
+      info.index = index;
+      info.grid_index = grid;
+      info.scheduled_time = scheduled;
+      info.start_time = now;
+      info.time_s = std::chrono::duration<double>(scheduled - origin).count();
+      info.dt_s = index == 0 ? info.period_s : std::chrono::duration<double>(now - previous_start).count();
+      callback(info);
+      const Clock::time_point end = Clock::now();
+
+      lateness_.record(abs_ns((now - scheduled).count()));
+      callback_duration_.record(abs_ns((end - now).count()));
+      if (index == 0) {
+        first_start_ns_.store(to_ns(now), std::memory_order_relaxed);
+      } else {
+        period_error_.record(abs_ns((now - previous_start - period).count()));
+      }
+      last_start_ns_.store(to_ns(now), std::memory_order_relaxed);
+      ticks_.fetch_add(1, std::memory_order_release);
+
+      previous_start = now;
+      ++index;
+      ++grid;
+      scheduled += period;
+    }
+  } catch (const std::exception& e) {
+    log::error("FixedRateLoop '{}': the tick callback threw ({}); the loop stopped", options_.name, e.what());
+  } catch (...) {
+    log::error("FixedRateLoop '{}': the tick callback threw; the loop stopped", options_.name);
+  }
+  running_.store(false, std::memory_order_release);
+}
+
+}  // namespace uh
