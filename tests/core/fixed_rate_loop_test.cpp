@@ -1,0 +1,195 @@
+#include "uh/core/fixed_rate_loop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <thread>
+
+using namespace std::chrono_literals;
+
+namespace {
+
+// waits (in wall time, generously) until `pred` holds; returns whether it did
+template <typename Pred>
+bool wait_for(Pred pred, std::chrono::milliseconds limit = 10s) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST(FixedRateLoop, RunsNearItsRate) {
+  uh::FixedRateLoop loop({.rate_hz = 1000.0, .name = "test-loop"});
+  std::atomic<std::uint64_t> calls{0};
+  std::atomic<bool> indices_ok{true};
+  std::uint64_t expected_index = 0;  // loop thread only
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
+    if (t.index != expected_index || t.grid_index < t.index + 1 || t.period_s != 1e-3 ||
+        t.start_time < t.scheduled_time) {
+      indices_ok.store(false, std::memory_order_relaxed);
+    }
+    ++expected_index;
+    calls.fetch_add(1, std::memory_order_relaxed);
+  }));
+  EXPECT_TRUE(loop.running());
+  std::this_thread::sleep_for(300ms);
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+
+  const uh::FixedRateLoopStats s = loop.stats();
+  EXPECT_TRUE(indices_ok.load());
+  EXPECT_EQ(s.ticks, calls.load());
+  // sanity bounds only (speed is measured by the benchmarks): 300 ms at 1 kHz is ~300 ticks;
+  // a loaded machine may lose some, but the loop can never run more than the grid allows
+  EXPECT_GT(s.ticks, 30u);
+  EXPECT_LE(s.ticks, 310u);
+  EXPECT_GT(s.achieved_rate_hz, 100.0);
+  EXPECT_LT(s.achieved_rate_hz, 1100.0);
+  EXPECT_DOUBLE_EQ(s.rate_hz, 1000.0);
+  EXPECT_EQ(s.lateness.count, s.ticks);
+  EXPECT_EQ(s.callback_duration.count, s.ticks);
+  EXPECT_EQ(s.period_error.count, s.ticks - 1);
+  EXPECT_LE(s.period_error.p50_ns, s.period_error.p99_ns);
+  EXPECT_LE(s.period_error.p99_ns, s.period_error.p999_ns);
+  EXPECT_LE(s.period_error.p999_ns, s.period_error.max_ns);
+  EXPECT_FALSE(s.running);
+  EXPECT_FALSE(s.priority_raised) << "priority was not asked for";
+}
+
+TEST(FixedRateLoop, KeepsAbsoluteDeadlines) {
+  // scheduled(k) = origin + k * period for every tick, however late it starts, and no tick starts
+  // before its deadline
+  constexpr std::chrono::nanoseconds kPeriod(500'000);
+  uh::FixedRateLoop loop({.rate_hz = 2000.0});
+  std::atomic<int> violations{0};
+  std::chrono::steady_clock::time_point origin{};
+  std::uint64_t previous_grid = 0;
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
+    const auto this_origin = t.scheduled_time - kPeriod * static_cast<std::int64_t>(t.grid_index);
+    if (t.index == 0) origin = this_origin;
+    if (this_origin != origin || t.start_time < t.scheduled_time || t.grid_index <= previous_grid) {
+      violations.fetch_add(1);
+    }
+    previous_grid = t.grid_index;
+    if (t.index >= 200) loop.request_stop();
+  }));
+  EXPECT_TRUE(wait_for([&] { return !loop.running(); }));
+  loop.stop();
+  EXPECT_EQ(violations.load(), 0);
+  EXPECT_EQ(loop.stats().ticks, 201u);
+}
+
+TEST(FixedRateLoop, StartAndStopAreIdempotent) {
+  uh::FixedRateLoop loop({.rate_hz = 1000.0});
+  loop.stop();  // never started: no effect
+  std::atomic<int> calls{0};
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo&) { calls.fetch_add(1); }));
+  const uh::Status second = loop.start([](const uh::TickInfo&) {});
+  ASSERT_FALSE(second);
+  EXPECT_NE(second.error().message.find("already running"), std::string::npos);
+  EXPECT_TRUE(wait_for([&] { return calls.load() >= 5; }));
+  loop.stop();
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+  const int after_stop = calls.load();
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(calls.load(), after_stop) << "no tick may run after stop() returned";
+
+  // restart: statistics start again from zero
+  std::atomic<int> calls2{0};
+  std::atomic<bool> index_restarted{false};
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
+    if (t.index == 0 && calls2.load() == 0) index_restarted.store(true);
+    calls2.fetch_add(1);
+  }));
+  EXPECT_TRUE(wait_for([&] { return calls2.load() >= 5; }));
+  loop.stop();
+  EXPECT_TRUE(index_restarted.load());
+  EXPECT_EQ(loop.stats().ticks, static_cast<std::uint64_t>(calls2.load()));
+}
+
+TEST(FixedRateLoop, RejectsInvalidOptions) {
+  auto noop = [](const uh::TickInfo&) {};
+  EXPECT_FALSE(uh::FixedRateLoop({.rate_hz = 0.0}).start(noop));
+  EXPECT_FALSE(uh::FixedRateLoop({.rate_hz = -5.0}).start(noop));
+  EXPECT_FALSE(uh::FixedRateLoop({.rate_hz = 1e9}).start(noop));
+  EXPECT_FALSE(uh::FixedRateLoop({.spin_us = -1.0}).start(noop));
+  EXPECT_FALSE(uh::FixedRateLoop({.raise_priority = true, .fifo_priority = 0}).start(noop));
+  uh::FixedRateLoop loop;
+  EXPECT_FALSE(loop.start(uh::FixedRateLoop::Callback{}));
+  EXPECT_FALSE(loop.running());
+}
+
+TEST(FixedRateLoop, StatsAreReadableWhileRunning) {
+  uh::FixedRateLoop loop({.rate_hz = 4000.0});
+  ASSERT_TRUE(loop.start([](const uh::TickInfo&) {}));
+  std::uint64_t last_ticks = 0;
+  bool monotonic = true;
+  for (int i = 0; i < 50; ++i) {
+    const uh::FixedRateLoopStats s = loop.stats();
+    if (s.ticks < last_ticks) monotonic = false;
+    last_ticks = s.ticks;
+    std::this_thread::sleep_for(1ms);
+  }
+  EXPECT_TRUE(wait_for([&] { return loop.stats().ticks >= 20; }));
+  loop.stop();
+  EXPECT_TRUE(monotonic);
+  EXPECT_GT(loop.stats().ticks, last_ticks - 1);
+}
+
+TEST(FixedRateLoop, CountsMissedDeadlinesAndSkipsInsteadOfBursting) {
+  // every 5th tick sleeps 3.5 periods: each overrun misses a deadline and drops ~3 grid points
+  uh::FixedRateLoop loop({.rate_hz = 500.0});
+  std::atomic<int> overruns{0};
+  std::atomic<int> short_gaps{0};
+  std::chrono::steady_clock::time_point previous_start{};
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
+    // after a skip the loop restarts on the grid instead of running back-to-back catch-up ticks
+    if (t.index > 0 && t.start_time - previous_start < 100us) short_gaps.fetch_add(1);
+    previous_start = t.start_time;
+    if (t.index % 5 == 0 && overruns.load() < 10) {
+      overruns.fetch_add(1);
+      std::this_thread::sleep_for(7ms);
+    }
+  }));
+  EXPECT_TRUE(wait_for([&] { return overruns.load() >= 10; }));
+  std::this_thread::sleep_for(20ms);
+  loop.stop();
+  const uh::FixedRateLoopStats s = loop.stats();
+  EXPECT_GE(s.missed_deadlines, 10u);
+  EXPECT_GE(s.skipped_ticks, 20u);  // 7 ms overrun at 2 ms period: at least 2 skipped per overrun
+  // a catch-up burst would give 3 back-to-back ticks per overrun; re-anchoring gives none, bar a
+  // rare one when the sleep overshoots by almost a period
+  EXPECT_LE(short_gaps.load(), 3);
+  EXPECT_GE(s.callback_duration.max_ns, 7e6);
+}
+
+TEST(FixedRateLoop, ExposesRaisePriorityOutcome) {
+  // SCHED_FIFO needs a privilege this machine may lack: start() must succeed either way
+  uh::FixedRateLoop loop({.rate_hz = 1000.0, .raise_priority = true});
+  std::atomic<int> calls{0};
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo&) { calls.fetch_add(1); }));
+  EXPECT_TRUE(wait_for([&] { return calls.load() >= 3; }));
+  loop.stop();
+  const uh::FixedRateLoopStats s = loop.stats();
+  EXPECT_GE(s.ticks, 3u);
+  RecordProperty("priority_raised", s.priority_raised ? "yes" : "no");
+}
+
+TEST(FixedRateLoop, DestructorStopsTheThread) {
+  std::atomic<int> calls{0};
+  {
+    uh::FixedRateLoop loop({.rate_hz = 1000.0});
+    ASSERT_TRUE(loop.start([&](const uh::TickInfo&) { calls.fetch_add(1); }));
+    EXPECT_TRUE(wait_for([&] { return calls.load() >= 2; }));
+  }
+  const int after = calls.load();
+  std::this_thread::sleep_for(10ms);
+  EXPECT_EQ(calls.load(), after);
+}
