@@ -6,7 +6,9 @@
 /// trivially copyable, have a fixed capacity plus a count, and use integer ids, never pointers,
 /// so that a whole frame can cross threads through a LatestValue handoff.
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
@@ -56,5 +58,25 @@ struct ContactFrame {
   std::array<SpherePairContact, kMaxPairs> pairs{};
 };
 static_assert(std::is_trivially_copyable_v<ContactFrame>);
+
+/// Copies `src` into `dst`, only the `pair_count` valid pairs (a full ContactFrame is ~2.5 MB;
+/// a frame usually holds a few thousand pairs). Real-time safe.
+inline void copy_contact_frame(const ContactFrame& src, ContactFrame& dst) {
+  const auto count = static_cast<std::size_t>(src.pair_count < 0 ? 0 : src.pair_count);
+  dst.sequence = src.sequence;
+  dst.time_s = src.time_s;
+  dst.object_a = src.object_a;
+  dst.object_b = src.object_b;
+  dst.world_from_a = src.world_from_a;
+  dst.world_from_b = src.world_from_b;
+  dst.total_volume = src.total_volume;
+  dst.restoring_direction_world = src.restoring_direction_world;
+  dst.volume_centroid_world = src.volume_centroid_world;
+  dst.distance = src.distance;
+  dst.query_seconds = src.query_seconds;
+  dst.pair_count = src.pair_count;
+  dst.truncated = src.truncated;
+  std::copy_n(src.pairs.begin(), count < src.pairs.size() ? count : src.pairs.size(), dst.pairs.begin());
+}
 
 }  // namespace uh

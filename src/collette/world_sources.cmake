@@ -1,0 +1,4 @@
+# the collision world and its thread
+list(APPEND UH_COLLETTE_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/collision_world.cpp
+)
