@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// The .ist asset file: a packed and built Inner Sphere Tree with the facts about its packing.
+///
+/// Versioned little-endian binary (byte layout in docs/collette-queries.md): a 128-byte header
+/// (magic, format version, counts, units, a hash of the source mesh, packing report, payload size,
+/// CRC-32 of the payload and of the header), then the node array (32 bytes a node) and the leaf
+/// spheres (16 bytes each). Loaders check every count against the real size before allocating
+/// and validate() the tree, so a hostile file gives an error message, never a crash.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "uh/collette/sphere_tree.hpp"
+#include "uh/core/result.hpp"
+
+namespace uh::collette {
+
+/// Format version written by save_ist() and the only one load_ist() reads.
+inline constexpr std::uint32_t kIstFormatVersion = 1;
+/// Size of the fixed header [bytes].
+inline constexpr std::size_t kIstHeaderSize = 128;
+
+/// Facts stored next to the tree: units, provenance and the packing report.
+struct IstMetadata {
+  double meters_per_unit = 1.0;       ///< length of one mesh unit [m]
+  std::uint64_t source_mesh_hash = 0; ///< hash of the source mesh (e.g. ist_hash_bytes of the file), 0 if unknown
+  double coverage = 0.0;              ///< sphere volume / mesh volume, 0..1
+  double mesh_volume = 0.0;           ///< volume of the closed mesh [length^3]
+  double max_gap = 0.0;               ///< largest distance from the surface to the spheres [length]
+  double build_seconds = 0.0;         ///< time the packing and tree build took [s]
+};
+
+/// A loaded or to-be-saved asset. The sphere count, node count and depth come from the tree.
+struct IstAsset {
+  SphereTree tree;
+  IstMetadata meta;
+};
+
+/// Writes `asset` to `path` atomically: to a temporary file in the same directory, flushed to
+/// disk, then renamed over `path`, so a failure never leaves a half-written or clobbered file.
+/// Fails (message names the file) when the tree is invalid or the file cannot be written.
+/// Not real-time safe; any thread.
+Status save_ist(const std::filesystem::path& path, const IstAsset& asset);
+
+/// Reads and checks a .ist file. The error names the file and says what is wrong: missing,
+/// truncated, not a .ist file (magic), unsupported format version, corrupted (checksum), or
+/// an invalid tree. Not real-time safe; any thread.
+Result<IstAsset> load_ist(const std::filesystem::path& path);
+
+/// Decodes a .ist image from memory (the fuzz target's entry point). `name` prefixes messages.
+Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::string_view name = "<memory>");
+
+/// Encodes `asset` (not validated) into a .ist image.
+std::vector<std::byte> encode_ist(const IstAsset& asset);
+
+/// CRC-32 (IEEE 802.3, as zlib's crc32) of `bytes`.
+std::uint32_t ist_crc32(std::span<const std::byte> bytes);
+
+/// 64-bit FNV-1a hash of `bytes`, for IstMetadata::source_mesh_hash.
+std::uint64_t ist_hash_bytes(std::span<const std::byte> bytes);
+
+}  // namespace uh::collette

@@ -1,0 +1,78 @@
+#pragma once
+/// \file
+/// SphereTree: an Inner Sphere Tree, the immutable n-ary bounding-sphere hierarchy over the
+/// non-overlapping leaf spheres that fill an object (after Weller & Zachmann's IST, laid out like
+/// madmann91/bvh v2: flat node array, int32 indices, contiguous children).
+///
+/// Built by build_sphere_tree() (sphere_tree_builder.hpp) or loaded from a .ist file
+/// (ist_file.hpp). Once built it never changes: share it read-only between any number of threads;
+/// the per-thread scratch lives in the query objects (volume_query.hpp, ...).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "uh/core/contact.hpp"
+#include "uh/core/result.hpp"
+
+namespace uh::collette {
+
+/// One node of a SphereTree: 32 bytes, so that two nodes share a cache line and a 4-child block
+/// is two lines. Frame and length unit: those of the object's mesh.
+struct SphereTreeNode {
+  float x = 0.f;       ///< centre of the node's sphere [length]
+  float y = 0.f;
+  float z = 0.f;
+  float radius = 0.f;  ///< inner node: encloses every leaf sphere below; leaf: the leaf sphere [length]
+  float volume = 0.f;  ///< total volume of the leaf spheres at or below this node [length^3]
+  std::int32_t first = 0;   ///< inner node: index of the first child; leaf: index into SphereTree::leaves()
+  std::int32_t count = 0;   ///< inner node: number of children (contiguous from `first`), >= 1; leaf: 0
+  std::int32_t parent = -1; ///< index of the parent node; -1 for the root (node 0)
+
+  constexpr bool is_leaf() const { return count == 0; }
+};
+static_assert(sizeof(SphereTreeNode) == 32);
+
+/// The most children an inner node may have (builder arity and file loader limit).
+inline constexpr int kMaxSphereTreeArity = 8;
+
+/// An immutable Inner Sphere Tree. Node 0 is the root. Owns its arrays.
+/// Thread rules: all member functions are const and may be called from any thread concurrently.
+class SphereTree {
+ public:
+  SphereTree() = default;
+  /// Takes the arrays as they are; call validate() on data from outside (files, tests).
+  SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> leaves, int depth, int arity)
+      : nodes_(std::move(nodes)), leaves_(std::move(leaves)), depth_(depth), arity_(arity) {}
+
+  std::span<const SphereTreeNode> nodes() const { return nodes_; }
+  /// The leaf spheres in their original (packing) order; leaf nodes refer to them by index.
+  std::span<const Sphere> leaves() const { return leaves_; }
+  const SphereTreeNode& root() const { return nodes_.front(); }
+  bool empty() const { return nodes_.empty(); }
+  int node_count() const { return static_cast<int>(nodes_.size()); }
+  int leaf_count() const { return static_cast<int>(leaves_.size()); }
+  /// Number of node levels on the longest root-to-leaf path (a single leaf: 1).
+  int depth() const { return depth_; }
+  /// The largest number of children the builder allowed per node.
+  int arity() const { return arity_; }
+  /// Sum of the leaf sphere volumes [length^3].
+  double total_volume() const { return nodes_.empty() ? 0.0 : static_cast<double>(nodes_.front().volume); }
+
+ private:
+  std::vector<SphereTreeNode> nodes_;
+  std::vector<Sphere> leaves_;
+  int depth_ = 0;
+  int arity_ = 0;
+};
+
+/// Checks every invariant of `tree`: non-empty; children contiguous, in range and at most
+/// kMaxSphereTreeArity per node; every node reached exactly once from the root (no cycles, no
+/// sharing) with matching parent links; each leaf index used exactly once and the leaf node equal
+/// to its leaf sphere; finite values and positive radii; each inner node enclosing every leaf sphere
+/// below it (relative tolerance 1e-5 of the root radius); volumes summing up (relative 1e-4);
+/// the stored depth. The error message names the first broken invariant and node.
+/// Not real-time safe (allocates); any thread.
+Status validate(const SphereTree& tree);
+
+}  // namespace uh::collette

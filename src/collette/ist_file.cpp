@@ -1,0 +1,252 @@
+#include "uh/collette/ist_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <system_error>
+
+namespace uh::collette {
+namespace {
+
+constexpr std::array<unsigned char, 8> kMagic{'U', 'H', 'I', 'S', 'T', '\r', '\n', 0x1a};
+constexpr std::size_t kNodeBytes = 32;
+constexpr std::size_t kLeafBytes = 16;
+// header field offsets [bytes]
+constexpr std::size_t kOffVersion = 8, kOffHeaderSize = 12, kOffNodes = 16, kOffLeaves = 20, kOffDepth = 24,
+                      kOffArity = 28, kOffMetersPerUnit = 32, kOffMeshHash = 40, kOffCoverage = 48,
+                      kOffMeshVolume = 56, kOffMaxGap = 64, kOffBuildSeconds = 72, kOffSphereCount = 80,
+                      kOffFlags = 84, kOffPayloadBytes = 88, kOffPayloadCrc = 96, kOffHeaderCrc = 100;
+// a .ist above this size is refused before reading it into memory
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 31;
+
+std::array<std::uint32_t, 256> make_crc_table() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t i = 0; i < 256; ++i) {
+    std::uint32_t c = i;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    t[i] = c;
+  }
+  return t;
+}
+
+void put_u32(std::byte* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::byte>((v >> (8 * i)) & 0xffu);
+}
+void put_u64(std::byte* p, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i) p[i] = static_cast<std::byte>((v >> (8 * i)) & 0xffu);
+}
+void put_f32(std::byte* p, float v) { put_u32(p, std::bit_cast<std::uint32_t>(v)); }
+void put_f64(std::byte* p, double v) { put_u64(p, std::bit_cast<std::uint64_t>(v)); }
+void put_i32(std::byte* p, std::int32_t v) { put_u32(p, static_cast<std::uint32_t>(v)); }
+
+std::uint32_t get_u32(const std::byte* p) {
+  std::uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(p[i]) << (8 * i);
+  return v;
+}
+std::uint64_t get_u64(const std::byte* p) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
+  return v;
+}
+float get_f32(const std::byte* p) { return std::bit_cast<float>(get_u32(p)); }
+double get_f64(const std::byte* p) { return std::bit_cast<double>(get_u64(p)); }
+std::int32_t get_i32(const std::byte* p) { return static_cast<std::int32_t>(get_u32(p)); }
+
+std::string str(std::string_view s) { return std::string(s); }
+
+}  // namespace
+
+std::uint32_t ist_crc32(std::span<const std::byte> bytes) {
+  static const std::array<std::uint32_t, 256> table = make_crc_table();
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (std::byte b : bytes) c = table[(c ^ static_cast<std::uint32_t>(b)) & 0xffu] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+std::uint64_t ist_hash_bytes(std::span<const std::byte> bytes) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (std::byte b : bytes) {
+    h ^= static_cast<std::uint64_t>(b);
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+std::vector<std::byte> encode_ist(const IstAsset& asset) {
+  const auto nodes = asset.tree.nodes();
+  const auto leaves = asset.tree.leaves();
+  const std::size_t payload = nodes.size() * kNodeBytes + leaves.size() * kLeafBytes;
+  std::array<std::byte, kIstHeaderSize> header{};
+  std::vector<std::byte> body(payload, std::byte{0});
+  std::byte* h = header.data();
+  std::memcpy(h, kMagic.data(), kMagic.size());
+  put_u32(h + kOffVersion, kIstFormatVersion);
+  put_u32(h + kOffHeaderSize, static_cast<std::uint32_t>(kIstHeaderSize));
+  put_u32(h + kOffNodes, static_cast<std::uint32_t>(nodes.size()));
+  put_u32(h + kOffLeaves, static_cast<std::uint32_t>(leaves.size()));
+  put_u32(h + kOffDepth, static_cast<std::uint32_t>(asset.tree.depth()));
+  put_u32(h + kOffArity, static_cast<std::uint32_t>(asset.tree.arity()));
+  put_f64(h + kOffMetersPerUnit, asset.meta.meters_per_unit);
+  put_u64(h + kOffMeshHash, asset.meta.source_mesh_hash);
+  put_f64(h + kOffCoverage, asset.meta.coverage);
+  put_f64(h + kOffMeshVolume, asset.meta.mesh_volume);
+  put_f64(h + kOffMaxGap, asset.meta.max_gap);
+  put_f64(h + kOffBuildSeconds, asset.meta.build_seconds);
+  put_u32(h + kOffSphereCount, static_cast<std::uint32_t>(leaves.size()));
+  put_u32(h + kOffFlags, 0);
+  put_u64(h + kOffPayloadBytes, payload);
+  std::byte* p = body.data();
+  for (const SphereTreeNode& n : nodes) {
+    put_f32(p + 0, n.x);
+    put_f32(p + 4, n.y);
+    put_f32(p + 8, n.z);
+    put_f32(p + 12, n.radius);
+    put_f32(p + 16, n.volume);
+    put_i32(p + 20, n.first);
+    put_i32(p + 24, n.count);
+    put_i32(p + 28, n.parent);
+    p += kNodeBytes;
+  }
+  for (const Sphere& s : leaves) {
+    put_f32(p + 0, s.x);
+    put_f32(p + 4, s.y);
+    put_f32(p + 8, s.z);
+    put_f32(p + 12, s.radius);
+    p += kLeafBytes;
+  }
+  put_u32(h + kOffPayloadCrc, ist_crc32(body));
+  put_u32(h + kOffHeaderCrc, ist_crc32({h, kOffHeaderCrc}));
+  body.resize(kIstHeaderSize + payload);
+  std::memmove(body.data() + kIstHeaderSize, body.data(), payload);
+  std::memcpy(body.data(), header.data(), kIstHeaderSize);
+  return body;
+}
+
+Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::string_view name) {
+  const std::string who = str(name) + ": ";
+  const std::size_t size = bytes.size();
+  const std::byte* h = bytes.data();
+  const std::size_t magic_len = std::min(size, kMagic.size());
+  if (magic_len == 0 || std::memcmp(h, kMagic.data(), magic_len) != 0)
+    return Error{who + "not a .ist sphere-tree file (wrong magic bytes)"};
+  if (size < kIstHeaderSize)
+    return Error{who + "truncated: " + std::to_string(size) + " bytes, but the .ist header alone has " +
+                 std::to_string(kIstHeaderSize)};
+  const std::uint32_t version = get_u32(h + kOffVersion);
+  if (version != kIstFormatVersion)
+    return Error{who + "unsupported .ist format version " + std::to_string(version) + " (this build reads version " +
+                 std::to_string(kIstFormatVersion) + "; rebuild the file with this version)"};
+  if (get_u32(h + kOffHeaderCrc) != ist_crc32({h, kOffHeaderCrc}))
+    return Error{who + "corrupted: header checksum mismatch"};
+  if (get_u32(h + kOffHeaderSize) != kIstHeaderSize)
+    return Error{who + "corrupted: header size " + std::to_string(get_u32(h + kOffHeaderSize)) + ", expected " +
+                 std::to_string(kIstHeaderSize)};
+  const std::uint64_t node_count = get_u32(h + kOffNodes);
+  const std::uint64_t leaf_count = get_u32(h + kOffLeaves);
+  const std::uint64_t payload = get_u64(h + kOffPayloadBytes);
+  if (node_count == 0 || leaf_count == 0 || node_count > 2 * leaf_count || get_u32(h + kOffSphereCount) != leaf_count)
+    return Error{who + "corrupted: inconsistent counts (" + std::to_string(node_count) + " nodes, " +
+                 std::to_string(leaf_count) + " leaves, " + std::to_string(get_u32(h + kOffSphereCount)) + " spheres)"};
+  const std::uint64_t expected = node_count * kNodeBytes + leaf_count * kLeafBytes;
+  if (payload != expected)
+    return Error{who + "corrupted: payload size " + std::to_string(payload) + " does not match the counts (" +
+                 std::to_string(expected) + " bytes)"};
+  // compare with the bytes really present before allocating anything
+  if (size - kIstHeaderSize < payload)
+    return Error{who + "truncated: " + std::to_string(size) + " bytes, the header announces " +
+                 std::to_string(kIstHeaderSize + payload)};
+  if (size - kIstHeaderSize > payload)
+    return Error{who + "corrupted: " + std::to_string(size - kIstHeaderSize - payload) + " unexpected bytes after the payload"};
+  if (get_u32(h + kOffPayloadCrc) != ist_crc32({h + kIstHeaderSize, static_cast<std::size_t>(payload)}))
+    return Error{who + "corrupted: payload checksum mismatch"};
+
+  std::vector<SphereTreeNode> nodes(static_cast<std::size_t>(node_count));
+  std::vector<Sphere> leaves(static_cast<std::size_t>(leaf_count));
+  const std::byte* p = h + kIstHeaderSize;
+  for (SphereTreeNode& n : nodes) {
+    n = {get_f32(p + 0), get_f32(p + 4),  get_f32(p + 8),  get_f32(p + 12),
+         get_f32(p + 16), get_i32(p + 20), get_i32(p + 24), get_i32(p + 28)};
+    p += kNodeBytes;
+  }
+  for (Sphere& s : leaves) {
+    s = {get_f32(p + 0), get_f32(p + 4), get_f32(p + 8), get_f32(p + 12)};
+    p += kLeafBytes;
+  }
+  const std::uint32_t depth = get_u32(h + kOffDepth);
+  const std::uint32_t arity = get_u32(h + kOffArity);
+  if (depth > node_count || arity < 2 || arity > static_cast<std::uint32_t>(kMaxSphereTreeArity))
+    return Error{who + "corrupted: depth " + std::to_string(depth) + " or arity " + std::to_string(arity) + " out of range"};
+  IstAsset asset{SphereTree(std::move(nodes), std::move(leaves), static_cast<int>(depth), static_cast<int>(arity)), {}};
+  if (const Status ok = validate(asset.tree); !ok) return Error{who + "invalid tree: " + ok.error().message};
+  for (int c = 0; c < asset.tree.node_count(); ++c)
+    if (asset.tree.nodes()[static_cast<std::size_t>(c)].count > asset.tree.arity())
+      return Error{who + "invalid tree: node " + std::to_string(c) + " has more children than the arity " +
+                   std::to_string(arity)};
+  asset.meta.meters_per_unit = get_f64(h + kOffMetersPerUnit);
+  asset.meta.source_mesh_hash = get_u64(h + kOffMeshHash);
+  asset.meta.coverage = get_f64(h + kOffCoverage);
+  asset.meta.mesh_volume = get_f64(h + kOffMeshVolume);
+  asset.meta.max_gap = get_f64(h + kOffMaxGap);
+  asset.meta.build_seconds = get_f64(h + kOffBuildSeconds);
+  return asset;
+}
+
+Result<IstAsset> load_ist(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Error{name + ": cannot open .ist file: " + ec.message()};
+  if (size > kMaxFileBytes) return Error{name + ": " + std::to_string(size) + " bytes is too large for a .ist file"};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{name + ": cannot open .ist file for reading"};
+  std::vector<std::byte> bytes(static_cast<std::size_t>(size));
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size)
+    return Error{name + ": read error (got " + std::to_string(in.gcount()) + " of " + std::to_string(size) + " bytes)"};
+  return load_ist_from_memory(bytes, name);
+}
+
+Status save_ist(const std::filesystem::path& path, const IstAsset& asset) {
+  const std::string name = path.string();
+  if (const Status ok = validate(asset.tree); !ok) return Error{name + ": not saved: " + ok.error().message};
+  const std::vector<std::byte> bytes = encode_ist(asset);
+  const std::string tmp = name + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return Error{name + ": cannot create temporary file " + tmp + ": " + std::strerror(errno)};
+  auto fail = [&](const char* what) {
+    const std::string msg = name + ": " + what + ": " + std::strerror(errno);
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    return Error{msg};
+  };
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      return fail("write failed");
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (::fsync(fd) != 0) return fail("fsync failed");
+  if (::close(fd) != 0) {
+    const std::string msg = name + ": close failed: " + std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return Error{msg};
+  }
+  if (::rename(tmp.c_str(), name.c_str()) != 0) {
+    const std::string msg = name + ": cannot rename the temporary file into place: " + std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return Error{msg};
+  }
+  return Ok{};
+}
+
+}  // namespace uh::collette

@@ -1,0 +1,108 @@
+#include "uh/collette/sphere_tree.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace uh::collette {
+namespace {
+
+Error node_error(int node, const std::string& what) {
+  return Error{"sphere tree: node " + std::to_string(node) + ": " + what};
+}
+
+bool finite_node(const SphereTreeNode& n) {
+  return std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z) && std::isfinite(n.radius) &&
+         std::isfinite(n.volume);
+}
+
+double sphere_volume(double r) { return 4.0 / 3.0 * 3.14159265358979323846 * r * r * r; }
+
+}  // namespace
+
+Status validate(const SphereTree& tree) {
+  const auto nodes = tree.nodes();
+  const auto leaves = tree.leaves();
+  if (nodes.empty()) return Error{"sphere tree: no nodes (an empty tree cannot be queried)"};
+  const int n = static_cast<int>(nodes.size());
+  const int leaf_total = static_cast<int>(leaves.size());
+  if (nodes[0].parent != -1) return node_error(0, "the root has parent " + std::to_string(nodes[0].parent) + ", expected -1");
+
+  // reach every node from the root exactly once, checking the links on the way
+  std::vector<int> depth_of(static_cast<std::size_t>(n), 0);
+  std::vector<char> leaf_used(static_cast<std::size_t>(leaf_total), 0);
+  std::vector<int> queue;
+  queue.reserve(static_cast<std::size_t>(n));
+  queue.push_back(0);
+  depth_of[0] = 1;
+  int max_depth = 0;
+  int leaf_nodes = 0;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int i = queue[head];
+    const SphereTreeNode& node = nodes[static_cast<std::size_t>(i)];
+    const int d = depth_of[static_cast<std::size_t>(i)];
+    if (d > max_depth) max_depth = d;
+    if (!finite_node(node)) return node_error(i, "non-finite centre, radius or volume");
+    if (!(node.radius > 0.f)) return node_error(i, "radius " + std::to_string(node.radius) + " is not positive");
+    if (!(node.volume > 0.f)) return node_error(i, "volume " + std::to_string(node.volume) + " is not positive");
+    if (node.count < 0 || node.count > kMaxSphereTreeArity)
+      return node_error(i, "child count " + std::to_string(node.count) + " outside 0.." + std::to_string(kMaxSphereTreeArity));
+    if (node.is_leaf()) {
+      ++leaf_nodes;
+      if (node.first < 0 || node.first >= leaf_total)
+        return node_error(i, "leaf index " + std::to_string(node.first) + " outside 0.." + std::to_string(leaf_total - 1));
+      char& used = leaf_used[static_cast<std::size_t>(node.first)];
+      if (used) return node_error(i, "leaf index " + std::to_string(node.first) + " used twice");
+      used = 1;
+      const Sphere& s = leaves[static_cast<std::size_t>(node.first)];
+      if (s.x != node.x || s.y != node.y || s.z != node.z || s.radius != node.radius)
+        return node_error(i, "leaf node differs from leaf sphere " + std::to_string(node.first));
+      const double expected = sphere_volume(static_cast<double>(node.radius));
+      if (std::abs(static_cast<double>(node.volume) - expected) > 1e-4 * expected)
+        return node_error(i, "leaf volume " + std::to_string(node.volume) + " is not the sphere volume " + std::to_string(expected));
+      continue;
+    }
+    if (node.first < 1 || node.first > n - node.count)
+      return node_error(i, "children " + std::to_string(node.first) + "+" + std::to_string(node.count) +
+                               " outside the node array 1.." + std::to_string(n - 1));
+    double child_volume = 0.0;
+    for (int c = node.first; c < node.first + node.count; ++c) {
+      const SphereTreeNode& child = nodes[static_cast<std::size_t>(c)];
+      if (child.parent != i)
+        return node_error(c, "parent link " + std::to_string(child.parent) + " but it is a child of node " + std::to_string(i));
+      if (depth_of[static_cast<std::size_t>(c)] != 0) return node_error(c, "reached twice (cycle or shared child)");
+      depth_of[static_cast<std::size_t>(c)] = d + 1;
+      child_volume += static_cast<double>(child.volume);
+      queue.push_back(c);
+    }
+    if (std::abs(child_volume - static_cast<double>(node.volume)) > 1e-4 * child_volume)
+      return node_error(i, "volume " + std::to_string(node.volume) + " is not the sum of its children's " + std::to_string(child_volume));
+  }
+  if (static_cast<int>(queue.size()) != n)
+    return Error{"sphere tree: " + std::to_string(n - static_cast<int>(queue.size())) + " of " + std::to_string(n) +
+                 " nodes are not reachable from the root"};
+  if (leaf_nodes != leaf_total)
+    return Error{"sphere tree: " + std::to_string(leaf_nodes) + " leaf nodes for " + std::to_string(leaf_total) + " leaf spheres"};
+  if (max_depth != tree.depth())
+    return Error{"sphere tree: stored depth " + std::to_string(tree.depth()) + " but the longest path has " + std::to_string(max_depth) + " levels"};
+
+  // every ancestor encloses every leaf below it; parent chains are known to be acyclic now
+  const double tol = 1e-5 * static_cast<double>(nodes[0].radius);
+  for (int i = 0; i < n; ++i) {
+    const SphereTreeNode& leaf = nodes[static_cast<std::size_t>(i)];
+    if (!leaf.is_leaf()) continue;
+    for (int p = leaf.parent; p >= 0; p = nodes[static_cast<std::size_t>(p)].parent) {
+      const SphereTreeNode& a = nodes[static_cast<std::size_t>(p)];
+      const double dx = static_cast<double>(leaf.x) - static_cast<double>(a.x);
+      const double dy = static_cast<double>(leaf.y) - static_cast<double>(a.y);
+      const double dz = static_cast<double>(leaf.z) - static_cast<double>(a.z);
+      const double reach = std::sqrt(dx * dx + dy * dy + dz * dz) + static_cast<double>(leaf.radius);
+      if (reach > static_cast<double>(a.radius) + tol)
+        return node_error(p, "does not enclose leaf node " + std::to_string(i) + " (reach " + std::to_string(reach) +
+                                 " > radius " + std::to_string(a.radius) + ")");
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace uh::collette

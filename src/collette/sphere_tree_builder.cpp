@@ -1,0 +1,265 @@
+#include "uh/collette/sphere_tree_builder.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace uh::collette {
+namespace {
+
+constexpr double kPiD = 3.14159265358979323846;
+
+struct Vec3d {
+  double x, y, z;
+};
+
+Vec3d centre_of(const Sphere& s) {
+  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+}
+
+double dist(const Vec3d& a, const Vec3d& b) {
+  const double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double sphere_volume(const Sphere& s) {
+  const double r = static_cast<double>(s.radius);
+  return 4.0 / 3.0 * kPiD * r * r * r;
+}
+
+// Tight sphere around the spheres leaves[idx[i]]: start at the box centre, then repeatedly step
+// towards the farthest point (Badoiu-Clarkson for balls) with shrinking steps, keeping the best.
+SphereTreeNode enclose(std::span<const Sphere> leaves, std::span<const int> idx, int iterations) {
+  Vec3d lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
+  Vec3d hi{-lo.x, -lo.y, -lo.z};
+  for (int i : idx) {
+    const Sphere& s = leaves[static_cast<std::size_t>(i)];
+    const Vec3d c = centre_of(s);
+    const double r = static_cast<double>(s.radius);
+    lo = {std::min(lo.x, c.x - r), std::min(lo.y, c.y - r), std::min(lo.z, c.z - r)};
+    hi = {std::max(hi.x, c.x + r), std::max(hi.y, c.y + r), std::max(hi.z, c.z + r)};
+  }
+  auto farthest = [&](const Vec3d& c, int& which) {
+    double best = -1.0;
+    for (int i : idx) {
+      const Sphere& s = leaves[static_cast<std::size_t>(i)];
+      const double reach = dist(c, centre_of(s)) + static_cast<double>(s.radius);
+      if (reach > best) {
+        best = reach;
+        which = i;
+      }
+    }
+    return best;
+  };
+  Vec3d c{0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z)};
+  int far = idx[0];
+  double best_r = farthest(c, far);
+  Vec3d best_c = c;
+  for (int t = 1; t <= iterations; ++t) {
+    const Sphere& s = leaves[static_cast<std::size_t>(far)];
+    const Vec3d sc = centre_of(s);
+    const double d = dist(c, sc);
+    Vec3d p = sc;
+    if (d > 0.0) {
+      const double k = static_cast<double>(s.radius) / d;
+      p = {sc.x + (sc.x - c.x) * k, sc.y + (sc.y - c.y) * k, sc.z + (sc.z - c.z) * k};
+    }
+    const double step = 1.0 / (t + 1.0);
+    c = {c.x + (p.x - c.x) * step, c.y + (p.y - c.y) * step, c.z + (p.z - c.z) * step};
+    const double r = farthest(c, far);
+    if (r < best_r) {
+      best_r = r;
+      best_c = c;
+    }
+  }
+  // round the centre to float, then make the float radius enclose every sphere from that centre
+  SphereTreeNode node;
+  node.x = static_cast<float>(best_c.x);
+  node.y = static_cast<float>(best_c.y);
+  node.z = static_cast<float>(best_c.z);
+  const Vec3d cf{static_cast<double>(node.x), static_cast<double>(node.y), static_cast<double>(node.z)};
+  int unused = 0;
+  const double r = farthest(cf, unused);
+  float rf = static_cast<float>(r);
+  while (static_cast<double>(rf) < r * (1.0 + 1e-7)) rf = std::nextafter(rf, std::numeric_limits<float>::infinity());
+  node.radius = rf;
+  return node;
+}
+
+// Splits idx into at most k clusters by volume-weighted k-means on the centres; returns the
+// cluster sizes after reordering idx so that clusters are contiguous. Deterministic.
+std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k, int iterations) {
+  const std::size_t m = idx.size();
+  // seed: volume quantiles along the longest axis of the centres' box
+  Vec3d lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
+  Vec3d hi{-lo.x, -lo.y, -lo.z};
+  for (int i : idx) {
+    const Vec3d c = centre_of(leaves[static_cast<std::size_t>(i)]);
+    lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
+    hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
+  }
+  const double ex = hi.x - lo.x, ey = hi.y - lo.y, ez = hi.z - lo.z;
+  const int axis = (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
+  auto coord = [&](int i) {
+    const Sphere& s = leaves[static_cast<std::size_t>(i)];
+    return axis == 0 ? s.x : (axis == 1 ? s.y : s.z);
+  };
+  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
+  double total = 0.0;
+  for (int i : idx) total += sphere_volume(leaves[static_cast<std::size_t>(i)]);
+
+  std::vector<int> label(m, 0);
+  {
+    double acc = 0.0;
+    for (std::size_t j = 0; j < m; ++j) {
+      const double v = sphere_volume(leaves[static_cast<std::size_t>(idx[j])]);
+      label[j] = std::min(k - 1, static_cast<int>((acc + 0.5 * v) / total * k));
+      acc += v;
+    }
+  }
+  std::vector<Vec3d> centre(static_cast<std::size_t>(k));
+  std::vector<double> weight(static_cast<std::size_t>(k));
+  auto update_centres = [&]() {
+    std::fill(centre.begin(), centre.end(), Vec3d{0, 0, 0});
+    std::fill(weight.begin(), weight.end(), 0.0);
+    for (std::size_t j = 0; j < m; ++j) {
+      const Sphere& s = leaves[static_cast<std::size_t>(idx[j])];
+      const double v = sphere_volume(s);
+      Vec3d& c = centre[static_cast<std::size_t>(label[j])];
+      c = {c.x + v * static_cast<double>(s.x), c.y + v * static_cast<double>(s.y), c.z + v * static_cast<double>(s.z)};
+      weight[static_cast<std::size_t>(label[j])] += v;
+    }
+    for (std::size_t c = 0; c < centre.size(); ++c)
+      if (weight[c] > 0.0) centre[c] = {centre[c].x / weight[c], centre[c].y / weight[c], centre[c].z / weight[c]};
+  };
+  update_centres();
+  for (int it = 0; it < iterations; ++it) {
+    bool changed = false;
+    for (std::size_t j = 0; j < m; ++j) {
+      const Vec3d p = centre_of(leaves[static_cast<std::size_t>(idx[j])]);
+      int best = label[j];
+      double best_d = std::numeric_limits<double>::max();
+      for (int c = 0; c < k; ++c) {
+        if (weight[static_cast<std::size_t>(c)] <= 0.0) continue;
+        const double d = dist(p, centre[static_cast<std::size_t>(c)]);
+        if (d < best_d) {
+          best_d = d;
+          best = c;
+        }
+      }
+      if (best != label[j]) {
+        label[j] = best;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+    update_centres();
+  }
+
+  // reorder idx by label (stable, so the result is deterministic)
+  std::vector<int> order(m);
+  for (std::size_t j = 0; j < m; ++j) order[j] = static_cast<int>(j);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return label[static_cast<std::size_t>(a)] < label[static_cast<std::size_t>(b)];
+  });
+  std::vector<int> sorted(m);
+  std::vector<int> sizes(static_cast<std::size_t>(k), 0);
+  for (std::size_t j = 0; j < m; ++j) {
+    sorted[j] = idx[static_cast<std::size_t>(order[j])];
+    ++sizes[static_cast<std::size_t>(label[static_cast<std::size_t>(order[j])])];
+  }
+  std::copy(sorted.begin(), sorted.end(), idx.begin());
+  std::erase(sizes, 0);
+  if (sizes.size() < 2) {
+    // all centres coincide (or k-means collapsed): split evenly in the axis order instead
+    std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
+    sizes.assign(static_cast<std::size_t>(k), 0);
+    for (std::size_t j = 0; j < m; ++j) ++sizes[j * static_cast<std::size_t>(k) / m];
+    std::erase(sizes, 0);
+  }
+  return sizes;
+}
+
+}  // namespace
+
+Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options) {
+  if (leaves.empty()) return Error{"build_sphere_tree: no leaf spheres (a tree needs at least one)"};
+  if (options.arity < 2 || options.arity > kMaxSphereTreeArity)
+    return Error{"build_sphere_tree: arity " + std::to_string(options.arity) + " outside 2.." + std::to_string(kMaxSphereTreeArity)};
+  if (leaves.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() / 2))
+    return Error{"build_sphere_tree: too many leaves (" + std::to_string(leaves.size()) + ")"};
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Sphere& s = leaves[i];
+    if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !std::isfinite(s.radius) || !(s.radius > 0.f))
+      return Error{"build_sphere_tree: leaf " + std::to_string(i) + " has a non-finite centre or a radius that is not positive"};
+  }
+
+  std::vector<int> idx(leaves.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i);
+  std::vector<SphereTreeNode> nodes;
+  nodes.reserve(2 * leaves.size());
+  nodes.emplace_back();
+
+  struct Work {
+    int node, begin, end, depth;
+  };
+  std::vector<Work> stack{{0, 0, static_cast<int>(idx.size()), 1}};
+  int depth = 0;
+  while (!stack.empty()) {
+    const Work w = stack.back();
+    stack.pop_back();
+    depth = std::max(depth, w.depth);
+    const int parent = nodes[static_cast<std::size_t>(w.node)].parent;
+    if (w.end - w.begin == 1) {
+      const int leaf = idx[static_cast<std::size_t>(w.begin)];
+      const Sphere& s = leaves[static_cast<std::size_t>(leaf)];
+      SphereTreeNode& node = nodes[static_cast<std::size_t>(w.node)];
+      node = {s.x, s.y, s.z, s.radius, static_cast<float>(sphere_volume(s)), leaf, 0, parent};
+      continue;
+    }
+    const std::span<int> range(idx.data() + w.begin, static_cast<std::size_t>(w.end - w.begin));
+    SphereTreeNode bound = enclose(leaves, range, options.enclosing_iterations);
+    double volume = 0.0;
+    for (int i : range) volume += sphere_volume(leaves[static_cast<std::size_t>(i)]);
+    std::vector<int> sizes;
+    if (static_cast<int>(range.size()) <= options.arity) {
+      sizes.assign(range.size(), 1);
+    } else {
+      sizes = split(leaves, range, options.arity, options.kmeans_iterations);
+    }
+    const int first = static_cast<int>(nodes.size());
+    bound.volume = static_cast<float>(volume);
+    bound.first = first;
+    bound.count = static_cast<int>(sizes.size());
+    bound.parent = parent;
+    nodes[static_cast<std::size_t>(w.node)] = bound;
+    int begin = w.begin;
+    for (std::size_t c = 0; c < sizes.size(); ++c) {
+      SphereTreeNode child;
+      child.parent = w.node;
+      nodes.push_back(child);
+    }
+    // push in reverse so that the first child's subtree is laid out first (depth-first order)
+    std::vector<Work> children;
+    for (std::size_t c = 0; c < sizes.size(); ++c) {
+      children.push_back({first + static_cast<int>(c), begin, begin + sizes[c], w.depth + 1});
+      begin += sizes[c];
+    }
+    for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
+  }
+  // inner volumes as float sums of the float child volumes keep validate()'s check tight
+  for (int i = static_cast<int>(nodes.size()) - 1; i >= 0; --i) {
+    SphereTreeNode& n = nodes[static_cast<std::size_t>(i)];
+    if (n.is_leaf()) continue;
+    double v = 0.0;
+    for (int c = n.first; c < n.first + n.count; ++c) v += static_cast<double>(nodes[static_cast<std::size_t>(c)].volume);
+    n.volume = static_cast<float>(v);
+  }
+  return SphereTree(std::move(nodes), std::vector<Sphere>(leaves.begin(), leaves.end()), depth, options.arity);
+}
+
+}  // namespace uh::collette

@@ -1,0 +1,173 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "tree_test_support.hpp"
+#include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/collette/volume_query.hpp"
+
+namespace uh::collette {
+namespace {
+
+using testing::brute_volume;
+using testing::make_packing;
+using testing::Shape;
+
+Vec3 v3(const float f[3]) { return {static_cast<double>(f[0]), static_cast<double>(f[1]), static_cast<double>(f[2])}; }
+
+void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector<Sphere>& lb, int arity, int poses,
+                                std::uint32_t seed) {
+  const auto ta = build_sphere_tree(la, {.arity = arity});
+  const auto tb = build_sphere_tree(lb, {.arity = arity});
+  ASSERT_TRUE(ta && tb);
+  VolumeQuery query;
+  std::mt19937 rng(seed);
+  int overlapping_poses = 0;
+  for (int k = 0; k < poses; ++k) {
+    const Pose pose = testing::random_pose(rng, 1.2);
+    const VolumeQueryResult& r = query.run(*ta, *tb, pose);
+    const testing::BruteVolume ref = brute_volume(la, lb, pose);
+    const double scale = std::max(ref.volume, 1e-9);
+    ASSERT_NEAR(r.total_volume, ref.volume, 1e-4 * scale + 1e-9) << "pose " << k;
+    ASSERT_EQ(r.stats.overlapping_pairs, r.pair_count);
+    if (ref.volume == 0.0) {
+      EXPECT_EQ(r.pair_count, 0);
+      continue;
+    }
+    ++overlapping_poses;
+    // the same pair set, up to pairs whose lens is at float round-off
+    std::set<std::pair<int, int>> got;
+    for (const PairOverlap& p : query.pairs()) got.emplace(p.leaf_a, p.leaf_b);
+    std::size_t missing = 0;
+    for (std::size_t i = 0; i < ref.pairs.size(); ++i)
+      if (!got.count(ref.pairs[i])) {
+        ++missing;
+        EXPECT_LT(ref.pair_volumes[i], 1e-6 * scale) << "pose " << k << " pair missing";
+      }
+    EXPECT_EQ(got.size(), query.pairs().size()) << "a pair reported twice";
+    EXPECT_LE(got.size(), ref.pairs.size() - missing + 2);
+    // weighted normal sum and centroid
+    const Vec3 dn = r.weighted_normal_sum - ref.normal_sum;
+    EXPECT_LT(norm(dn), 1e-4 * scale + 1e-4 * norm(ref.normal_sum)) << "pose " << k;
+    EXPECT_LT(norm(r.volume_centroid - ref.centroid_sum / ref.volume), 1e-4) << "pose " << k;
+    // per-pair entries agree with the totals
+    double sum = 0.0;
+    Vec3 nsum{};
+    for (const PairOverlap& p : query.pairs()) {
+      sum += static_cast<double>(p.volume);
+      nsum += static_cast<double>(p.volume) * v3(p.normal);
+      EXPECT_NEAR(norm(v3(p.normal)), 1.0, 1e-5);
+    }
+    EXPECT_NEAR(sum, r.total_volume, 1e-5 * r.total_volume);
+    EXPECT_LT(norm(nsum - r.weighted_normal_sum), 1e-5 * r.total_volume);
+  }
+  EXPECT_GT(overlapping_poses, poses / 3) << "the random poses hardly overlap: the test would prove little";
+}
+
+TEST(VolumeQuery, MatchesBruteForceOnRandomPoses) {
+  const auto ball = make_packing(0.16, Shape::kBall, 21);
+  const auto box = make_packing(0.14, Shape::kBox, 22);
+  for (int arity : {2, 4, 8}) expect_matches_brute_force(ball, box, arity, 40, 100u + static_cast<std::uint32_t>(arity));
+}
+
+TEST(VolumeQuery, MatchesBruteForceForSameObject) {
+  // an object against a copy of itself: nearly coincident leaves and containment cases
+  const auto rod = make_packing(0.07, Shape::kRod, 23);
+  expect_matches_brute_force(rod, rod, 4, 30, 7);
+  const auto ta = build_sphere_tree(rod);
+  ASSERT_TRUE(ta);
+  VolumeQuery q;
+  const auto& r = q.run(*ta, *ta, Pose{});
+  EXPECT_NEAR(r.total_volume, ta->total_volume(), 1e-5 * ta->total_volume());
+}
+
+TEST(VolumeQuery, DisjointAndSingleLeafTrees) {
+  const std::vector<Sphere> one{{0.f, 0.f, 0.f, 1.f}};
+  const auto t = build_sphere_tree(one);
+  ASSERT_TRUE(t);
+  VolumeQuery q;
+  EXPECT_EQ(q.run(*t, *t, Pose{{}, {2.5, 0, 0}}).total_volume, 0.0);
+  const auto& r = q.run(*t, *t, Pose{{}, {1.0, 0, 0}});
+  EXPECT_NEAR(r.total_volume, lens_volume(1.0, 1.0, 1.0), 1e-6);
+  EXPECT_NEAR(r.restoring_direction.x, 1.0, 1e-9);
+  EXPECT_NEAR(r.volume_centroid.x, 0.5, 1e-6);
+  ASSERT_EQ(r.pair_count, 1);
+}
+
+TEST(VolumeQuery, ContactFrameMatchesResultInWorldFrame) {
+  const auto la = make_packing(0.15, Shape::kBall, 31);
+  const auto ta = build_sphere_tree(la);
+  ASSERT_TRUE(ta);
+  const Pose world_from_a{quat_from_axis_angle({0, 0, 1}, 0.7), {1.0, 2.0, 3.0}};
+  const Pose b_in_a{quat_from_axis_angle({0, 1, 0}, 0.5), {0.8, 0.1, 0.0}};
+  const Pose world_from_b = world_from_a * b_in_a;
+  VolumeQuery q;
+  const VolumeQueryResult local = q.run(*ta, *ta, b_in_a);
+  ASSERT_GT(local.pair_count, 10);
+  auto frame = std::make_unique<ContactFrame>();
+  q.run(*ta, *ta, world_from_a, world_from_b, *frame);
+  EXPECT_NEAR(frame->total_volume, local.total_volume, 1e-6 * local.total_volume);
+  EXPECT_EQ(frame->pair_count, local.pair_count);
+  EXPECT_FALSE(frame->truncated);
+  const Vec3 dir = transform_vector(world_from_a, local.restoring_direction);
+  EXPECT_LT(norm(frame->restoring_direction_world - dir), 1e-4);
+  EXPECT_LT(norm(frame->volume_centroid_world - transform_point(world_from_a, local.volume_centroid)), 1e-4);
+  double sum = 0.0;
+  for (int i = 0; i < frame->pair_count; ++i) {
+    const SpherePairContact& c = frame->pairs[static_cast<std::size_t>(i)];
+    sum += static_cast<double>(c.volume);
+    // recompute the pair from the local spheres and the world poses
+    const Vec3 ca = transform_point(world_from_a, testing::centre(c.sphere_a_local));
+    const Vec3 cb = transform_point(world_from_b, testing::centre(c.sphere_b_local));
+    const double d = norm(cb - ca);
+    EXPECT_NEAR(static_cast<double>(c.volume),
+                lens_volume(d, static_cast<double>(c.sphere_a_local.radius), static_cast<double>(c.sphere_b_local.radius)),
+                1e-4 * static_cast<double>(c.volume) + 1e-7);
+    EXPECT_LT(norm(v3(c.normal_world) - normalized(cb - ca)), 1e-3);
+    EXPECT_EQ(c.sphere_a_local.x, la[static_cast<std::size_t>(c.leaf_a)].x);
+  }
+  EXPECT_NEAR(sum, frame->total_volume, 1e-5 * sum);
+}
+
+TEST(VolumeQuery, TruncatesAtCapacityButKeepsTotals) {
+  const auto la = make_packing(0.15, Shape::kBall, 41);
+  const auto ta = build_sphere_tree(la);
+  ASSERT_TRUE(ta);
+  const Pose pose{quat_from_axis_angle({0, 1, 0}, 0.3), {0.5, 0, 0}};
+  VolumeQuery full;
+  const VolumeQueryResult all = full.run(*ta, *ta, pose);
+  ASSERT_GT(all.pair_count, 20);
+  VolumeQuery small({.pair_capacity = 10});
+  const VolumeQueryResult& r = small.run(*ta, *ta, pose);
+  EXPECT_TRUE(r.truncated);
+  EXPECT_EQ(r.pair_count, 10);
+  EXPECT_EQ(r.stats.overlapping_pairs, all.stats.overlapping_pairs);
+  EXPECT_DOUBLE_EQ(r.total_volume, all.total_volume);
+  VolumeQuery none({.collect_pairs = false});
+  const VolumeQueryResult& n = none.run(*ta, *ta, pose);
+  EXPECT_EQ(n.pair_count, 0);
+  EXPECT_FALSE(n.truncated);
+  EXPECT_DOUBLE_EQ(n.total_volume, all.total_volume);
+}
+
+TEST(VolumeQuery, PrunesMostLeafPairs) {
+  // the traversal must test far fewer leaf pairs than brute force (n_a * n_b)
+  const auto la = make_packing(0.08, Shape::kBall, 51);
+  const auto ta = build_sphere_tree(la);
+  ASSERT_TRUE(ta);
+  VolumeQuery q;
+  const auto& r = q.run(*ta, *ta, Pose{quat_from_axis_angle({0, 1, 0}, 0.5), {1.5, 0, 0}});
+  ASSERT_GT(r.stats.overlapping_pairs, 0);
+  const double brute = static_cast<double>(la.size()) * static_cast<double>(la.size());
+  EXPECT_LT(static_cast<double>(r.stats.leaf_pairs_tested), 0.01 * brute);
+  EXPECT_LT(r.stats.leaf_pairs_tested, 20 * r.stats.overlapping_pairs);
+}
+
+}  // namespace
+}  // namespace uh::collette

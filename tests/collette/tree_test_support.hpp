@@ -1,0 +1,96 @@
+#pragma once
+// Leaf-set generators and brute-force references shared by the sphere-tree tests.
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "uh/core/contact.hpp"
+#include "uh/core/math.hpp"
+#include "uh/core/sphere_overlap.hpp"
+
+namespace uh::collette::testing {
+
+enum class Shape { kBall, kBox, kRod };
+
+/// Non-overlapping spheres on a jittered grid of spacing `h` inside a shape of size ~1 centred at
+/// `offset`; radii vary in [0.15 h, 0.5 h - jitter] so that the spheres never overlap.
+inline std::vector<Sphere> make_packing(double h, Shape shape, std::uint32_t seed, Vec3 offset = {}) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double jitter = 0.1 * h;
+  std::vector<Sphere> out;
+  const int n = static_cast<int>(std::ceil(1.0 / h));
+  for (int i = -n; i <= n; ++i)
+    for (int j = -n; j <= n; ++j)
+      for (int k = -n; k <= n; ++k) {
+        const Vec3 p{i * h, j * h, k * h};
+        bool inside = false;
+        switch (shape) {
+          case Shape::kBall: inside = norm(p) <= 1.0; break;
+          case Shape::kBox: inside = std::abs(p.x) <= 1.0 && std::abs(p.y) <= 0.6 && std::abs(p.z) <= 0.4; break;
+          case Shape::kRod: inside = std::abs(p.x) <= 1.0 && p.y * p.y + p.z * p.z <= 0.09; break;
+        }
+        if (!inside) continue;
+        const Vec3 c = p + Vec3{(2 * u(rng) - 1) * jitter, (2 * u(rng) - 1) * jitter, (2 * u(rng) - 1) * jitter} + offset;
+        const double r = 0.15 * h + u(rng) * (0.5 * h - jitter - 0.15 * h);
+        out.push_back({static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z), static_cast<float>(r)});
+      }
+  return out;
+}
+
+inline Pose random_pose(std::mt19937& rng, double max_shift) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(-max_shift, max_shift);
+  const Quat q = normalized(Quat{g(rng), g(rng), g(rng), g(rng)});
+  return {q, {u(rng), u(rng), u(rng)}};
+}
+
+inline Vec3 centre(const Sphere& s) {
+  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+}
+
+/// Brute force over all leaf pairs, in double, A frame.
+struct BruteVolume {
+  double volume = 0.0;
+  Vec3 normal_sum{};
+  Vec3 centroid_sum{};  // sum of volume * centroid
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<double> pair_volumes;
+};
+
+inline BruteVolume brute_volume(const std::vector<Sphere>& a, const std::vector<Sphere>& b, const Pose& b_in_a) {
+  BruteVolume r;
+  for (int j = 0; j < static_cast<int>(b.size()); ++j) {
+    const Vec3 cb = transform_point(b_in_a, centre(b[static_cast<std::size_t>(j)]));
+    const double rb = static_cast<double>(b[static_cast<std::size_t>(j)].radius);
+    for (int i = 0; i < static_cast<int>(a.size()); ++i) {
+      const Vec3 ca = centre(a[static_cast<std::size_t>(i)]);
+      const double ra = static_cast<double>(a[static_cast<std::size_t>(i)].radius);
+      const double d = norm(cb - ca);
+      const double v = lens_volume(d, ra, rb);
+      if (!(v > 0.0)) continue;
+      const Vec3 n = normalized(cb - ca);
+      r.volume += v;
+      r.normal_sum += v * n;
+      r.centroid_sum += v * (ca + n * lens_centroid_offset(d, ra, rb));
+      r.pairs.emplace_back(i, j);
+      r.pair_volumes.push_back(v);
+    }
+  }
+  return r;
+}
+
+/// Smallest gap between a sphere of a and one of b (negative when overlapping).
+inline double brute_gap(const std::vector<Sphere>& a, const std::vector<Sphere>& b, const Pose& b_in_a) {
+  double best = 1e300;
+  for (const Sphere& sb : b) {
+    const Vec3 cb = transform_point(b_in_a, centre(sb));
+    for (const Sphere& sa : a)
+      best = std::min(best, norm(cb - centre(sa)) - static_cast<double>(sa.radius) - static_cast<double>(sb.radius));
+  }
+  return best;
+}
+
+}  // namespace uh::collette::testing
