@@ -75,8 +75,9 @@ std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_
     const Vec3 delta = cb - ca;
     const double d = norm(delta);
     const double volume = lens_volume(d, ra, rb);
-    // coincident centres leave the centre line undefined: keep the held normal, turned with A
-    const Vec3 u = d > 1e-12 * (ra + rb) ? delta / d : rotate(world_from_a.rotation, normal_a_local_[i]);
+    // coincident centres (within float storage precision) leave the centre line undefined: keep
+    // the held normal, turned with A
+    const Vec3 u = d > 1e-6 * (ra + rb) ? delta / d : rotate(world_from_a.rotation, normal_a_local_[i]);
     const Vec3 centroid = ca + lens_centroid_offset(d, ra, rb) * u;
     out.volume = static_cast<float>(volume);
     store(out.normal_world, u);

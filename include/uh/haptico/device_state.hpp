@@ -1,0 +1,33 @@
+#pragma once
+/// \file
+/// DeviceState: one timestamped snapshot of a device, read once per haptic tick.
+
+#include <cstdint>
+#include <type_traits>
+
+#include "uh/core/math.hpp"
+
+namespace uh::haptico {
+
+/// Whether a read produced a valid state.
+enum class DeviceStatus : std::uint8_t {
+  kOk,       ///< the state is valid
+  kNotOpen,  ///< the device is not open; the state is meaningless
+  kFault,    ///< the device reported an error (lost connection, amplifier fault); meaningless
+};
+
+/// Everything the haptic tick knows about the handle at one instant. All fields share `time_s`
+/// (no per-field getters with different sampling times). Frame: the device's base frame.
+/// Trivially copyable.
+struct DeviceState {
+  double time_s = 0.0;              ///< when the sample was taken [s] (device clock; simulated devices: simulated time)
+  Vec3 position{};                  ///< handle position [m]
+  Quat orientation{};               ///< handle orientation (unit quaternion)
+  Vec3 linear_velocity{};           ///< [m/s]
+  Vec3 angular_velocity{};          ///< [rad/s]
+  std::uint32_t buttons = 0;        ///< bit i set while button i is pressed
+  DeviceStatus status = DeviceStatus::kNotOpen;
+};
+static_assert(std::is_trivially_copyable_v<DeviceState>);
+
+}  // namespace uh::haptico

@@ -1,0 +1,138 @@
+#pragma once
+/// \file
+/// HapticManager: owns a device and the haptic thread; broadcasts MoveOnHapticTick and
+/// ForceOnHapticTick every tick and sends the summed force through a safety stage to the device.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <ostream>
+#include <vector>
+
+#include "uh/core/delegator.hpp"
+#include "uh/core/event_counter.hpp"
+#include "uh/core/fixed_rate_loop.hpp"
+#include "uh/core/result.hpp"
+#include "uh/core/spsc_queue.hpp"
+#include "uh/haptico/haptic_device.hpp"
+#include "uh/haptico/trace_sample.hpp"
+
+namespace uh::haptico {
+
+/// Options of a HapticManager (options aggregate).
+struct HapticManagerOptions {
+  double rate_hz = 1000.0;          ///< haptic tick rate [Hz], in (0, 10000]; devices run 1-4 kHz
+  bool raise_priority = false;      ///< ask for SCHED_FIFO for the haptic thread (see FixedRateLoop)
+  std::size_t trace_capacity = 0;   ///< ticks the trace queue holds between drains; 0 = no trace
+};
+
+/// Counters of a HapticManager; a snapshot, plain data.
+struct HapticStats {
+  FixedRateLoopStats loop{};          ///< timing of the haptic thread (zero in stepped sessions)
+  std::uint64_t ticks = 0;            ///< ticks run (threaded and stepped)
+  std::uint64_t force_clamped = 0;    ///< ticks whose force was scaled down to max_force_n
+  std::uint64_t torque_clamped = 0;   ///< ticks whose torque was scaled down to max_torque_nm
+  std::uint64_t nonfinite = 0;        ///< ticks whose requested command had a NaN/inf (zero sent)
+  std::uint64_t device_errors = 0;    ///< ticks whose read_state() failed
+  std::uint64_t zeroed_ticks = 0;     ///< ticks that sent zero because of halt() or a fault
+  std::uint64_t trace_dropped = 0;    ///< trace samples lost because the queue was full
+  bool faulted = false;               ///< a device error is latched (see clear_fault())
+  bool halted = false;                ///< halt() is in effect
+};
+
+/// Runs the haptic loop for one device. Every tick, on the haptic thread:
+///   1. state = device.read_state();
+///   2. MoveOnHapticTick.broadcast(state)            (e.g. move the tool in the scene);
+///   3. ForceOnHapticTick.broadcast(state, command)  (each delegate adds its force to `command`,
+///      which starts at zero);
+///   4. safety: a NaN/inf anywhere -> zero (counted); force and torque scaled down to the
+///      device's max_force_n / max_torque_nm (counted); torque zeroed on 3-DOF devices; zero while
+///      halted or after a device error (latched until clear_fault());
+///   5. device.command(command); the tick is pushed to the trace queue if enabled.
+/// The same tick code runs in threaded sessions (start()/stop()) and stepped ones (step()).
+///
+/// Frames and units: those of the device (DeviceState, DeviceCommand), SI.
+///
+/// Threads: construct, open(), start(), stop(), step(), bind delegates and destroy from one
+/// controlling thread. Bind delegates only while no threaded session runs (the Delegator is not
+/// a cross-thread primitive; start() publishes the bindings to the haptic thread). Delegates run
+/// on the haptic thread and must be real-time safe. halt(), resume(), clear_fault(), stats() and
+/// running() may be called from any thread; drain_trace() from one consumer thread.
+class HapticManager {
+ public:
+  /// Takes ownership of `device` (not null). Allocates the trace queue. Not real-time safe.
+  explicit HapticManager(std::unique_ptr<HapticDevice> device, const HapticManagerOptions& options = {});
+  /// Stops the haptic thread, sends zero force and closes the device.
+  ~HapticManager();
+  HapticManager(const HapticManager&) = delete;
+  HapticManager& operator=(const HapticManager&) = delete;
+
+  /// Opens the device and checks its description (an actuated device must report positive force
+  /// limits). Idempotent. An Error names the device and the problem.
+  Status open();
+  /// Opens the device if needed and starts the haptic thread at options().rate_hz.
+  Status start();
+  /// Stops the haptic thread (the current tick finishes), then sends zero force. The device stays
+  /// open; start() or step() may follow. Idempotent.
+  void stop();
+  /// Runs one tick now on the calling thread, with `now_s` [s] as the tick time: the deterministic
+  /// entry for stepped sessions and tests. The device must be open and no threaded session may
+  /// run (asserted). Returns what happened in that tick.
+  TraceSample step(double now_s);
+
+  /// Sends zero force from the next tick on, whatever the delegates ask, until resume(). Any
+  /// thread; real-time safe.
+  void halt() { halted_.store(true, std::memory_order_release); }
+  /// Ends a halt(). Any thread.
+  void resume() { halted_.store(false, std::memory_order_release); }
+  /// Clears a latched device fault so that forces are sent again. Any thread.
+  void clear_fault() { faulted_.store(false, std::memory_order_release); }
+
+  /// Binding side of MoveOnHapticTick(const DeviceState&). See the thread rules above.
+  DelegateSink<const DeviceState&> move_on_haptic_tick() { return DelegateSink{move_event_}; }
+  /// Binding side of ForceOnHapticTick(const DeviceState&, DeviceCommand&): add to the command.
+  DelegateSink<const DeviceState&, DeviceCommand&> force_on_haptic_tick() { return DelegateSink{force_event_}; }
+
+  /// Time of the tick being run [s]: in threaded sessions the steady-clock time of the tick's start
+  /// (seconds since the steady clock's epoch, the clock of ContactFrame::time_s); in stepped ones
+  /// the `now_s` given to step(). For delegates (haptic thread) during a tick.
+  double tick_time_s() const { return tick_time_s_; }
+
+  /// Moves the recorded ticks out of the trace queue into `out` (appends); returns how many.
+  /// One consumer thread; not real-time safe.
+  std::size_t drain_trace(std::vector<TraceSample>& out);
+  /// Same, writing CSV rows (see write_trace_row) to `csv`.
+  std::size_t drain_trace(std::ostream& csv);
+
+  HapticStats stats() const;
+  bool running() const { return loop_.running(); }
+  bool is_open() const { return open_; }
+  /// The device's description as read by open().
+  const DeviceInfo& device_info() const { return info_; }
+  const HapticManagerOptions& options() const { return options_; }
+
+ private:
+  TraceSample tick(double now_s);
+
+  HapticManagerOptions options_;
+  std::unique_ptr<HapticDevice> device_;
+  DeviceInfo info_{};
+  bool open_ = false;
+  FixedRateLoop loop_;
+  Delegator<const DeviceState&> move_event_;
+  Delegator<const DeviceState&, DeviceCommand&> force_event_;
+  std::unique_ptr<SpscQueue<TraceSample>> trace_;
+  double tick_time_s_ = 0.0;
+  std::atomic<bool> halted_{false};
+  std::atomic<bool> faulted_{false};
+  EventCounter ticks_;
+  EventCounter force_clamped_;
+  EventCounter torque_clamped_;
+  EventCounter nonfinite_;
+  EventCounter device_errors_;
+  EventCounter zeroed_ticks_;
+  EventCounter trace_dropped_;
+};
+
+}  // namespace uh::haptico

@@ -1,0 +1,173 @@
+#include "uh/haptico/haptic_manager.hpp"
+
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+#include <utility>
+
+namespace uh::haptico {
+
+namespace {
+
+bool finite(const DeviceCommand& c) { return is_finite(c.force) && is_finite(c.torque); }
+
+// scales v down to `limit` keeping its direction; true if it did
+bool clamp_norm(Vec3& v, double limit) {
+  const double n = norm(v);
+  if (n <= limit) return false;
+  v = limit > 0.0 ? v * (limit / n) : Vec3{};
+  return true;
+}
+
+FixedRateLoopOptions loop_options(const HapticManagerOptions& o) {
+  FixedRateLoopOptions l;
+  l.rate_hz = o.rate_hz;
+  l.raise_priority = o.raise_priority;
+  l.name = "uh-haptic";
+  return l;
+}
+
+}  // namespace
+
+HapticManager::HapticManager(std::unique_ptr<HapticDevice> device, const HapticManagerOptions& options)
+    : options_(options), device_(std::move(device)), loop_(loop_options(options)) {
+  assert(device_ != nullptr && "uh::haptico::HapticManager::HapticManager(): device must not be null");
+  if (options_.trace_capacity > 0) trace_ = std::make_unique<SpscQueue<TraceSample>>(options_.trace_capacity);
+}
+
+HapticManager::~HapticManager() {
+  stop();
+  if (open_) {
+    const Status closed = device_->close();
+    (void)closed;  // nothing left to report to at destruction
+  }
+}
+
+Status HapticManager::open() {
+  if (open_) return Ok{};
+  if (Status s = device_->open(); !s) return s;
+  info_ = device_->info();
+  const auto refuse = [this](std::string why) -> Status {
+    const Status closed = device_->close();
+    (void)closed;
+    return Error{fmt::format("device '{}': {}", info_.name, why)};
+  };
+  if (info_.dof_actuated != 0 && info_.dof_actuated != 3 && info_.dof_actuated != 6) {
+    return refuse(fmt::format("dof_actuated is {}, expected 0, 3 or 6", info_.dof_actuated));
+  }
+  // a device without a stated force limit cannot be protected by the safety stage
+  if (info_.dof_actuated > 0 && !(info_.max_force_n > 0.0 && std::isfinite(info_.max_force_n))) {
+    return refuse("reports no valid max_force_n; refusing to send it forces");
+  }
+  if (info_.dof_actuated == 6 && !(info_.max_torque_nm > 0.0 && std::isfinite(info_.max_torque_nm))) {
+    return refuse("is 6-DOF actuated but reports no valid max_torque_nm; refusing to send it torques");
+  }
+  open_ = true;
+  return Ok{};
+}
+
+Status HapticManager::start() {
+  if (!(options_.rate_hz > 0.0 && options_.rate_hz <= 10000.0)) {
+    return Error{fmt::format("haptic manager: rate_hz {} is outside (0, 10000]", options_.rate_hz)};
+  }
+  if (loop_.running()) return Error{"haptic manager: already running"};
+  if (Status s = open(); !s) return s;
+  return loop_.start([this](const TickInfo& t) {
+    const double now = std::chrono::duration<double>(t.start_time.time_since_epoch()).count();
+    tick(now);
+  });
+}
+
+void HapticManager::stop() {
+  loop_.stop();
+  // the haptic thread is joined: this thread may talk to the device now
+  if (open_) device_->command(DeviceCommand{});
+}
+
+TraceSample HapticManager::step(double now_s) {
+  assert(open_ && "uh::haptico::HapticManager::step(): open() the device first");
+  assert(!loop_.running() && "uh::haptico::HapticManager::step(): a threaded session is running");
+  return tick(now_s);
+}
+
+TraceSample HapticManager::tick(double now_s) {
+  ticks_.increment();
+  tick_time_s_ = now_s;
+  TraceSample sample;
+  sample.tick_time_s = now_s;
+  sample.state = device_->read_state();
+  if (sample.state.status != DeviceStatus::kOk) {
+    device_errors_.increment();
+    faulted_.store(true, std::memory_order_release);
+    sample.flags |= kTraceDeviceError;
+  } else {
+    move_event_.broadcast(sample.state);
+    force_event_.broadcast(sample.state, sample.requested);
+  }
+
+  DeviceCommand out = sample.requested;
+  if (!finite(out)) {
+    nonfinite_.increment();
+    sample.flags |= kTraceNonFinite;
+    out = DeviceCommand{};
+  }
+  if (info_.dof_actuated < 6) out.torque = {};
+  if (clamp_norm(out.force, info_.max_force_n)) {
+    force_clamped_.increment();
+    sample.flags |= kTraceForceClamped;
+  }
+  if (clamp_norm(out.torque, info_.max_torque_nm)) {
+    torque_clamped_.increment();
+    sample.flags |= kTraceTorqueClamped;
+  }
+  if (halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire)) {
+    zeroed_ticks_.increment();
+    sample.flags |= kTraceZeroed;
+    out = DeviceCommand{};
+  }
+  sample.sent = out;
+  device_->command(out);
+
+  if (trace_ && !trace_->try_push(sample)) trace_dropped_.increment();
+  return sample;
+}
+
+std::size_t HapticManager::drain_trace(std::vector<TraceSample>& out) {
+  if (!trace_) return 0;
+  std::size_t n = 0;
+  TraceSample s;
+  while (trace_->try_pop(s)) {
+    out.push_back(s);
+    ++n;
+  }
+  return n;
+}
+
+std::size_t HapticManager::drain_trace(std::ostream& csv) {
+  if (!trace_) return 0;
+  std::size_t n = 0;
+  TraceSample s;
+  while (trace_->try_pop(s)) {
+    write_trace_row(csv, s);
+    ++n;
+  }
+  return n;
+}
+
+HapticStats HapticManager::stats() const {
+  HapticStats s;
+  s.loop = loop_.stats();
+  s.ticks = ticks_.load();
+  s.force_clamped = force_clamped_.load();
+  s.torque_clamped = torque_clamped_.load();
+  s.nonfinite = nonfinite_.load();
+  s.device_errors = device_errors_.load();
+  s.zeroed_ticks = zeroed_ticks_.load();
+  s.trace_dropped = trace_dropped_.load();
+  s.faulted = faulted_.load(std::memory_order_acquire);
+  s.halted = halted_.load(std::memory_order_acquire);
+  return s;
+}
+
+}  // namespace uh::haptico

@@ -1,0 +1,116 @@
+#include "uh/forcecomp/force_safety.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace uh::forcecomp {
+namespace {
+
+Wrench wrench(Vec3 f, Vec3 t = {}) { return Wrench{f, t}; }
+
+TEST(ForceSafety, ClampsForceAndTorqueKeepingDirection) {
+  ForceSafety safety({.max_force_n = 5.0, .max_torque_nm = 0.2});
+  const Wrench out = safety.apply(wrench({30, 40, 0}, {0, 0, -1}), 0.0, 0.0);
+  EXPECT_NEAR(out.force.x, 3.0, 1e-12);
+  EXPECT_NEAR(out.force.y, 4.0, 1e-12);
+  EXPECT_NEAR(out.torque.z, -0.2, 1e-12);
+  EXPECT_EQ(safety.counters().force_clamped, 1u);
+  EXPECT_EQ(safety.counters().torque_clamped, 1u);
+  // within limits: unchanged and not counted
+  const Wrench small = safety.apply(wrench({1, 2, 3}, {0.1, 0, 0}), 0.001, 0.001);
+  EXPECT_EQ(small.force, (Vec3{1, 2, 3}));
+  EXPECT_EQ(safety.counters().force_clamped, 1u);
+  EXPECT_EQ(safety.counters().ticks, 2u);
+}
+
+TEST(ForceSafety, NonFiniteReplacedByZeroAndCounted) {
+  ForceSafety safety;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(safety.apply(wrench({nan, 1, 1}), 0.0, 0.0).force, Vec3{});
+  const Wrench t = safety.apply(wrench({1, 1, 1}, {0, inf, 0}), 0.001, 0.001);
+  EXPECT_EQ(t.force, Vec3{});
+  EXPECT_EQ(t.torque, Vec3{});
+  EXPECT_EQ(safety.counters().nonfinite, 2u);
+  EXPECT_EQ(safety.counters().force_clamped, 0u);
+}
+
+TEST(ForceSafety, WatchdogRampsForceToZeroWhenDataStale) {
+  ForceSafety safety({.max_force_n = 100.0, .watchdog = {.max_age_s = 0.01, .ramp_s = 0.1}});
+  const double data_time = 0.0;
+  const Vec3 f{10, 0, 0};
+  // fresh data: full force
+  EXPECT_EQ(safety.apply(wrench(f), 0.005, data_time).force.x, 10.0);
+  EXPECT_EQ(safety.apply(wrench(f), 0.010, data_time).force.x, 10.0);
+  // stale from here on (collision thread stalled): the gain falls 1 per ramp_s, never a step
+  double previous = 10.0;
+  double t = 0.010;
+  for (int i = 0; i < 150; ++i) {
+    t += 0.001;
+    const double now = safety.apply(wrench(f), t, data_time).force.x;
+    EXPECT_LE(now, previous);
+    EXPECT_GE(now, previous - 10.0 * 0.001 / 0.1 - 1e-9);  // at most one ramp step per tick
+    previous = now;
+    if (i == 49) {
+      EXPECT_NEAR(now, 5.0, 1e-6);  // half the ramp: half the force
+    }
+  }
+  EXPECT_EQ(previous, 0.0);
+  EXPECT_EQ(safety.counters().stale_ticks, 150u);
+}
+
+TEST(ForceSafety, WatchdogRampsBackUpWithoutStep) {
+  ContactWatchdog dog({.max_age_s = 0.01, .ramp_s = 0.1});
+  dog.update(0.0, 0.0);
+  for (int i = 1; i <= 200; ++i) dog.update(0.001 * i, 0.0);  // stale for long
+  EXPECT_EQ(dog.gain(), 0.0);
+  EXPECT_TRUE(dog.stale());
+  // fresh data arrives: the gain climbs at the same bounded rate
+  EXPECT_NEAR(dog.update(0.201, 0.2), 0.01, 1e-9);
+  EXPECT_FALSE(dog.stale());
+  for (int i = 2; i <= 100; ++i) dog.update(0.2 + 0.001 * i, 0.2 + 0.001 * i);
+  EXPECT_NEAR(dog.gain(), 1.0, 1e-9);
+}
+
+TEST(ForceSafety, NonFiniteDataTimeCountsAsStale) {
+  ContactWatchdog dog;
+  EXPECT_EQ(dog.update(1.0, std::numeric_limits<double>::quiet_NaN()), 0.0);
+  EXPECT_TRUE(dog.stale());
+}
+
+TEST(ForceSafety, StopZeroesAndResumeFadesIn) {
+  ForceSafety safety({.max_force_n = 100.0, .watchdog = {.max_age_s = 1.0, .ramp_s = 0.01}});
+  EXPECT_EQ(safety.apply(wrench({10, 0, 0}), 0.0, 0.0).force.x, 10.0);
+  safety.stop();
+  EXPECT_TRUE(safety.stopped());
+  for (int i = 1; i <= 5; ++i) EXPECT_EQ(safety.apply(wrench({10, 0, 0}, {0.1, 0, 0}), 0.001 * i, 0.0).force, Vec3{});
+  EXPECT_EQ(safety.counters().zeroed_ticks, 5u);
+  safety.resume();
+  // no step back to full force after a stop
+  const double first = safety.apply(wrench({10, 0, 0}), 0.006, 0.006).force.x;
+  EXPECT_LT(first, 10.0);
+  for (int i = 7; i <= 30; ++i) safety.apply(wrench({10, 0, 0}), 0.001 * i, 0.001 * i);
+  EXPECT_NEAR(safety.apply(wrench({10, 0, 0}), 0.031, 0.031).force.x, 10.0, 1e-9);
+}
+
+TEST(ForceSafety, DeviceFaultZeroesUntilResume) {
+  ForceSafety safety;
+  safety.report_fault();
+  EXPECT_TRUE(safety.faulted());
+  EXPECT_EQ(safety.apply(wrench({1, 0, 0}), 0.0, 0.0).force, Vec3{});
+  safety.resume();
+  EXPECT_FALSE(safety.faulted());
+}
+
+TEST(ForceSafety, ClampNormHandlesZeroLimit) {
+  Vec3 v{1, 0, 0};
+  EXPECT_TRUE(clamp_norm(v, 0.0));
+  EXPECT_EQ(v, Vec3{});
+  Vec3 w{0.5, 0, 0};
+  EXPECT_FALSE(clamp_norm(w, 1.0));
+}
+
+}  // namespace
+}  // namespace uh::forcecomp

@@ -1,0 +1,60 @@
+#pragma once
+// Brute-force reference for the forcecomp tests: builds SpherePairContacts straight from the
+// overlap formulas, the way a collision query would, without any tree.
+
+#include <vector>
+
+#include "uh/core/contact.hpp"
+#include "uh/core/math.hpp"
+#include "uh/core/sphere_overlap.hpp"
+
+namespace uh::forcecomp::test {
+
+inline Vec3 centre_of(const Sphere& s) {
+  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+}
+
+inline Sphere sphere(double x, double y, double z, double r) {
+  return {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z), static_cast<float>(r)};
+}
+
+/// The pair record of spheres a (in A) and b (in B) at the given poses; volume 0 when apart.
+inline SpherePairContact make_pair(const Sphere& a, const Pose& world_from_a, const Sphere& b, const Pose& world_from_b,
+                                   int leaf_a = 0, int leaf_b = 0) {
+  SpherePairContact p;
+  const Vec3 ca = transform_point(world_from_a, centre_of(a));
+  const Vec3 cb = transform_point(world_from_b, centre_of(b));
+  const double ra = static_cast<double>(a.radius);
+  const double rb = static_cast<double>(b.radius);
+  const double d = norm(cb - ca);
+  const Vec3 u = normalized(cb - ca);
+  const Vec3 c = ca + lens_centroid_offset(d, ra, rb) * u;
+  p.volume = static_cast<float>(lens_volume(d, ra, rb));
+  p.normal_world[0] = static_cast<float>(u.x);
+  p.normal_world[1] = static_cast<float>(u.y);
+  p.normal_world[2] = static_cast<float>(u.z);
+  p.centroid_world[0] = static_cast<float>(c.x);
+  p.centroid_world[1] = static_cast<float>(c.y);
+  p.centroid_world[2] = static_cast<float>(c.z);
+  p.sphere_a_local = a;
+  p.sphere_b_local = b;
+  p.leaf_a = leaf_a;
+  p.leaf_b = leaf_b;
+  return p;
+}
+
+/// All overlapping pairs of two sphere sets, by testing every pair.
+inline std::vector<SpherePairContact> brute_force_pairs(const std::vector<Sphere>& a, const Pose& world_from_a,
+                                                        const std::vector<Sphere>& b, const Pose& world_from_b) {
+  std::vector<SpherePairContact> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      SpherePairContact p =
+          make_pair(a[i], world_from_a, b[j], world_from_b, static_cast<int>(i), static_cast<int>(j));
+      if (p.volume > 0.f) out.push_back(p);
+    }
+  }
+  return out;
+}
+
+}  // namespace uh::forcecomp::test
