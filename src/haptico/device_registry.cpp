@@ -1,5 +1,6 @@
 #include "uh/haptico/device_registry.hpp"
 
+#include <cmath>
 #include <fmt/format.h>
 #include <utility>
 
@@ -154,7 +155,7 @@ Result<std::unique_ptr<HapticDevice>> make_replay(const DeviceConfig& c) {
 Result<std::unique_ptr<HapticDevice>> make_hand(const DeviceConfig& c) {
   constexpr std::string_view kName = "sim-hand";
   if (Status s = c.check_keys({UH_SIM_COMMON_KEYS, "handle_mass_kg", "hand_stiffness", "hand_damping", "device_damping",
-                               "target_start", "target_end", "duration_s"},
+                               "target_start", "target_end", "duration_s", "substeps"},
                               kName);
       !s) {
     return s.error();
@@ -168,6 +169,12 @@ Result<std::unique_ptr<HapticDevice>> make_hand(const DeviceConfig& c) {
   UH_TRY_ASSIGN(o.target_start, field(c.vec3("target_start", o.target_start), kName));
   UH_TRY_ASSIGN(o.target_end, field(c.vec3("target_end", o.target_end), kName));
   UH_TRY_ASSIGN(o.duration_s, field(c.number("duration_s", o.duration_s), kName));
+  double substeps = o.substeps;
+  UH_TRY_ASSIGN(substeps, field(c.number("substeps", substeps), kName));
+  if (!(substeps >= 1.0 && substeps <= 1000.0) || substeps != std::floor(substeps)) {
+    return Error{"sim-hand: substeps must be a whole number in [1, 1000]"};
+  }
+  o.substeps = static_cast<int>(substeps);
   if (!(o.handle_mass_kg > 0.0)) return Error{"sim-hand: handle_mass_kg must be positive"};
   if (!(o.hand_stiffness >= 0.0 && o.hand_damping >= 0.0 && o.device_damping >= 0.0)) {
     return Error{"sim-hand: hand_stiffness, hand_damping and device_damping must not be negative"};

@@ -20,13 +20,20 @@ DeviceState SimHandDevice::sample(double) const {
 }
 
 void SimHandDevice::integrate(double t, double dt, const DeviceCommand& cmd) {
-  const Vec3 target = target_at(t);
-  const Vec3 target_velocity =
-      t < options_.duration_s ? (options_.target_end - options_.target_start) / options_.duration_s : Vec3{};
-  const Vec3 f = options_.hand_stiffness * (target - position_) + options_.hand_damping * (target_velocity - velocity_) -
-                 options_.device_damping * velocity_ + cmd.force;
-  velocity_ += (dt / options_.handle_mass_kg) * f;
-  position_ += dt * velocity_;
+  // the hand and the handle move continuously while the command is held for the whole period
+  // (zero-order hold): substeps resolve that, which is where sampled walls gain energy
+  const int substeps = std::max(1, options_.substeps);
+  const double h = dt / substeps;
+  const Vec3 travel_velocity = (options_.target_end - options_.target_start) / options_.duration_s;
+  for (int i = 0; i < substeps; ++i) {
+    const double ti = t + i * h;
+    const Vec3 target_velocity = ti < options_.duration_s ? travel_velocity : Vec3{};
+    const Vec3 f = options_.hand_stiffness * (target_at(ti) - position_) +
+                   options_.hand_damping * (target_velocity - velocity_) - options_.device_damping * velocity_ +
+                   cmd.force;
+    velocity_ += (h / options_.handle_mass_kg) * f;
+    position_ += h * velocity_;
+  }
 }
 
 }  // namespace uh::haptico

@@ -7,7 +7,7 @@
 namespace uh::haptico {
 
 /// Options of a SimHandDevice. Config keys: handle_mass_kg, hand_stiffness, hand_damping,
-/// device_damping, target_start, target_end, duration_s, plus the SimDeviceOptions keys.
+/// device_damping, target_start, target_end, duration_s, substeps, plus the SimDeviceOptions keys.
 struct SimHandOptions {
   SimDeviceOptions device{};
   double handle_mass_kg = 0.1;     ///< moving mass of handle plus hand [kg], > 0
@@ -17,13 +17,15 @@ struct SimHandOptions {
   Vec3 target_start{};             ///< where the hand starts (and the handle) [m]
   Vec3 target_end{0.0, 0.0, -0.03};  ///< where the hand moves to [m]
   double duration_s = 1.0;         ///< time the target takes from start to end, then it stays [s], > 0
+  int substeps = 10;               ///< integration steps per period (the command is held over all of them), >= 1
 };
 
 /// A mass-spring-damper "hand": the handle of mass m is pulled by a spring-damper towards a target
 /// moving at constant speed from target_start to target_end, damped by the device, and pushed by
 /// the commanded force:
 ///     m dv/dt = k (x_t - x) + c (v_t - v) - b v + F_cmd
-/// integrated with semi-implicit Euler over each period. With a wall the handle settles where the
+/// integrated with semi-implicit Euler in `substeps` steps per period while the command is held
+/// (as a real servo loop holds it between samples). With a wall the handle settles where the
 /// hand spring balances the wall force, so the loop's stability can be observed. Orientation stays
 /// identity (the torque is recorded, not simulated).
 class SimHandDevice final : public SimulatedDevice {

@@ -1,0 +1,100 @@
+#include "uh/haptico/sim_replay_device.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace uh::haptico {
+namespace {
+
+Result<std::vector<TrajectorySample>> parse(const std::string& text) {
+  std::istringstream in(text);
+  return SimReplayDevice::parse_csv(in, "demo.csv");
+}
+
+std::string error_of(const std::string& text) {
+  auto r = parse(text);
+  EXPECT_FALSE(r.has_value()) << "parsed although invalid: " << text;
+  return r ? std::string() : r.error().message;
+}
+
+TEST(SimReplayDevice, ParsesHeaderCommentsAndRows) {
+  auto r = parse(
+      "# recorded by hand\n"
+      "time_s,x,y,z,qw,qx,qy,qz\n"
+      "\n"
+      "0.0, 0, 0, 0, 1, 0, 0, 0\n"
+      "1.0, 0.1, 0, 0, 0, 0, 0, 2\r\n");
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->size(), 2u);
+  EXPECT_EQ((*r)[1].pose.position, (Vec3{0.1, 0, 0}));
+  EXPECT_EQ((*r)[1].pose.rotation, (Quat{0, 0, 0, 1}));  // normalised
+}
+
+TEST(SimReplayDevice, ErrorsNameFileAndLine) {
+  EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\n1,0,0,0,1,0,0\n"),
+            "demo.csv:2: expected 8 comma-separated numbers (time_s,x,y,z,qw,qx,qy,qz), found 7 fields");
+  EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\n1,0,abc,0,1,0,0,0\n"), "demo.csv:2: field 3 ('abc') is not a finite number");
+  EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\n0,0,0,0,1,0,0,0\n"),
+            "demo.csv:2: time 0 s is not after the previous sample's 0 s (times must increase)");
+  EXPECT_EQ(error_of("t,x,y,z\n"),
+            "demo.csv:1: header 't,x,y,z' does not match the expected columns 'time_s,x,y,z,qw,qx,qy,qz'");
+  EXPECT_EQ(error_of("# nothing\n"), "demo.csv: no samples (expected lines of 'time_s,x,y,z,qw,qx,qy,qz')");
+  EXPECT_EQ(error_of("0,0,0,0,0,0,0,0\n"), "demo.csv:1: quaternion (qw,qx,qy,qz) has zero length");
+  EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\n1,nan,0,0,1,0,0,0\n"), "demo.csv:2: field 2 ('nan') is not a finite number");
+  // a header is only allowed before the first row
+  EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\ntime_s,x,y,z,qw,qx,qy,qz\n"),
+            "demo.csv:2: field 1 ('time_s') is not a finite number");
+}
+
+TEST(SimReplayDevice, MissingFileIsAnError) {
+  auto r = SimReplayDevice::load_csv("/nonexistent/trajectory.csv");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "/nonexistent/trajectory.csv: cannot open the trajectory file");
+}
+
+TEST(SimReplayDevice, InterpolatesAndHoldsLastPose) {
+  auto r = parse("10,0,0,0,1,0,0,0\n10.1,0.01,0.02,0,1,0,0,0\n10.2,0.01,0.02,0.03,1,0,0,0\n");
+  ASSERT_TRUE(r);
+  SimReplayDevice d(*r, {});
+  EXPECT_NEAR(d.duration_s(), 0.2, 1e-12);
+  ASSERT_TRUE(d.open());
+  for (int i = 0; i < 50; ++i) d.command({});  // t = 0.05 s after the first sample
+  const DeviceState s = d.read_state();
+  EXPECT_NEAR(s.position.x, 0.005, 1e-9);
+  EXPECT_NEAR(s.position.y, 0.01, 1e-9);
+  EXPECT_NEAR(s.linear_velocity.x, 0.1, 1e-6);
+  for (int i = 0; i < 500; ++i) d.command({});
+  const DeviceState end = d.read_state();
+  EXPECT_EQ(end.position, (Vec3{0.01, 0.02, 0.03}));
+}
+
+TEST(SimReplayDevice, LoopsWhenAsked) {
+  auto r = parse("0,0,0,0,1,0,0,0\n0.1,0.01,0,0,1,0,0,0\n");
+  ASSERT_TRUE(r);
+  SimReplayDevice d(*r, {.loop = true});
+  ASSERT_TRUE(d.open());
+  for (int i = 0; i < 125; ++i) d.command({});  // 1.25 periods
+  EXPECT_NEAR(d.read_state().position.x, 0.0025, 1e-9);
+}
+
+TEST(SimReplayDevice, InterpolatesOrientationTheShortWay) {
+  // q and -q are the same rotation: the halfway pose must be a quarter turn, not identity
+  const Quat q90 = quat_from_axis_angle({0, 0, 1}, kPi / 2);
+  std::ostringstream csv;
+  csv << "0,0,0,0,1,0,0,0\n1,0,0,0," << -q90.w << ",0,0," << -q90.z << "\n";
+  auto r = parse(csv.str());
+  ASSERT_TRUE(r);
+  SimReplayDevice d(*r, {});
+  ASSERT_TRUE(d.open());
+  for (int i = 0; i < 500; ++i) d.command({});
+  const Quat q = d.read_state().orientation;
+  const double angle = 2.0 * std::atan2(std::abs(q.z), std::abs(q.w));
+  EXPECT_NEAR(angle, kPi / 4, 1e-6);
+}
+
+}  // namespace
+}  // namespace uh::haptico
