@@ -1,0 +1,472 @@
+#include "uh/collette/sphere_packing.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+
+#include "sphere_grid.hpp"
+#include "triangle_bvh.hpp"
+
+namespace uh::collette {
+namespace {
+
+// Automatic voxel size: cbrt(volume / target) times this. Smaller gives better coverage and
+// costs time and memory roughly as its inverse cube (measured in docs/collette-packing.md).
+constexpr double kAutoVoxelFactor = 0.18;
+constexpr std::int64_t kMaxGridVoxels = 400'000'000;
+constexpr std::int64_t kDefaultAutoCount = 10000;
+// Spheres smaller than this fraction of a voxel are not placed: the grid cannot resolve them.
+constexpr double kMinRadiusInVoxels = 0.05;
+constexpr int kRefineIterations = 24;
+constexpr bool kFollowRidge = false;
+constexpr double kBucketsPerVoxel = 32.0;
+
+// Three fixed non-axis directions for the majority-vote parity test.
+constexpr Vec3 kVoteDirections[3] = {{0.8017837257372732, 0.2672612419124244, 0.5345224838248488},
+                                     {-0.3015113445777636, 0.9045340337332909, 0.3015113445777636},
+                                     {0.2357022603955158, -0.4714045207910317, 0.8498365855987975}};
+
+// Max-priority queue of voxel ids keyed by free radius, quantised into buckets of 1/delta:
+// O(1) push and pop instead of a binary heap's cache-missing sifts over a million entries.
+// Within a bucket the order is last in, first out, so the result stays deterministic; the
+// greedy choice is then "largest up to 1/kBucketsPerVoxel of a voxel".
+class BucketQueue {
+ public:
+  explicit BucketQueue(double buckets_per_length) : scale_(buckets_per_length) {}
+  std::int64_t bucket_of(float key) const {
+    const double b = std::floor(static_cast<double>(key) * scale_);
+    return b > 0.0 ? static_cast<std::int64_t>(b) : 0;
+  }
+  double upper_bound(std::int64_t bucket) const { return static_cast<double>(bucket + 1) / scale_; }
+  void push(float key, std::int32_t id) {
+    const std::int64_t b = bucket_of(key);
+    if (b >= static_cast<std::int64_t>(buckets_.size())) buckets_.resize(static_cast<std::size_t>(b) + 1);
+    buckets_[static_cast<std::size_t>(b)].push_back(id);
+    top_ = std::max(top_, b);
+  }
+  bool pop(std::int32_t& id, std::int64_t& bucket) {
+    while (top_ >= 0 && buckets_[static_cast<std::size_t>(top_)].empty()) --top_;
+    if (top_ < 0) return false;
+    auto& b = buckets_[static_cast<std::size_t>(top_)];
+    id = b.back();
+    b.pop_back();
+    bucket = top_;
+    return true;
+  }
+
+ private:
+  double scale_;
+  std::vector<std::vector<std::int32_t>> buckets_;
+  std::int64_t top_ = -1;
+};
+
+class Progress {
+ public:
+  explicit Progress(const std::function<void(double)>& fn) : fn_(fn) {}
+  void report(double f) {
+    if (!fn_) return;
+    f = std::clamp(f, 0.0, 1.0);
+    // at most about 200 calls: the callback may draw a progress bar
+    if (f < last_ + 0.005 && f < 1.0) return;
+    if (f <= last_ && last_ >= 0.0) return;
+    last_ = f;
+    fn_(f);
+  }
+
+ private:
+  const std::function<void(double)>& fn_;
+  double last_ = -1.0;
+};
+
+Vec3 to_vec(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
+
+bool inside_vote(const detail::TriangleBvh& bvh, const Vec3& p) {
+  int votes = 0;
+  for (const Vec3& d : kVoteDirections) votes += bvh.ray_crossings(p, d) % 2;
+  return votes >= 2;
+}
+
+// deterministic points on a triangle: the centroid, then a 2D low-discrepancy sequence folded in
+Vec3 triangle_sample(const detail::Triangle& t, int s) {
+  if (s == 0) return (t.a + t.b + t.c) / 3.0;
+  double u = std::fmod(0.5 + 0.7548776662466927 * s, 1.0);
+  double v = std::fmod(0.5 + 0.5698402909980532 * s, 1.0);
+  if (u + v > 1.0) {
+    u = 1.0 - u;
+    v = 1.0 - v;
+  }
+  return t.a + (t.b - t.a) * u + (t.c - t.a) * v;
+}
+
+}  // namespace
+
+double measure_max_gap(const TriangleMesh& mesh, const std::vector<Sphere>& spheres, int samples_per_triangle) {
+  if (spheres.empty() || mesh.vertices.empty()) return std::numeric_limits<double>::infinity();
+  const Aabb box = mesh_bounds(mesh);
+  const double diag = norm(box.max - box.min);
+  // cell size near the typical small sphere: about 64 cells along the diagonal
+  double cell = diag / 64.0;
+  std::vector<float> radii;
+  radii.reserve(spheres.size());
+  for (const Sphere& s : spheres) radii.push_back(s.radius);
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+  cell = std::clamp(4.0 * static_cast<double>(radii[radii.size() / 2]), diag / 512.0, diag / 16.0);
+  detail::SphereGrid grid(box.min, box.max, cell);
+  for (std::size_t i = 0; i < spheres.size(); ++i) grid.insert(spheres[i], static_cast<std::int32_t>(i));
+  double gap = 0.0;
+  for (const Vec3& v : mesh.vertices) gap = std::max(gap, grid.distance_to_union(v));
+  for (const auto& tri : mesh.triangles) {
+    const detail::Triangle t{mesh.vertices[static_cast<std::size_t>(tri[0])], mesh.vertices[static_cast<std::size_t>(tri[1])],
+                             mesh.vertices[static_cast<std::size_t>(tri[2])]};
+    for (int s = 0; s < samples_per_triangle; ++s) gap = std::max(gap, grid.distance_to_union(triangle_sample(t, s)));
+  }
+  return gap;
+}
+
+Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress(options.progress);
+  progress.report(0.0);
+  const std::string& name = mesh.source_name;
+  if (mesh.triangles.empty()) return Error{fmt::format("{}: cannot pack spheres into an empty mesh", name)};
+  if (!mesh.report.closed_manifold() && !mesh.report.assumed_open) {
+    return Error{fmt::format("{}: cannot pack spheres: the mesh is not closed and 2-manifold (load it with load_mesh)", name)};
+  }
+  const double volume = mesh_volume(mesh);
+  if (!(volume > 0.0)) return Error{fmt::format("{}: cannot pack spheres: the mesh encloses no volume ({})", name, volume)};
+  if (options.target_sphere_count < 0 || options.voxel_size < 0.0 || !std::isfinite(options.voxel_size)) {
+    return Error{fmt::format("{}: invalid packing options (negative sphere count or voxel size)", name)};
+  }
+  const std::int64_t target = options.target_sphere_count;
+  double h = options.voxel_size;
+  if (h == 0.0) {
+    const auto n = static_cast<double>(target > 0 ? target : kDefaultAutoCount);
+    h = std::cbrt(volume / n) * kAutoVoxelFactor;
+  }
+  const Aabb box = mesh_bounds(mesh);
+  const Vec3 origin = box.min - Vec3{h, h, h};
+  const Vec3 ext = box.max - box.min;
+  const std::int64_t nx = static_cast<std::int64_t>(std::ceil(ext.x / h)) + 2;
+  const std::int64_t ny = static_cast<std::int64_t>(std::ceil(ext.y / h)) + 2;
+  const std::int64_t nz = static_cast<std::int64_t>(std::ceil(ext.z / h)) + 2;
+  if (static_cast<double>(nx) * static_cast<double>(ny) * static_cast<double>(nz) > static_cast<double>(kMaxGridVoxels)) {
+    return Error{fmt::format("{}: voxel size {} needs a {}x{}x{} grid, more than {} voxels; use a larger voxel_size",
+                             name, h, nx, ny, nz, kMaxGridVoxels)};
+  }
+  const std::int64_t grid_size = nx * ny * nz;
+  auto centre = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return Vec3{origin.x + (static_cast<double>(i) + 0.5) * h, origin.y + (static_cast<double>(j) + 0.5) * h,
+                origin.z + (static_cast<double>(k) + 0.5) * h};
+  };
+
+  const detail::TriangleBvh bvh(mesh.vertices, mesh.triangles);
+  const bool open = mesh.report.assumed_open;
+
+  // 1. classify voxel centres row by row: one ray along +x per (j, k) row, crossings sorted.
+  // Between two consecutive crossings the whole run is on one side; for closed meshes parity
+  // says which, for open ones the winding number at the run's midpoint does.
+  std::vector<std::int32_t> interior_of(static_cast<std::size_t>(grid_size), -1);
+  std::vector<std::int64_t> interior_cell;
+  std::vector<double> hits;
+  const double diag = norm(ext);
+  for (std::int64_t k = 0; k < nz; ++k) {
+    for (std::int64_t j = 0; j < ny; ++j) {
+      const Vec3 o{origin.x - h, origin.y + (static_cast<double>(j) + 0.5) * h, origin.z + (static_cast<double>(k) + 0.5) * h};
+      hits.clear();
+      bvh.ray_hits(o, {1.0, 0.0, 0.0}, std::numeric_limits<double>::infinity(), hits);
+      if (hits.empty()) continue;
+      std::sort(hits.begin(), hits.end());
+      bool suspicious = !open && hits.size() % 2 != 0;
+      for (std::size_t q = 1; q < hits.size() && !suspicious; ++q) suspicious = (hits[q] - hits[q - 1]) < 1e-9 * diag;
+      std::size_t next_hit = 0;
+      std::int64_t run_start = -1;
+      int run_inside = -1;
+      for (std::int64_t i = 0; i < nx; ++i) {
+        const double t = (static_cast<double>(i) + 0.5) * h + h;
+        bool inside;
+        if (suspicious) {
+          inside = inside_vote(bvh, centre(i, j, k));
+        } else {
+          std::size_t before = next_hit;
+          while (next_hit < hits.size() && hits[next_hit] < t) ++next_hit;
+          if (!open) {
+            inside = (next_hit % 2) == 1;
+          } else {
+            if (next_hit != before || run_start < 0) {
+              run_start = i;
+              const double t0 = next_hit > 0 ? hits[next_hit - 1] : 0.0;
+              const double t1 = next_hit < hits.size() ? hits[next_hit] : t0 + 2.0 * h;
+              run_inside = (next_hit == 0 || next_hit == hits.size())
+                               ? 0
+                               : (bvh.winding_number(o + Vec3{0.5 * (t0 + t1), 0.0, 0.0}) > 0.5 ? 1 : 0);
+            }
+            inside = run_inside == 1;
+          }
+        }
+        if (inside) {
+          const std::int64_t g = i + nx * (j + ny * k);
+          interior_of[static_cast<std::size_t>(g)] = static_cast<std::int32_t>(interior_cell.size());
+          interior_cell.push_back(g);
+        }
+      }
+    }
+    progress.report(0.1 * static_cast<double>(k + 1) / static_cast<double>(nz));
+  }
+  const auto n_interior = static_cast<std::int64_t>(interior_cell.size());
+  if (n_interior == 0) {
+    return Error{fmt::format("{}: no voxel centre lies inside the mesh at voxel size {}; use a smaller voxel_size", name, h)};
+  }
+
+  // 2. distance to the surface for interior voxels: exact near the surface (every triangle
+  // visits the voxels around it), then propagated inwards by passing nearest surface points
+  // between neighbours. Propagated values are distances to real surface points, so they are
+  // upper bounds; the packing loop replaces them with exact BVH distances before using them.
+  const float kInf = std::numeric_limits<float>::infinity();
+  std::vector<float> dsurf(static_cast<std::size_t>(n_interior), kInf);
+  std::vector<Vec3> nearest(static_cast<std::size_t>(n_interior));
+  for (const auto& tri : mesh.triangles) {
+    const detail::Triangle t{mesh.vertices[static_cast<std::size_t>(tri[0])], mesh.vertices[static_cast<std::size_t>(tri[1])],
+                             mesh.vertices[static_cast<std::size_t>(tri[2])]};
+    const Vec3 lo{std::min({t.a.x, t.b.x, t.c.x}), std::min({t.a.y, t.b.y, t.c.y}), std::min({t.a.z, t.b.z, t.c.z})};
+    const Vec3 hi{std::max({t.a.x, t.b.x, t.c.x}), std::max({t.a.y, t.b.y, t.c.y}), std::max({t.a.z, t.b.z, t.c.z})};
+    auto cell_lo = [&](double v, double o) { return static_cast<std::int64_t>(std::floor((v - o) / h - 1.5)); };
+    auto cell_hi = [&](double v, double o) { return static_cast<std::int64_t>(std::ceil((v - o) / h + 0.5)); };
+    const std::int64_t i0 = std::max<std::int64_t>(0, cell_lo(lo.x, origin.x)), i1 = std::min(nx - 1, cell_hi(hi.x, origin.x));
+    const std::int64_t j0 = std::max<std::int64_t>(0, cell_lo(lo.y, origin.y)), j1 = std::min(ny - 1, cell_hi(hi.y, origin.y));
+    const std::int64_t k0 = std::max<std::int64_t>(0, cell_lo(lo.z, origin.z)), k1 = std::min(nz - 1, cell_hi(hi.z, origin.z));
+    for (std::int64_t k = k0; k <= k1; ++k) {
+      for (std::int64_t j = j0; j <= j1; ++j) {
+        for (std::int64_t i = i0; i <= i1; ++i) {
+          const std::int32_t id = interior_of[static_cast<std::size_t>(i + nx * (j + ny * k))];
+          if (id < 0) continue;
+          const Vec3 p = centre(i, j, k);
+          const Vec3 q = detail::closest_point_on_triangle(p, t);
+          const auto d = static_cast<float>(norm(q - p));
+          if (d < dsurf[static_cast<std::size_t>(id)]) {
+            dsurf[static_cast<std::size_t>(id)] = d;
+            nearest[static_cast<std::size_t>(id)] = q;
+          }
+        }
+      }
+    }
+  }
+  progress.report(0.15);
+  {
+    // two raster sweeps (forward over the 13 earlier neighbours, backward over the 13 later)
+    std::int64_t offsets[13];
+    int n_off = 0;
+    for (std::int64_t dk = -1; dk <= 0; ++dk) {
+      for (std::int64_t dj = -1; dj <= 1; ++dj) {
+        for (std::int64_t di = -1; di <= 1; ++di) {
+          const std::int64_t off = di + nx * (dj + ny * dk);
+          if (off < 0) offsets[n_off++] = off;
+        }
+      }
+    }
+    for (int pass = 0; pass < 4; ++pass) {
+      const bool forward = pass % 2 == 0;
+      for (std::int64_t q = 0; q < n_interior; ++q) {
+        const std::int64_t idx = forward ? q : n_interior - 1 - q;
+        const std::int64_t g = interior_cell[static_cast<std::size_t>(idx)];
+        const std::int64_t i = g % nx, j = (g / nx) % ny, k = g / (nx * ny);
+        const Vec3 p = centre(i, j, k);
+        float& d = dsurf[static_cast<std::size_t>(idx)];
+        for (int o = 0; o < n_off; ++o) {
+          const std::int64_t gn = g + (forward ? offsets[o] : -offsets[o]);
+          if (gn < 0 || gn >= grid_size) continue;
+          const std::int32_t nb = interior_of[static_cast<std::size_t>(gn)];
+          if (nb < 0 || dsurf[static_cast<std::size_t>(nb)] == kInf) continue;
+          const Vec3& cand = nearest[static_cast<std::size_t>(nb)];
+          const auto dc = static_cast<float>(norm(cand - p));
+          if (dc < d) {
+            d = dc;
+            nearest[static_cast<std::size_t>(idx)] = cand;
+          }
+        }
+      }
+      progress.report(0.15 + 0.05 * (pass + 1) / 4.0);
+    }
+  }
+  for (float& d : dsurf) {
+    if (d == kInf) d = static_cast<float>(diag);  // unreachable in practice; still an upper bound
+  }
+  std::vector<Vec3>().swap(nearest);
+
+  // 3. greedy largest-free-sphere placement. Heap entries are upper bounds of the current free
+  // radius (it only decreases); a popped entry that turns out smaller is pushed back.
+  std::vector<float> fsph(static_cast<std::size_t>(n_interior), kInf);
+  std::vector<char> exact(static_cast<std::size_t>(n_interior), 0);
+  std::vector<char> removed(static_cast<std::size_t>(n_interior), 0);
+  BucketQueue queue(kBucketsPerVoxel / h);
+  for (std::int64_t q = 0; q < n_interior; ++q) queue.push(dsurf[static_cast<std::size_t>(q)], static_cast<std::int32_t>(q));
+
+  const double min_radius = kMinRadiusInVoxels * h;
+  const double margin = options.safety_margin * h;
+  detail::SphereGrid sgrid(box.min, box.max, 2.0 * h);
+  std::vector<Sphere> spheres;
+  std::int64_t removed_count = 0;
+
+  // free radius at p: exact distance to the surface and to the placed spheres within `reach`
+  auto free_at = [&](const Vec3& p, double reach, Vec3* away) {
+    Vec3 qs{};
+    const double ds = std::sqrt(bvh.closest(p, &qs, reach * reach));
+    std::int32_t nid = -1;
+    const double dsp = sgrid.free_radius(p, std::min(ds, reach), &nid);
+    if (away != nullptr) {
+      if (nid >= 0 && dsp < ds) {
+        *away = normalized(p - to_vec(spheres[static_cast<std::size_t>(nid)]));
+      } else {
+        *away = ds < reach ? normalized(p - qs) : Vec3{};
+      }
+    }
+    return std::min(ds, dsp);
+  };
+
+  std::int32_t id = -1;
+  std::int64_t bucket = 0;
+  while ((target == 0 || static_cast<std::int64_t>(spheres.size()) < target) && queue.pop(id, bucket)) {
+    // every live voxel's free radius is below the top of this bucket
+    const auto key = static_cast<float>(queue.upper_bound(bucket));
+    const auto uid = static_cast<std::size_t>(id);
+    if (removed[uid] != 0) continue;
+    const float current = std::min(dsurf[uid], fsph[uid]);
+    if (static_cast<double>(current) <= min_radius) {
+      removed[uid] = 1;
+      ++removed_count;
+      continue;
+    }
+    if (queue.bucket_of(current) < bucket) {
+      queue.push(current, id);
+      continue;
+    }
+    const std::int64_t g = interior_cell[uid];
+    const Vec3 v = centre(g % nx, (g / nx) % ny, g / (nx * ny));
+    if (exact[uid] == 0) {
+      exact[uid] = 1;
+      const auto d = static_cast<float>(std::sqrt(bvh.closest(v)));
+      if (d < dsurf[uid]) {
+        dsurf[uid] = d;
+        if (queue.bucket_of(std::min(d, fsph[uid])) < bucket) {
+          queue.push(std::min(d, fsph[uid]), id);
+          continue;
+        }
+      }
+    }
+    // refine: walk away from the nearest obstacle while the free radius grows; stay within
+    // half the voxel's surface distance so the centre cannot leave the mesh
+    Vec3 p = v;
+    const double leash = 0.5 * static_cast<double>(dsurf[uid]);
+    // the free radius is 1-Lipschitz, so every evaluation below is bounded by the best value so
+    // far plus the step: searching further would only cost time
+    const double slack = 0.1 * h;
+    Vec3 away{};
+    double best = free_at(p, static_cast<double>(key) * 1.001 + slack, &away);
+    if (options.refine_centres) {
+      // ProtoSphere-style: move away from the nearest obstacle; when that runs into a second
+      // obstacle, follow the ridge between them (the sum of both escape directions)
+      double step = 0.5 * h;
+      Vec3 dir = away;
+      for (int iter = 0; iter < kRefineIterations && step > 0.02 * h; ++iter) {
+        const Vec3 cand = p + dir * step;
+        if (squared_norm(dir) == 0.0 || norm(cand - v) > leash) {
+          step *= 0.5;
+          dir = away;
+          continue;
+        }
+        Vec3 cand_away{};
+        const double f = free_at(cand, best + step + slack, &cand_away);
+        if (f > best) {
+          best = f;
+          p = cand;
+          away = cand_away;
+          dir = away;
+        } else {
+          const Vec3 ridge = normalized(away + cand_away);
+          if (kFollowRidge && dot(ridge, dir) < 0.999 && squared_norm(ridge) > 0.0) {
+            dir = ridge;
+          } else {
+            step *= 0.5;
+            dir = away;
+          }
+        }
+      }
+    }
+    // final radius from the float centre actually stored
+    Sphere s{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), 0.f};
+    const Vec3 pf = to_vec(s);
+    const double r = free_at(pf, best + slack, nullptr) - margin;
+    if (!(r > min_radius) || !inside_vote(bvh, pf)) {
+      removed[uid] = 1;
+      ++removed_count;
+      continue;
+    }
+    s.radius = static_cast<float>(r);
+    if (static_cast<double>(s.radius) > r) s.radius = std::nextafter(s.radius, 0.f);
+    const auto sid = static_cast<std::int32_t>(spheres.size());
+    spheres.push_back(s);
+    sgrid.insert(s, sid);
+
+    // lower the free radius of voxels within reach; voxels whose centre is covered are removed
+    const double rs = static_cast<double>(s.radius);
+    const double affect = rs + static_cast<double>(key) + h;
+    auto lo_cell = [&](double c, double o, std::int64_t n) {
+      return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((c - affect - o) / h)), 0, n - 1);
+    };
+    auto hi_cell = [&](double c, double o, std::int64_t n) {
+      return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::ceil((c + affect - o) / h)), 0, n - 1);
+    };
+    const std::int64_t i0 = lo_cell(pf.x, origin.x, nx), i1 = hi_cell(pf.x, origin.x, nx);
+    const std::int64_t j0 = lo_cell(pf.y, origin.y, ny), j1 = hi_cell(pf.y, origin.y, ny);
+    const std::int64_t k0 = lo_cell(pf.z, origin.z, nz), k1 = hi_cell(pf.z, origin.z, nz);
+    for (std::int64_t k = k0; k <= k1; ++k) {
+      for (std::int64_t j = j0; j <= j1; ++j) {
+        for (std::int64_t i = i0; i <= i1; ++i) {
+          const std::int32_t w = interior_of[static_cast<std::size_t>(i + nx * (j + ny * k))];
+          if (w < 0 || removed[static_cast<std::size_t>(w)] != 0) continue;
+          const double dd = norm(centre(i, j, k) - pf) - rs;
+          if (dd < static_cast<double>(fsph[static_cast<std::size_t>(w)])) {
+            fsph[static_cast<std::size_t>(w)] = static_cast<float>(dd);
+            if (dd <= min_radius) {
+              removed[static_cast<std::size_t>(w)] = 1;
+              ++removed_count;
+            }
+          }
+        }
+      }
+    }
+    if (target > 0) {
+      progress.report(0.2 + 0.75 * static_cast<double>(spheres.size()) / static_cast<double>(target));
+    } else {
+      progress.report(0.2 + 0.75 * static_cast<double>(removed_count) / static_cast<double>(n_interior));
+    }
+  }
+  progress.report(0.95);
+
+  SpherePacking out;
+  out.report.sphere_count = static_cast<std::int64_t>(spheres.size());
+  out.report.mesh_volume = volume;
+  out.report.voxel_size = h;
+  out.report.voxel_count = n_interior;
+  double sv = 0.0;
+  double rmin = std::numeric_limits<double>::infinity();
+  double rmax = 0.0;
+  for (const Sphere& s : spheres) {
+    const double r = static_cast<double>(s.radius);
+    sv += 4.0 / 3.0 * kPi * r * r * r;
+    rmin = std::min(rmin, r);
+    rmax = std::max(rmax, r);
+  }
+  out.report.sphere_volume = sv;
+  out.report.coverage = sv / volume;
+  out.report.min_radius = spheres.empty() ? 0.0 : rmin;
+  out.report.max_radius = rmax;
+  out.report.max_gap = measure_max_gap(mesh, spheres, options.gap_samples_per_triangle);
+  out.spheres = std::move(spheres);
+  out.report.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  progress.report(1.0);
+  return out;
+}
+
+}  // namespace uh::collette
