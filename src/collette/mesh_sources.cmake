@@ -6,4 +6,5 @@ list(APPEND UH_COLLETTE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/mesh_inside.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sphere_grid.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sphere_packing.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/packing_preview.cpp
 )

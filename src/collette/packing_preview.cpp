@@ -1,0 +1,166 @@
+#include "uh/collette/packing_preview.hpp"
+
+#include <png.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fmt/format.h>
+#include <limits>
+#include <system_error>
+
+namespace uh::collette {
+namespace {
+
+struct Rgb {
+  double r, g, b;
+};
+
+// small perceptual ramp (viridis-like): dark blue for small radii to yellow for large ones
+Rgb ramp(double t) {
+  static constexpr Rgb kStops[5] = {{0.27, 0.00, 0.33}, {0.23, 0.32, 0.55}, {0.13, 0.57, 0.55}, {0.37, 0.79, 0.38}, {0.99, 0.91, 0.14}};
+  t = std::clamp(t, 0.0, 1.0) * 4.0;
+  const int i = std::min(3, static_cast<int>(t));
+  const double f = t - i;
+  const Rgb& a = kStops[i];
+  const Rgb& b = kStops[i + 1];
+  return {a.r + (b.r - a.r) * f, a.g + (b.g - a.g) * f, a.b + (b.b - a.b) * f};
+}
+
+Status write_png(const std::filesystem::path& path, int w, int h, const std::vector<unsigned char>& rgb) {
+  FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) return Error{fmt::format("{}: cannot open for writing", path.string())};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr) {
+    png_destroy_write_struct(&png, nullptr);
+    std::fclose(file);
+    return Error{fmt::format("{}: libpng could not start", path.string())};
+  }
+  // libpng reports errors by longjmp; nothing with a destructor lives between here and the end
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(file);
+    return Error{fmt::format("{}: libpng failed while writing", path.string())};
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < h; ++y) {
+    png_write_row(png, rgb.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w) * 3);
+  }
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(file) != 0) return Error{fmt::format("{}: write failed (disk full?)", path.string())};
+  return Ok{};
+}
+
+}  // namespace
+
+Status write_packing_preview(const std::vector<Sphere>& spheres, const std::filesystem::path& png,
+                             const PreviewOptions& options) {
+  const int w = options.width;
+  const int h = options.height;
+  if (w < 1 || h < 1 || w > 16384 || h > 16384) {
+    return Error{fmt::format("{}: preview size {}x{} is out of range (1..16384 pixels a side)", png.string(), w, h)};
+  }
+  // camera: `back` points from the scene towards the camera
+  const double az = options.view_azimuth_deg * kPi / 180.0;
+  const double el = options.view_elevation_deg * kPi / 180.0;
+  const Vec3 back{std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+  const Vec3 right = normalized(cross(Vec3{0.0, 1.0, 0.0}, back));
+  const Vec3 up = cross(back, right);
+  const Vec3 light = normalized(back * 0.8 + up * 0.6 - right * 0.4);
+
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+  double rmin = 1e300, rmax = 0.0;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const Sphere& s : spheres) {
+    const Vec3 c{static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+    const double r = static_cast<double>(s.radius);
+    xmin = std::min(xmin, dot(c, right) - r);
+    xmax = std::max(xmax, dot(c, right) + r);
+    ymin = std::min(ymin, dot(c, up) - r);
+    ymax = std::max(ymax, dot(c, up) + r);
+    rmin = std::min(rmin, r);
+    rmax = std::max(rmax, r);
+    lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
+    hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
+  }
+  const double cut = spheres.empty() ? 0.0 : dot((lo + hi) * 0.5, back);
+
+  std::vector<unsigned char> rgb(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3, 245);
+  if (!spheres.empty()) {
+    std::vector<double> depth(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), -std::numeric_limits<double>::infinity());
+    const double span = std::max(xmax - xmin, ymax - ymin);
+    const double scale = 0.92 * std::min(w, h) / std::max(span, 1e-30);  // pixels per length unit
+    const double cx = 0.5 * (xmin + xmax);
+    const double cy = 0.5 * (ymin + ymax);
+    const double log_span = std::log(std::max(rmax / rmin, 1.0 + 1e-9));
+    for (const Sphere& s : spheres) {
+      const Vec3 c{static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+      const double r = static_cast<double>(s.radius);
+      const double cd = dot(c, back);
+      if (options.section && cd - r > cut) continue;  // wholly in the removed half
+      const double px = 0.5 * w + (dot(c, right) - cx) * scale;
+      const double py = 0.5 * h - (dot(c, up) - cy) * scale;
+      const double pr = r * scale;
+      const Rgb base = ramp(std::log(r / rmin) / log_span);
+      const int x0 = std::max(0, static_cast<int>(std::floor(px - pr)));
+      const int x1 = std::min(w - 1, static_cast<int>(std::ceil(px + pr)));
+      const int y0 = std::max(0, static_cast<int>(std::floor(py - pr)));
+      const int y1 = std::min(h - 1, static_cast<int>(std::ceil(py + pr)));
+      for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+          const double dx = (x + 0.5 - px) / scale;
+          const double dy = -(y + 0.5 - py) / scale;
+          const double q = r * r - dx * dx - dy * dy;
+          if (q < 0.0) continue;
+          const double dz = std::sqrt(q);
+          double z = cd + dz;
+          Vec3 n{dx / r, dy / r, dz / r};  // in (right, up, back) coordinates
+          bool flat = false;
+          if (options.section && z > cut) {
+            if (cd - dz > cut) continue;  // the whole chord lies in the removed half
+            z = cut;
+            flat = true;
+          }
+          const auto pix = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+          if (z <= depth[pix]) continue;
+          depth[pix] = z;
+          double shade;
+          if (flat) {
+            shade = 0.95;  // cross-sections: flat and bright, so the cut reads as a plane of discs
+          } else {
+            const Vec3 nw = right * n.x + up * n.y + back * n.z;
+            shade = 0.25 + 0.75 * std::max(0.0, dot(nw, light));
+          }
+          const Rgb col{base.r * shade, base.g * shade, base.b * shade};
+          rgb[pix * 3 + 0] = static_cast<unsigned char>(std::clamp(col.r * 255.0, 0.0, 255.0));
+          rgb[pix * 3 + 1] = static_cast<unsigned char>(std::clamp(col.g * 255.0, 0.0, 255.0));
+          rgb[pix * 3 + 2] = static_cast<unsigned char>(std::clamp(col.b * 255.0, 0.0, 255.0));
+        }
+      }
+    }
+  }
+
+  // write next to the target and rename, so a failure never leaves a half-written file there
+  const std::filesystem::path dir = png.has_parent_path() ? png.parent_path() : std::filesystem::path(".");
+  const std::filesystem::path tmp = dir / fmt::format(".{}.tmp{}", png.filename().string(), static_cast<long>(::getpid()));
+  Status st = write_png(tmp, w, h, rgb);
+  std::error_code ec;
+  if (!st) {
+    std::filesystem::remove(tmp, ec);
+    return st;
+  }
+  std::filesystem::rename(tmp, png, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    return Error{fmt::format("{}: cannot move the finished picture into place: {}", png.string(), ec.message())};
+  }
+  return Ok{};
+}
+
+}  // namespace uh::collette
