@@ -1,5 +1,6 @@
 #include "uh/haptico/haptic_manager.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -33,6 +34,8 @@ FixedRateLoopOptions loop_options(const HapticManagerOptions& o) {
 HapticManager::HapticManager(std::unique_ptr<HapticDevice> device, const HapticManagerOptions& options)
     : options_(options), device_(std::move(device)), loop_(loop_options(options)) {
   assert(device_ != nullptr && "uh::haptico::HapticManager::HapticManager(): device must not be null");
+  const double fade_ticks = options_.soft_start_s * options_.rate_hz;
+  fade_ticks_ = fade_ticks > 1.0 && std::isfinite(fade_ticks) ? fade_ticks : 1.0;
   if (options_.trace_capacity > 0) trace_ = std::make_unique<SpscQueue<TraceSample>>(options_.trace_capacity);
 }
 
@@ -64,6 +67,7 @@ Status HapticManager::open() {
     return refuse("is 6-DOF actuated but reports no valid max_torque_nm; refusing to send it torques");
   }
   open_ = true;
+  fade_count_ = 0;
   return Ok{};
 }
 
@@ -73,6 +77,7 @@ Status HapticManager::start() {
   }
   if (loop_.running()) return Error{"haptic manager: already running"};
   if (Status s = open(); !s) return s;
+  restart_fade_.store(true, std::memory_order_release);
   return loop_.start([this](const TickInfo& t) {
     const double now = std::chrono::duration<double>(t.start_time.time_since_epoch()).count();
     tick(now);
@@ -121,10 +126,19 @@ TraceSample HapticManager::tick(double now_s) {
     torque_clamped_.increment();
     sample.flags |= kTraceTorqueClamped;
   }
+  if (restart_fade_.exchange(false, std::memory_order_acq_rel)) fade_count_ = 0;
   if (halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire)) {
     zeroed_ticks_.increment();
     sample.flags |= kTraceZeroed;
     out = DeviceCommand{};
+    fade_count_ = 0;
+  } else if (static_cast<double>(fade_count_) < fade_ticks_) {
+    // gain from the tick count, not a running sum, so that it reaches exactly 1
+    ++fade_count_;
+    const double gain = std::min(1.0, static_cast<double>(fade_count_) / fade_ticks_);
+    out.force *= gain;
+    out.torque *= gain;
+    if (gain < 1.0) sample.flags |= kTraceFading;
   }
   sample.sent = out;
   device_->command(out);

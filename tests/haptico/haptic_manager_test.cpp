@@ -64,7 +64,7 @@ struct Fixture {
   FakeDevice* device = nullptr;
   std::unique_ptr<HapticManager> manager;
 
-  explicit Fixture(HapticManagerOptions options = {}, bool with_log = true) {
+  explicit Fixture(HapticManagerOptions options = {.soft_start_s = 0.0}, bool with_log = true) {
     auto d = std::make_unique<FakeDevice>(with_log ? &log : nullptr);
     device = d.get();
     manager = std::make_unique<HapticManager>(std::move(d), options);
@@ -180,6 +180,34 @@ TEST(HapticManager, DeviceErrorLatchesZeroForce) {
   EXPECT_EQ(f.manager->stats().device_errors, 1u);
 }
 
+TEST(HapticManager, SoftStartFadesForceIn) {
+  Fixture f({.rate_hz = 1000.0, .soft_start_s = 0.01});  // ten ticks
+  ASSERT_TRUE(f.manager->open());
+  f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) {
+    cmd.force = {0, 0, 2};
+    cmd.torque = {0.1, 0, 0};
+  });
+  for (int i = 1; i <= 10; ++i) {
+    const TraceSample t = f.manager->step(0.001 * i);
+    EXPECT_NEAR(t.sent.force.z, 0.2 * i, 1e-12) << "tick " << i;
+    EXPECT_NEAR(t.sent.torque.x, 0.01 * i, 1e-12) << "tick " << i;
+    EXPECT_EQ((t.flags & kTraceFading) != 0, i < 10);
+  }
+  EXPECT_EQ(f.manager->step(0.011).sent.force.z, 2.0);
+  // after a halt the force fades in again instead of jumping back
+  f.manager->halt();
+  f.manager->step(0.012);
+  f.manager->resume();
+  EXPECT_NEAR(f.manager->step(0.013).sent.force.z, 0.2, 1e-12);
+  for (int i = 0; i < 10; ++i) f.manager->step(0.014 + 0.001 * i);
+  // and after a device fault is cleared
+  f.device->status = DeviceStatus::kFault;
+  f.manager->step(0.03);
+  f.device->status = DeviceStatus::kOk;
+  f.manager->clear_fault();
+  EXPECT_NEAR(f.manager->step(0.031).sent.force.z, 0.2, 1e-12);
+}
+
 TEST(HapticManager, OpenFailuresAreErrors) {
   Fixture f;
   f.device->fail_open = true;
@@ -202,7 +230,7 @@ TEST(HapticManager, OpenFailuresAreErrors) {
 }
 
 TEST(HapticManager, TraceRecordsTicksAndWritesCsv) {
-  Fixture f({.trace_capacity = 4});
+  Fixture f({.trace_capacity = 4, .soft_start_s = 0.0});
   ASSERT_TRUE(f.manager->open());
   f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {0, 0, 2}; });
   // the queue may round its capacity up: overfill it by far and check that nothing is lost unseen
@@ -228,7 +256,7 @@ TEST(HapticManager, TraceRecordsTicksAndWritesCsv) {
 TEST(HapticManager, ThreadedRunTicksAndStopZeroesForce) {
   auto device = std::make_unique<SimLineDevice>(SimLineOptions{});
   SimLineDevice* raw = device.get();
-  HapticManager manager(std::move(device), {.rate_hz = 1000.0});
+  HapticManager manager(std::move(device), {.rate_hz = 1000.0, .soft_start_s = 0.0});
   std::atomic<int> moves{0};
   std::atomic<int> forces{0};
   manager.move_on_haptic_tick().add_delegate([&](const DeviceState&) { moves.fetch_add(1); });

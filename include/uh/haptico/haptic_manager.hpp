@@ -25,6 +25,10 @@ struct HapticManagerOptions {
   double rate_hz = 1000.0;          ///< haptic tick rate [Hz], in (0, 10000]; devices run 1-4 kHz
   bool raise_priority = false;      ///< ask for SCHED_FIFO for the haptic thread (see FixedRateLoop)
   std::size_t trace_capacity = 0;   ///< ticks the trace queue holds between drains; 0 = no trace
+  /// Time [s] over which forces fade in after open(), start(), resume() and clear_fault(), so that a tool
+  /// that starts inside an object does not jolt the hand; counted in ticks at rate_hz (also in
+  /// stepped sessions). 0 disables the fade.
+  double soft_start_s = 0.05;
 };
 
 /// Counters of a HapticManager; a snapshot, plain data.
@@ -48,7 +52,8 @@ struct HapticStats {
 ///      which starts at zero);
 ///   4. safety: a NaN/inf anywhere -> zero (counted); force and torque scaled down to the
 ///      device's max_force_n / max_torque_nm (counted); torque zeroed on 3-DOF devices; zero while
-///      halted or after a device error (latched until clear_fault());
+///      halted or after a device error (latched until clear_fault()); a linear fade-in over
+///      soft_start_s after open(), start(), resume() and clear_fault();
 ///   5. device.command(command); the tick is pushed to the trace queue if enabled.
 /// The same tick code runs in threaded sessions (start()/stop()) and stepped ones (step()).
 ///
@@ -85,9 +90,15 @@ class HapticManager {
   /// thread; real-time safe.
   void halt() { halted_.store(true, std::memory_order_release); }
   /// Ends a halt(). Any thread.
-  void resume() { halted_.store(false, std::memory_order_release); }
-  /// Clears a latched device fault so that forces are sent again. Any thread.
-  void clear_fault() { faulted_.store(false, std::memory_order_release); }
+  void resume() {
+    restart_fade_.store(true, std::memory_order_release);
+    halted_.store(false, std::memory_order_release);
+  }
+  /// Clears a latched device fault so that forces fade in again. Any thread.
+  void clear_fault() {
+    restart_fade_.store(true, std::memory_order_release);
+    faulted_.store(false, std::memory_order_release);
+  }
 
   /// Binding side of MoveOnHapticTick(const DeviceState&). See the thread rules above.
   DelegateSink<const DeviceState&> move_on_haptic_tick() { return DelegateSink{move_event_}; }
@@ -124,6 +135,9 @@ class HapticManager {
   Delegator<const DeviceState&, DeviceCommand&> force_event_;
   std::unique_ptr<SpscQueue<TraceSample>> trace_;
   double tick_time_s_ = 0.0;
+  std::int64_t fade_count_ = 0;  // ticks since the fade-in restarted (haptic thread)
+  double fade_ticks_ = 1.0;      // ticks the fade-in takes, >= 1
+  std::atomic<bool> restart_fade_{false};
   std::atomic<bool> halted_{false};
   std::atomic<bool> faulted_{false};
   EventCounter ticks_;

@@ -18,6 +18,7 @@ enum TraceFlag : std::uint32_t {
   kTraceNonFinite = 1u << 2,      ///< the requested command had a NaN/inf and was replaced by zero
   kTraceZeroed = 1u << 3,         ///< zero was sent because of halt() or a latched device fault
   kTraceDeviceError = 1u << 4,    ///< read_state() reported an error this tick
+  kTraceFading = 1u << 5,         ///< the soft-start fade scaled the command down
 };
 
 /// One tick: when, what the device reported, what the delegates asked for and what was sent.
