@@ -33,6 +33,7 @@ TEST(DelegatorAllocation, CounterSeesAllocations) {
 }
 
 TEST(DelegatorAllocation, BroadcastNeverAllocates) {
+  g_sum = 0.0;
   uh::Delegator<const Payload&> d;
   Accumulator acc;
   std::vector<double> seen;
