@@ -37,7 +37,7 @@ PenaltyResult ForceComponent::evaluate(const ContactFrame& frame, const BodyMoti
 
 PenaltyResult ForceComponent::evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
                                        const BodyMotion& self, const BodyMotion& other) const {
-  return evaluate_penalty(held.reevaluate(world_from_a, world_from_b), penalty_input(self, other));
+  return held.evaluate(world_from_a, world_from_b, penalty_input(self, other));
 }
 
 }  // namespace uh::forcecomp

@@ -26,7 +26,8 @@ HeldContactSet::HeldContactSet(std::int32_t capacity)
     : capacity_(capacity),
       held_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
       normal_a_local_(new Vec3[static_cast<std::size_t>(std::max(capacity, 1))]),
-      scratch_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]) {
+      scratch_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
+      local_(new LocalPair[static_cast<std::size_t>(std::max(capacity, 1))]) {
   assert(capacity > 0 && "uh::forcecomp::HeldContactSet::HeldContactSet(): capacity must be positive");
 }
 
@@ -84,6 +85,61 @@ std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_
     store(out.centroid_world, centroid);
   }
   return {scratch_.get(), static_cast<std::size_t>(size_)};
+}
+
+PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& world_from_b, const PenaltyInput& input) {
+  // everything in A's frame: A's spheres need no transform, B's one; the sums turn back at the end
+  const Pose a_from_world = inverse(world_from_a);
+  const Pose a_from_b = a_from_world * world_from_b;
+  double total = 0.0;
+  for (std::int32_t k = 0; k < size_; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const SpherePairContact& in = held_[i];
+    const Vec3 ca = centre(in.sphere_a_local);
+    const Vec3 cb = transform_point(a_from_b, centre(in.sphere_b_local));
+    const double ra = static_cast<double>(in.sphere_a_local.radius);
+    const double rb = static_cast<double>(in.sphere_b_local.radius);
+    const Vec3 delta = cb - ca;
+    const double d = norm(delta);
+    LocalPair& out = local_[i];
+    out.volume = lens_volume(d, ra, rb);
+    if (!(out.volume > 0.0)) continue;
+    out.normal_a = d > 1e-6 * (ra + rb) ? delta / d : normal_a_local_[i];
+    out.centroid_a = ca + lens_centroid_offset(d, ra, rb) * out.normal_a;
+    total += out.volume;
+  }
+
+  PenaltyResult result;
+  result.total_volume = total;
+  if (!(total > 0.0)) return result;
+
+  const auto to_a = [&a_from_world](const BodyMotion& m) {
+    return BodyMotion{transform_point(a_from_world, m.center_of_mass_world),
+                      rotate(a_from_world.rotation, m.linear_velocity_world),
+                      rotate(a_from_world.rotation, m.angular_velocity_world)};
+  };
+  const BodyMotion tool = to_a(input.tool);
+  const BodyMotion other = to_a(input.other);
+  const double sign = input.tool_side == ContactSide::kB ? 1.0 : -1.0;
+  const double damping_per_volume = input.damping / total;
+  const bool six_dof = input.mode == ForceMode::k6Dof;
+  Vec3 force{};
+  Vec3 torque{};
+  for (std::int32_t k = 0; k < size_; ++k) {
+    const LocalPair& p = local_[static_cast<std::size_t>(k)];
+    if (!(p.volume > 0.0)) continue;
+    ++result.pair_count;
+    const Vec3 n = sign * p.normal_a;
+    const double vel = dot(tool.point_velocity(p.centroid_a) - other.point_velocity(p.centroid_a), n);
+    const double f = input.force_scale * p.volume - damping_per_volume * vel * p.volume;
+    if (!(f > 0.0)) continue;  // never pull the objects together
+    ++result.pushing_pairs;
+    force += f * n;
+    if (six_dof) torque += cross(p.centroid_a - tool.center_of_mass_world, f * n);
+  }
+  result.wrench.force = rotate(world_from_a.rotation, force);
+  result.wrench.torque = rotate(world_from_a.rotation, torque);
+  return result;
 }
 
 }  // namespace uh::forcecomp

@@ -61,6 +61,7 @@ TEST(HeldContactSet, ReevaluationMatchesBruteForceAtNewPose) {
 
   HeldContactSet held(256);
   held.hold(before, 7, 1.25);
+  EXPECT_EQ(held.dropped_pairs(), 0u);
   EXPECT_EQ(held.size(), static_cast<int>(before.size()));
   EXPECT_EQ(held.sequence(), 7u);
   EXPECT_EQ(held.time_s(), 1.25);
@@ -112,6 +113,45 @@ TEST(HeldContactSet, ReevaluatedPairsMatchBruteForcePerPair) {
         EXPECT_NEAR(now[i].centroid_world[k], ref.centroid_world[k], 1e-5f);
       }
     }
+  }
+}
+
+TEST(HeldContactSet, FusedEvaluationMatchesReevaluateThenPenalty) {
+  std::mt19937 rng(11);
+  const std::vector<Sphere> a = random_spheres(rng, 30);
+  const std::vector<Sphere> b = random_spheres(rng, 30);
+  const Pose wa = pose_of({0.2, 0.1, -0.1}, {1, -1, 2}, 0.7);
+  const Pose b0 = pose_of({0.6, 0.3, 0.1}, {0, 1, 0}, 0.5);
+  const Pose b1 = pose_of({0.62, 0.29, 0.08}, {0.1, 1, 0}, 0.53);  // new pairs may appear: irrelevant here
+  auto frame = std::make_unique<ContactFrame>();
+  const std::vector<SpherePairContact> before = brute_force_pairs(a, wa, b, b0);
+  ASSERT_GT(before.size(), 10u);
+  std::copy(before.begin(), before.end(), frame->pairs.begin());
+  frame->pair_count = static_cast<std::int32_t>(before.size());
+  frame->world_from_a = wa;
+  frame->world_from_b = b0;
+  HeldContactSet held(64);
+  held.hold(*frame);
+  EXPECT_EQ(held.dropped_pairs(), 0u);
+
+  for (const ContactSide side : {ContactSide::kA, ContactSide::kB}) {
+    PenaltyInput in;
+    in.force_scale = 500.0;
+    in.damping = 3.0;
+    in.tool_side = side;
+    in.tool = {{0.6, 0.3, 0.1}, {0.2, -0.4, 0.1}, {1.0, -2.0, 0.5}};
+    in.other = {{0.2, 0.1, -0.1}, {-0.1, 0.0, 0.3}, {0.0, 0.5, 0.0}};
+    const PenaltyResult reference = evaluate_penalty(held.reevaluate(wa, b1), in);
+    const PenaltyResult fused = held.evaluate(wa, b1, in);
+    const double fs = norm(reference.wrench.force);
+    const double ts = norm(reference.wrench.torque);
+    ASSERT_GT(fs, 0.0);
+    ASSERT_GT(ts, 0.0);
+    EXPECT_LT(norm(fused.wrench.force - reference.wrench.force), 1e-4 * fs);
+    EXPECT_LT(norm(fused.wrench.torque - reference.wrench.torque), 1e-4 * ts);
+    EXPECT_EQ(fused.pair_count, reference.pair_count);
+    EXPECT_EQ(fused.pushing_pairs, reference.pushing_pairs);
+    EXPECT_NEAR(fused.total_volume, reference.total_volume, 1e-5 * reference.total_volume);
   }
 }
 

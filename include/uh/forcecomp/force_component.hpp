@@ -45,8 +45,8 @@ class ForceComponent {
                          const BodyMotion& other = {}) const;
   /// Same from a whole ContactFrame (at the poses the query used).
   PenaltyResult evaluate(const ContactFrame& frame, const BodyMotion& self, const BodyMotion& other = {}) const;
-  /// Multi-rate: re-evaluates a held pair set at the current poses of A and B, then the force.
-  /// Not const on `held` because it writes the held set's preallocated scratch.
+  /// Multi-rate: re-evaluates a held pair set at the current poses of A and B and computes the
+  /// force (HeldContactSet::evaluate). `held` is not const: it writes its preallocated scratch.
   PenaltyResult evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
                          const BodyMotion& self, const BodyMotion& other = {}) const;
 

@@ -9,6 +9,7 @@
 
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
+#include "uh/forcecomp/penalty_force.hpp"
 
 namespace uh::forcecomp {
 
@@ -43,6 +44,13 @@ class HeldContactSet {
   /// is kept. Returns a view of the preallocated scratch, valid until the next call. Real-time safe.
   std::span<const SpherePairContact> reevaluate(const Pose& world_from_a, const Pose& world_from_b);
 
+  /// Re-evaluates the held pairs at the poses world_from_a, world_from_b and applies the penalty
+  /// law (penalty_force.hpp) in the same pass: equal, up to rounding, to
+  /// evaluate_penalty(reevaluate(world_from_a, world_from_b), input), but faster (about 1.3x in
+  /// uh_forcecomp_bench) because it works in A's frame (one rotation per pair) on compact scratch
+  /// and keeps doubles throughout. The result is in the world frame. Real-time safe.
+  PenaltyResult evaluate(const Pose& world_from_a, const Pose& world_from_b, const PenaltyInput& input);
+
   std::int32_t size() const { return size_; }
   std::int32_t capacity() const { return capacity_; }
   bool empty() const { return size_ == 0; }
@@ -62,6 +70,12 @@ class HeldContactSet {
   std::unique_ptr<SpherePairContact[]> held_;   // pairs as held (sphere locals are what matters)
   std::unique_ptr<Vec3[]> normal_a_local_;      // held normals in A's frame, for coincident centres
   std::unique_ptr<SpherePairContact[]> scratch_;  // output of reevaluate()
+  struct LocalPair {
+    double volume;
+    Vec3 normal_a;    // unit, A's frame, from a towards b
+    Vec3 centroid_a;  // A's frame
+  };
+  std::unique_ptr<LocalPair[]> local_;  // scratch of evaluate()
 };
 
 }  // namespace uh::forcecomp
