@@ -22,6 +22,9 @@ bool clamp_norm(Vec3& v, double limit) {
 
 Wrench ForceSafety::apply(const Wrench& raw, double now_s, double data_time_s) {
   bump(ticks_);
+  // read the stop/fault state before the resume request: resume() publishes the request before it
+  // clears the stop, so a tick that sees the stop cleared also sees the request (no one-tick spike)
+  const bool zero = stopped_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire);
   if (resume_requested_.exchange(false, std::memory_order_acq_rel)) watchdog_.reset(0.0);
 
   Wrench w = raw;
@@ -36,7 +39,7 @@ Wrench ForceSafety::apply(const Wrench& raw, double now_s, double data_time_s) {
   w.torque *= gain;
   if (clamp_norm(w.force, options_.max_force_n)) bump(force_clamped_);
   if (clamp_norm(w.torque, options_.max_torque_nm)) bump(torque_clamped_);
-  if (stopped_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire)) {
+  if (zero) {
     bump(zeroed_ticks_);
     return Wrench{};
   }
@@ -44,8 +47,8 @@ Wrench ForceSafety::apply(const Wrench& raw, double now_s, double data_time_s) {
 }
 
 void ForceSafety::resume() {
-  faulted_.store(false, std::memory_order_release);
   resume_requested_.store(true, std::memory_order_release);
+  faulted_.store(false, std::memory_order_release);
   stopped_.store(false, std::memory_order_release);
 }
 

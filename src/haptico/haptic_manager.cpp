@@ -126,8 +126,11 @@ TraceSample HapticManager::tick(double now_s) {
     torque_clamped_.increment();
     sample.flags |= kTraceTorqueClamped;
   }
+  // the halt/fault state first: resume() and clear_fault() publish the fade restart before they
+  // clear it, so a tick that sees it cleared also sees the restart
+  const bool zero = halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire);
   if (restart_fade_.exchange(false, std::memory_order_acq_rel)) fade_count_ = 0;
-  if (halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire)) {
+  if (zero) {
     zeroed_ticks_.increment();
     sample.flags |= kTraceZeroed;
     out = DeviceCommand{};
