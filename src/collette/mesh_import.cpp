@@ -122,29 +122,19 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
   }
   const double diag = bbox_diagonal(mesh.vertices);
 
-  // weld, then drop vertices no triangle uses
+  // weld: every index now names the representative of its cluster in the input array
   const std::vector<std::int32_t> map = weld_map(mesh.vertices, options.weld_tolerance * diag);
-  std::vector<std::int32_t> compact(mesh.vertices.size(), -1);
-  std::vector<Vec3> vertices;
   for (auto& t : mesh.triangles) {
-    for (std::int32_t& i : t) {
-      const auto root = static_cast<std::size_t>(map[static_cast<std::size_t>(i)]);
-      if (compact[root] < 0) {
-        compact[root] = static_cast<std::int32_t>(vertices.size());
-        vertices.push_back(mesh.vertices[root]);
-      }
-      i = compact[root];
-    }
+    for (std::int32_t& i : t) i = map[static_cast<std::size_t>(i)];
   }
   std::int64_t distinct_inputs = 0;
   for (std::size_t i = 0; i < map.size(); ++i) distinct_inputs += (map[i] == static_cast<std::int32_t>(i)) ? 1 : 0;
   report.welded_vertices = report.input_vertex_count - distinct_inputs;
-  mesh.vertices = std::move(vertices);
 
   // degenerate faces: repeated vertices after welding, or (near) zero area
   std::vector<std::array<std::int32_t, 3>> kept;
   kept.reserve(mesh.triangles.size());
-  std::vector<char> repeated(mesh.triangles.size(), 0);
+  std::vector<char> degenerate(mesh.triangles.size(), 0);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const auto& t = mesh.triangles[f];
     const Vec3& a = mesh.vertices[static_cast<std::size_t>(t[0])];
@@ -154,12 +144,27 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     const bool tiny = norm(cross(b - a, c - a)) <= options.degenerate_area_tolerance * diag * diag;
     if (rep || tiny) {
       ++report.degenerate_faces;
-      repeated[f] = rep ? 1 : 0;
+      degenerate[f] = 1;  // kept out of the edge counts, so one bad face is reported once
       if (options.drop_degenerate) continue;
     }
     kept.push_back(t);
   }
   if (options.drop_degenerate) mesh.triangles = std::move(kept);
+
+  // drop vertices no triangle uses and number the rest in order of first use
+  std::vector<std::int32_t> compact(mesh.vertices.size(), -1);
+  std::vector<Vec3> vertices;
+  for (auto& t : mesh.triangles) {
+    for (std::int32_t& i : t) {
+      const auto root = static_cast<std::size_t>(i);
+      if (compact[root] < 0) {
+        compact[root] = static_cast<std::int32_t>(vertices.size());
+        vertices.push_back(mesh.vertices[root]);
+      }
+      i = compact[root];
+    }
+  }
+  mesh.vertices = std::move(vertices);
   report.triangle_count = static_cast<std::int64_t>(mesh.triangles.size());
   report.vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
   if (mesh.triangles.empty()) {
@@ -176,7 +181,7 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
   uses.reserve(mesh.triangles.size() * 3);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const auto& t = mesh.triangles[f];
-    if (!options.drop_degenerate && repeated[f] != 0) continue;
+    if (!options.drop_degenerate && degenerate[f] != 0) continue;
     for (int e = 0; e < 3; ++e) {
       const std::int32_t a = t[static_cast<std::size_t>(e)];
       const std::int32_t b = t[static_cast<std::size_t>((e + 1) % 3)];

@@ -22,14 +22,7 @@ MeshInside& MeshInside::operator=(MeshInside&&) noexcept = default;
 
 bool MeshInside::contains(const Vec3& p) const {
   if (impl_->open) return winding_number(p) > 0.5;
-  // three fixed, non-axis-aligned directions: a ray that grazes an edge or vertex (and so
-  // counts a crossing twice or not at all) is outvoted by the other two
-  static constexpr Vec3 kDirections[3] = {{0.8017837257372732, 0.2672612419124244, 0.5345224838248488},
-                                          {-0.3015113445777636, 0.9045340337332909, 0.3015113445777636},
-                                          {0.2357022603955158, -0.4714045207910317, 0.8498365855987975}};
-  int votes = 0;
-  for (const Vec3& d : kDirections) votes += impl_->bvh.ray_crossings(p, d) % 2;
-  return votes >= 2;
+  return impl_->bvh.inside_vote(p);
 }
 
 double MeshInside::winding_number(const Vec3& p) const { return impl_->bvh.winding_number(p); }

@@ -23,11 +23,6 @@ constexpr int kRefineIterations = 24;
 constexpr bool kFollowRidge = false;
 constexpr double kBucketsPerVoxel = 32.0;
 
-// Three fixed non-axis directions for the majority-vote parity test.
-constexpr Vec3 kVoteDirections[3] = {{0.8017837257372732, 0.2672612419124244, 0.5345224838248488},
-                                     {-0.3015113445777636, 0.9045340337332909, 0.3015113445777636},
-                                     {0.2357022603955158, -0.4714045207910317, 0.8498365855987975}};
-
 // Max-priority queue of voxel ids keyed by free radius, quantised into buckets of 1/delta:
 // O(1) push and pop instead of a binary heap's cache-missing sifts over a million entries.
 // Within a bucket the order is last in, first out, so the result stays deterministic; the
@@ -82,11 +77,6 @@ class Progress {
 
 Vec3 to_vec(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
 
-bool inside_vote(const detail::TriangleBvh& bvh, const Vec3& p) {
-  int votes = 0;
-  for (const Vec3& d : kVoteDirections) votes += bvh.ray_crossings(p, d) % 2;
-  return votes >= 2;
-}
 
 // deterministic points on a triangle: the centroid, then a 2D low-discrepancy sequence folded in
 Vec3 triangle_sample(const detail::Triangle& t, int s) {
@@ -98,6 +88,61 @@ Vec3 triangle_sample(const detail::Triangle& t, int s) {
     v = 1.0 - v;
   }
   return t.a + (t.b - t.a) * u + (t.c - t.a) * v;
+}
+
+// Closes each hole of an open mesh with a fan around the hole's centroid, wound against the
+// boundary so that the result is consistently oriented. This is the assumption pack_spheres
+// makes for meshes accepted with allow_open: holes are spanned by (nearly) flat caps.
+TriangleMesh cap_holes(const TriangleMesh& mesh) {
+  TriangleMesh out = mesh;
+  std::vector<std::pair<std::uint64_t, std::int32_t>> undirected;  // (edge key, source vertex)
+  for (const auto& t : mesh.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::int32_t a = t[static_cast<std::size_t>(e)];
+      const std::int32_t b = t[static_cast<std::size_t>((e + 1) % 3)];
+      const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+      const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+      undirected.emplace_back((lo << 32) | hi, a);
+    }
+  }
+  std::sort(undirected.begin(), undirected.end());
+  // boundary edges as directed a -> b, sorted by a for lookup
+  std::vector<std::pair<std::int32_t, std::int32_t>> next;
+  for (std::size_t i = 0; i < undirected.size();) {
+    std::size_t j = i;
+    while (j < undirected.size() && undirected[j].first == undirected[i].first) ++j;
+    if (j - i == 1) {
+      const auto lo = static_cast<std::int32_t>(undirected[i].first >> 32);
+      const auto hi = static_cast<std::int32_t>(undirected[i].first & 0xffffffffULL);
+      const std::int32_t a = undirected[i].second;
+      next.emplace_back(a, a == lo ? hi : lo);
+    }
+    i = j;
+  }
+  std::sort(next.begin(), next.end());
+  std::vector<char> used(next.size(), 0);
+  for (std::size_t start = 0; start < next.size(); ++start) {
+    if (used[start] != 0) continue;
+    std::vector<std::int32_t> loop;
+    std::size_t e = start;
+    while (used[e] == 0) {
+      used[e] = 1;
+      loop.push_back(next[e].first);
+      const std::int32_t to = next[e].second;
+      auto it = std::lower_bound(next.begin(), next.end(), std::make_pair(to, std::numeric_limits<std::int32_t>::min()));
+      while (it != next.end() && it->first == to && used[static_cast<std::size_t>(it - next.begin())] != 0) ++it;
+      if (it == next.end() || it->first != to) break;
+      e = static_cast<std::size_t>(it - next.begin());
+    }
+    if (loop.size() < 3) continue;
+    Vec3 c{};
+    for (const std::int32_t v : loop) c += mesh.vertices[static_cast<std::size_t>(v)];
+    out.vertices.push_back(c / static_cast<double>(loop.size()));
+    const auto ci = static_cast<std::int32_t>(out.vertices.size() - 1);
+    for (std::size_t i = 0; i < loop.size(); ++i) out.triangles.push_back({ci, loop[(i + 1) % loop.size()], loop[i]});
+  }
+  out.report.assumed_open = false;
+  return out;
 }
 
 }  // namespace
@@ -134,7 +179,10 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   if (!mesh.report.closed_manifold() && !mesh.report.assumed_open) {
     return Error{fmt::format("{}: cannot pack spheres: the mesh is not closed and 2-manifold (load it with load_mesh)", name)};
   }
-  const double volume = mesh_volume(mesh);
+  // open meshes are packed as if their holes were closed by flat fans
+  const TriangleMesh capped = mesh.report.assumed_open ? cap_holes(mesh) : TriangleMesh{};
+  const TriangleMesh& solid = mesh.report.assumed_open ? capped : mesh;
+  const double volume = mesh_volume(solid);
   if (!(volume > 0.0)) return Error{fmt::format("{}: cannot pack spheres: the mesh encloses no volume ({})", name, volume)};
   if (options.target_sphere_count < 0 || options.voxel_size < 0.0 || !std::isfinite(options.voxel_size)) {
     return Error{fmt::format("{}: invalid packing options (negative sphere count or voxel size)", name)};
@@ -161,12 +209,11 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
                 origin.z + (static_cast<double>(k) + 0.5) * h};
   };
 
-  const detail::TriangleBvh bvh(mesh.vertices, mesh.triangles);
-  const bool open = mesh.report.assumed_open;
+  const detail::TriangleBvh bvh(solid.vertices, solid.triangles);
 
-  // 1. classify voxel centres row by row: one ray along +x per (j, k) row, crossings sorted.
-  // Between two consecutive crossings the whole run is on one side; for closed meshes parity
-  // says which, for open ones the winding number at the run's midpoint does.
+  // 1. classify voxel centres row by row: one ray along +x per (j, k) row, crossings sorted,
+  // parity. Rows whose ray grazes an edge or vertex (odd count, coincident crossings) fall back
+  // to a three-ray vote per voxel.
   std::vector<std::int32_t> interior_of(static_cast<std::size_t>(grid_size), -1);
   std::vector<std::int64_t> interior_cell;
   std::vector<double> hits;
@@ -178,32 +225,17 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
       bvh.ray_hits(o, {1.0, 0.0, 0.0}, std::numeric_limits<double>::infinity(), hits);
       if (hits.empty()) continue;
       std::sort(hits.begin(), hits.end());
-      bool suspicious = !open && hits.size() % 2 != 0;
+      bool suspicious = hits.size() % 2 != 0;
       for (std::size_t q = 1; q < hits.size() && !suspicious; ++q) suspicious = (hits[q] - hits[q - 1]) < 1e-9 * diag;
       std::size_t next_hit = 0;
-      std::int64_t run_start = -1;
-      int run_inside = -1;
       for (std::int64_t i = 0; i < nx; ++i) {
         const double t = (static_cast<double>(i) + 0.5) * h + h;
         bool inside;
         if (suspicious) {
-          inside = inside_vote(bvh, centre(i, j, k));
+          inside = bvh.inside_vote(centre(i, j, k));
         } else {
-          std::size_t before = next_hit;
           while (next_hit < hits.size() && hits[next_hit] < t) ++next_hit;
-          if (!open) {
-            inside = (next_hit % 2) == 1;
-          } else {
-            if (next_hit != before || run_start < 0) {
-              run_start = i;
-              const double t0 = next_hit > 0 ? hits[next_hit - 1] : 0.0;
-              const double t1 = next_hit < hits.size() ? hits[next_hit] : t0 + 2.0 * h;
-              run_inside = (next_hit == 0 || next_hit == hits.size())
-                               ? 0
-                               : (bvh.winding_number(o + Vec3{0.5 * (t0 + t1), 0.0, 0.0}) > 0.5 ? 1 : 0);
-            }
-            inside = run_inside == 1;
-          }
+          inside = (next_hit % 2) == 1;
         }
         if (inside) {
           const std::int64_t g = i + nx * (j + ny * k);
@@ -226,9 +258,9 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   const float kInf = std::numeric_limits<float>::infinity();
   std::vector<float> dsurf(static_cast<std::size_t>(n_interior), kInf);
   std::vector<Vec3> nearest(static_cast<std::size_t>(n_interior));
-  for (const auto& tri : mesh.triangles) {
-    const detail::Triangle t{mesh.vertices[static_cast<std::size_t>(tri[0])], mesh.vertices[static_cast<std::size_t>(tri[1])],
-                             mesh.vertices[static_cast<std::size_t>(tri[2])]};
+  for (const auto& tri : solid.triangles) {
+    const detail::Triangle t{solid.vertices[static_cast<std::size_t>(tri[0])], solid.vertices[static_cast<std::size_t>(tri[1])],
+                             solid.vertices[static_cast<std::size_t>(tri[2])]};
     const Vec3 lo{std::min({t.a.x, t.b.x, t.c.x}), std::min({t.a.y, t.b.y, t.c.y}), std::min({t.a.z, t.b.z, t.c.z})};
     const Vec3 hi{std::max({t.a.x, t.b.x, t.c.x}), std::max({t.a.y, t.b.y, t.c.y}), std::max({t.a.z, t.b.z, t.c.z})};
     auto cell_lo = [&](double v, double o) { return static_cast<std::int64_t>(std::floor((v - o) / h - 1.5)); };
@@ -397,7 +429,7 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
     Sphere s{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), 0.f};
     const Vec3 pf = to_vec(s);
     const double r = free_at(pf, best + slack, nullptr) - margin;
-    if (!(r > min_radius) || !inside_vote(bvh, pf)) {
+    if (!(r > min_radius) || !bvh.inside_vote(pf)) {
       removed[uid] = 1;
       ++removed_count;
       continue;

@@ -224,6 +224,17 @@ int TriangleBvh::ray_crossings(const Vec3& o, const Vec3& d) const {
   return n;
 }
 
+bool TriangleBvh::inside_vote(const Vec3& p) const {
+  // unnormalised, with no simple ratios between components, so that rays from points on
+  // rational grids do not run exactly through the edges and vertices of axis-aligned meshes
+  static constexpr Vec3 kDirections[3] = {{0.9173251, 0.3281647, 0.2257319},
+                                          {-0.2811437, 0.9137213, 0.2935071},
+                                          {0.1931559, -0.3512873, 0.9162341}};
+  int votes = 0;
+  for (const Vec3& d : kDirections) votes += ray_crossings(p, d) % 2;
+  return votes >= 2;
+}
+
 double TriangleBvh::winding_number(const Vec3& p) const {
   double w = 0.0;
   for (const Triangle& t : tris_) w += triangle_winding(p, t);

@@ -38,6 +38,9 @@ class TriangleBvh {
   void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<double>& hits) const;
   /// Number of crossings of the ray o + t d, t > 0 (no allocation).
   int ray_crossings(const Vec3& o, const Vec3& d) const;
+  /// Majority vote of ray parity along three fixed directions: a ray that grazes an edge or a
+  /// vertex (counting a crossing twice or not at all) is outvoted by the other two.
+  bool inside_vote(const Vec3& p) const;
   /// Exact generalised winding number (sum over all triangles).
   double winding_number(const Vec3& p) const;
 

@@ -27,7 +27,7 @@ struct PackingOptions {
   /// Surface points sampled per triangle (besides the vertices) to measure max_gap; 0 = only vertices.
   int gap_samples_per_triangle = 1;
   /// Called from the calling thread with a fraction in [0, 1] that never decreases and ends at 1.
-  std::function<void(double fraction)> progress;
+  std::function<void(double fraction)> progress{};
 };
 
 /// Quality and cost figures of one packing (plain, trivially copyable).

@@ -1,0 +1,209 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "mesh_test_support.hpp"
+#include "uh/collette/mesh_import.hpp"
+
+namespace uh::collette {
+namespace {
+
+using test::TempDir;
+using test::unit_cube;
+
+TEST(MeshImport, MissingFileIsAClearError) {
+  const auto r = load_mesh("/nonexistent/dir/nothing_here.obj");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("nothing_here.obj"), std::string::npos);
+  EXPECT_NE(r.error().message.find("not found"), std::string::npos);
+}
+
+TEST(MeshImport, EmptyAndGarbageFilesAreClearErrors) {
+  TempDir dir("garbage");
+  { std::ofstream(dir / "empty.obj"); }
+  {
+    std::ofstream out(dir / "garbage.stl");
+    out << "this is not a mesh at all \x01\x02\x03";
+  }
+  {
+    std::ofstream out(dir / "no_faces.obj");
+    out << "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  }
+  for (const char* name : {"empty.obj", "garbage.stl", "no_faces.obj"}) {
+    const auto r = load_mesh(dir / name);
+    ASSERT_FALSE(r) << name;
+    EXPECT_NE(r.error().message.find(name), std::string::npos) << r.error().message;
+  }
+}
+
+TEST(MeshImport, ClosedCubeLoadsFromObjOffAndStl) {
+  TempDir dir("cube");
+  const TriangleMesh cube = unit_cube();
+  test::write_obj(dir / "cube.obj", cube.vertices, cube.triangles);
+  test::write_off(dir / "cube.off", cube.vertices, cube.triangles);
+  test::write_stl(dir / "cube.stl", cube.vertices, cube.triangles);
+  for (const char* name : {"cube.obj", "cube.off", "cube.stl"}) {
+    const auto r = load_mesh(dir / name);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->source_name, name);
+    EXPECT_EQ(r->report.vertex_count, 8) << name;
+    EXPECT_EQ(r->report.triangle_count, 12) << name;
+    EXPECT_EQ(r->report.boundary_edges, 0);
+    EXPECT_EQ(r->report.components, 1);
+    EXPECT_FALSE(r->report.winding_flipped);
+    EXPECT_NEAR(mesh_volume(*r), 1.0, 1e-12);
+    EXPECT_NEAR(r->report.volume, 1.0, 1e-12);
+  }
+}
+
+TEST(MeshImport, StlIsWeldedByPosition) {
+  TempDir dir("weld");
+  const TriangleMesh cube = unit_cube();
+  test::write_stl(dir / "cube.stl", cube.vertices, cube.triangles);
+  const auto r = load_mesh(dir / "cube.stl");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->report.input_vertex_count, 36);
+  EXPECT_EQ(r->report.welded_vertices, 28);
+  EXPECT_EQ(r->vertices.size(), 8u);
+}
+
+TEST(MeshImport, WeldToleranceMergesNearDuplicates) {
+  TriangleMesh cube = unit_cube();
+  // a ninth vertex 1e-9 away from vertex 6, used by one triangle: only welding closes the mesh
+  cube.vertices.push_back({1.0 + 1e-9, 1.0, 1.0});
+  cube.triangles[2] = {4, 5, 8};
+  const auto exact = validate_mesh(cube, {.weld_tolerance = 0.0});
+  ASSERT_FALSE(exact);
+  EXPECT_NE(exact.error().message.find("not"), std::string::npos);
+  const auto welded = validate_mesh(cube, {.weld_tolerance = 1e-6});
+  ASSERT_TRUE(welded) << welded.error().message;
+  EXPECT_EQ(welded->vertices.size(), 8u);
+  EXPECT_EQ(welded->report.welded_vertices, 1);
+}
+
+TEST(MeshImport, CubeMissingAFaceIsNotClosed) {
+  TempDir dir("open");
+  TriangleMesh cube = unit_cube();
+  cube.triangles.resize(10);  // drop the +x face (two triangles)
+  test::write_obj(dir / "open_cube.obj", cube.vertices, cube.triangles);
+  const auto r = load_mesh(dir / "open_cube.obj");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("open_cube.obj: mesh is not closed: 4 boundary edges, 0 non-manifold edges, 0 degenerate faces"),
+            std::string::npos)
+      << r.error().message;
+  EXPECT_NE(r.error().message.find("allow_open"), std::string::npos);
+}
+
+TEST(MeshImport, AllowOpenAcceptsSmallHolesAndSaysSo) {
+  TempDir dir("allow_open");
+  TriangleMesh cube = unit_cube();
+  cube.triangles.resize(10);
+  test::write_obj(dir / "open_cube.obj", cube.vertices, cube.triangles);
+  const auto r = load_mesh(dir / "open_cube.obj", {.allow_open = true});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->report.assumed_open);
+  EXPECT_EQ(r->report.boundary_edges, 4);
+  const auto too_many = load_mesh(dir / "open_cube.obj", {.allow_open = true, .max_open_boundary_edges = 3});
+  ASSERT_FALSE(too_many);
+  EXPECT_NE(too_many.error().message.find("at most 3"), std::string::npos) << too_many.error().message;
+}
+
+TEST(MeshImport, FinIsNonManifold) {
+  TempDir dir("fin");
+  TriangleMesh cube = unit_cube();
+  cube.vertices.push_back({0.5, -0.5, 1.5});
+  cube.triangles.push_back({4, 5, 8});  // a third triangle on edge 4-5
+  test::write_off(dir / "fin.off", cube.vertices, cube.triangles);
+  const auto r = load_mesh(dir / "fin.off");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("fin.off: mesh is not 2-manifold: 2 boundary edges, 1 non-manifold edges"), std::string::npos)
+      << r.error().message;
+}
+
+TEST(MeshImport, DegenerateFaceIsReportedOrDropped) {
+  TempDir dir("degenerate");
+  TriangleMesh cube = unit_cube();
+  cube.vertices.push_back({0.5, 0.0, 0.0});      // on edge 0-1
+  cube.triangles.push_back({0, 1, 8});           // zero area, distinct vertices
+  test::write_obj(dir / "degenerate.obj", cube.vertices, cube.triangles);
+  const auto r = load_mesh(dir / "degenerate.obj");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("degenerate.obj: mesh has degenerate faces: 0 boundary edges, 0 non-manifold edges, 1 degenerate faces"),
+            std::string::npos)
+      << r.error().message;
+  const auto dropped = load_mesh(dir / "degenerate.obj", {.drop_degenerate = true});
+  ASSERT_TRUE(dropped) << dropped.error().message;
+  EXPECT_EQ(dropped->report.degenerate_faces, 1);
+  EXPECT_EQ(dropped->report.triangle_count, 12);
+  EXPECT_EQ(dropped->vertices.size(), 8u);
+}
+
+TEST(MeshImport, InvertedCubeIsFlipped) {
+  TempDir dir("inverted");
+  TriangleMesh cube = unit_cube();
+  for (auto& t : cube.triangles) std::swap(t[1], t[2]);
+  ASSERT_LT(mesh_volume(cube), 0.0);
+  test::write_obj(dir / "inverted.obj", cube.vertices, cube.triangles);
+  const auto r = load_mesh(dir / "inverted.obj");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->report.winding_flipped);
+  EXPECT_NEAR(mesh_volume(*r), 1.0, 1e-12);
+  // every triangle now has an outward normal: it points away from the cube's centre
+  for (const auto& t : r->triangles) {
+    const Vec3& a = r->vertices[static_cast<std::size_t>(t[0])];
+    const Vec3& b = r->vertices[static_cast<std::size_t>(t[1])];
+    const Vec3& c = r->vertices[static_cast<std::size_t>(t[2])];
+    EXPECT_GT(dot(cross(b - a, c - a), (a + b + c) / 3.0 - Vec3{0.5, 0.5, 0.5}), 0.0);
+  }
+}
+
+TEST(MeshImport, InconsistentOrientationIsReported) {
+  TriangleMesh cube = unit_cube();
+  std::swap(cube.triangles[0][1], cube.triangles[0][2]);
+  cube.source_name = "patchy.obj";
+  const auto r = validate_mesh(cube);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("patchy.obj: mesh orientation is inconsistent: 3 edges"), std::string::npos)
+      << r.error().message;
+}
+
+TEST(MeshImport, IndexOutOfRangeIsAnError) {
+  TriangleMesh cube = unit_cube();
+  cube.triangles.push_back({0, 1, 99});
+  EXPECT_FALSE(validate_mesh(cube));
+}
+
+TEST(MeshVolume, IcosphereApproachesTheBallVolume) {
+  const double r = 2.0;
+  const double ball = 4.0 / 3.0 * kPi * r * r * r;
+  double previous_error = 1.0;
+  for (int level = 1; level <= 4; ++level) {
+    const auto m = validate_mesh(test::icosphere(r, level));
+    ASSERT_TRUE(m) << m.error().message;
+    const double v = mesh_volume(*m);
+    EXPECT_LT(v, ball);  // inscribed polyhedron
+    const double error = (ball - v) / ball;
+    EXPECT_LT(error, previous_error / 3.0);  // about quartered per level
+    previous_error = error;
+  }
+  EXPECT_LT(previous_error, 0.01);
+}
+
+TEST(MeshVolume, BoundsOfTheCube) {
+  const Aabb b = mesh_bounds(unit_cube());
+  EXPECT_EQ(b.min, (Vec3{0, 0, 0}));
+  EXPECT_EQ(b.max, (Vec3{1, 1, 1}));
+  EXPECT_GT(mesh_bounds(TriangleMesh{}).min.x, mesh_bounds(TriangleMesh{}).max.x);
+}
+
+TEST(MeshImport, BunnyAssetIsClosed) {
+  const auto r = load_mesh(std::filesystem::path(UH_TEST_DATA_DIR) / "meshes" / "bunny_npm_3674.obj");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->report.triangle_count, 3674);
+  EXPECT_TRUE(r->report.closed_manifold());
+  EXPECT_EQ(r->report.inconsistent_edges, 0);
+  EXPECT_GT(r->report.volume, 0.0);
+}
+
+}  // namespace
+}  // namespace uh::collette

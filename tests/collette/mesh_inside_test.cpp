@@ -1,0 +1,91 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "mesh_test_support.hpp"
+#include "uh/collette/mesh_import.hpp"
+#include "uh/collette/mesh_inside.hpp"
+
+namespace uh::collette {
+namespace {
+
+TriangleMesh bunny() {
+  auto r = load_mesh(std::filesystem::path(UH_TEST_DATA_DIR) / "meshes" / "bunny_npm_3674.obj");
+  EXPECT_TRUE(r) << r.error().message;
+  return std::move(r).value();
+}
+
+std::vector<Vec3> random_points(const Aabb& box, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  const Vec3 pad = (box.max - box.min) * 0.1;
+  std::uniform_real_distribution<double> ux(box.min.x - pad.x, box.max.x + pad.x);
+  std::uniform_real_distribution<double> uy(box.min.y - pad.y, box.max.y + pad.y);
+  std::uniform_real_distribution<double> uz(box.min.z - pad.z, box.max.z + pad.z);
+  std::vector<Vec3> p;
+  for (int i = 0; i < n; ++i) p.push_back({ux(rng), uy(rng), uz(rng)});
+  return p;
+}
+
+TEST(MeshInside, ContainsMatchesBruteForceWindingOnBunny) {
+  const TriangleMesh m = bunny();
+  const MeshInside inside(m);
+  int n_inside = 0;
+  for (const Vec3& p : random_points(mesh_bounds(m), 400, 7)) {
+    const double w = test::brute_winding(m, p);
+    ASSERT_TRUE(std::abs(w) < 1e-6 || std::abs(w - 1.0) < 1e-6) << "reference winding " << w;
+    EXPECT_EQ(inside.contains(p), w > 0.5) << p.x << ' ' << p.y << ' ' << p.z;
+    EXPECT_NEAR(inside.winding_number(p), w, 1e-9);
+    n_inside += w > 0.5 ? 1 : 0;
+  }
+  EXPECT_GT(n_inside, 20);  // the sample must exercise both answers
+  EXPECT_LT(n_inside, 380);
+}
+
+TEST(MeshInside, GrazingRaysOnAxisAlignedCube) {
+  // points level with the cube's edges and vertices: single-ray parity gets these wrong
+  const auto cube = validate_mesh(test::unit_cube());
+  ASSERT_TRUE(cube);
+  const MeshInside inside(*cube);
+  for (double a : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    for (double b : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+      if (a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
+        EXPECT_TRUE(inside.contains(Vec3{0.5, a, b}));
+        EXPECT_TRUE(inside.contains(Vec3{a, b, 0.5}));
+      }
+      EXPECT_FALSE(inside.contains(Vec3{-0.5, a, b}));
+      EXPECT_FALSE(inside.contains(Vec3{1.5, a, b}));
+      EXPECT_FALSE(inside.contains(Vec3{a, b, 2.0}));
+    }
+  }
+  EXPECT_TRUE(inside.contains({1e-6, 1e-6, 1e-6}));
+  EXPECT_FALSE(inside.contains({-1e-6, 0.5, 0.5}));
+}
+
+TEST(MeshInside, DistanceMatchesBruteForce) {
+  const TriangleMesh m = bunny();
+  const MeshInside inside(m);
+  for (const Vec3& p : random_points(mesh_bounds(m), 300, 11)) {
+    const double ref = test::brute_distance(m, p);
+    EXPECT_NEAR(inside.distance(p), ref, 1e-9 * (1.0 + ref));
+    EXPECT_NEAR(norm(inside.closest_point(p) - p), ref, 1e-9 * (1.0 + ref));
+    EXPECT_NEAR(std::abs(inside.signed_distance(p)), ref, 1e-9 * (1.0 + ref));
+  }
+}
+
+TEST(MeshInside, OpenMeshUsesTheWindingNumber) {
+  TriangleMesh cube = test::unit_cube();
+  cube.triangles.resize(10);  // no +x face
+  cube.source_name = "open";
+  const auto open = validate_mesh(cube, {.allow_open = true});
+  ASSERT_TRUE(open) << open.error().message;
+  const MeshInside inside(*open);
+  // the missing face subtends 1/6 of the sphere of directions at the centre
+  EXPECT_NEAR(inside.winding_number({0.5, 0.5, 0.5}), 5.0 / 6.0, 1e-12);
+  EXPECT_TRUE(inside.contains({0.5, 0.5, 0.5}));
+  EXPECT_TRUE(inside.contains({0.2, 0.3, 0.7}));
+  EXPECT_FALSE(inside.contains({-0.5, 0.5, 0.5}));
+  EXPECT_FALSE(inside.contains({1.5, 0.5, 0.5}));
+}
+
+}  // namespace
+}  // namespace uh::collette
