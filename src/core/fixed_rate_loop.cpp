@@ -142,6 +142,11 @@ void FixedRateLoop::run(Callback callback) {
     param.sched_priority = options_.fifo_priority;
     const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
     priority_raised_.store(rc == 0, std::memory_order_relaxed);
+    // still before the first tick, so the loop thread may log here
+    if (rc != 0) {
+      log::warn("FixedRateLoop '{}': SCHED_FIFO priority {} refused ({}); running at normal priority",
+                options_.name, options_.fifo_priority, rc == EPERM ? "no CAP_SYS_NICE" : "error " + std::to_string(rc));
+    }
   }
 
   const Nanos period(static_cast<std::int64_t>(std::llround(1e9 / options_.rate_hz)));

@@ -1,6 +1,8 @@
 #include "uh/core/fixed_rate_loop.hpp"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <atomic>
 #include <chrono>
@@ -179,6 +181,15 @@ TEST(FixedRateLoop, ExposesRaisePriorityOutcome) {
   loop.stop();
   const uh::FixedRateLoopStats s = loop.stats();
   EXPECT_GE(s.ticks, 3u);
+  // reference: may a fresh thread of this process switch to SCHED_FIFO 80?
+  bool fifo_allowed = false;
+  std::thread probe([&fifo_allowed] {
+    sched_param param{};
+    param.sched_priority = 80;
+    fifo_allowed = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  });
+  probe.join();
+  EXPECT_EQ(s.priority_raised, fifo_allowed);
   RecordProperty("priority_raised", s.priority_raised ? "yes" : "no");
 }
 
