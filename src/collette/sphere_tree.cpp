@@ -1,5 +1,6 @@
 #include "uh/collette/sphere_tree.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -19,6 +20,63 @@ bool finite_node(const SphereTreeNode& n) {
 double sphere_volume(double r) { return 4.0 / 3.0 * 3.14159265358979323846 * r * r * r; }
 
 }  // namespace
+
+SphereTree::SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> leaves, int depth, int arity)
+    : nodes_(std::move(nodes)), leaves_(std::move(leaves)), depth_(depth), arity_(arity) {
+  const std::size_t n = nodes_.size();
+  if (n == 0) return;
+  // the blocks are only built for well-formed child ranges; validate() reports the others and
+  // the queries require a validated tree
+  int widest = 1;
+  std::vector<std::int32_t> block_of(n, -1);
+  std::int32_t blocks = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const SphereTreeNode& node = nodes_[i];
+    if (node.is_leaf()) continue;
+    if (node.count < 0 || node.count > kMaxSphereTreeArity || node.first < 0 ||
+        static_cast<std::size_t>(node.first) + static_cast<std::size_t>(node.count) > n)
+      continue;
+    widest = std::max(widest, node.count);
+    block_of[i] = blocks++;
+  }
+  block_width_ = widest <= 4 ? 4 : 8;
+  const auto w = static_cast<std::size_t>(block_width_);
+  block_bounds_.assign(static_cast<std::size_t>(blocks) * 4 * w, 0.f);
+  block_child_.assign(static_cast<std::size_t>(blocks) * w, 0);
+  block_count_.assign(static_cast<std::size_t>(blocks), 0);
+  block_leaf_mask_.assign(static_cast<std::size_t>(blocks), 0);
+  auto id_of = [&](std::size_t i) -> std::int32_t {
+    const SphereTreeNode& node = nodes_[i];
+    if (node.is_leaf()) return ~node.first;
+    return block_of[i] >= 0 ? block_of[i] : ~0;
+  };
+  root_id_ = id_of(0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t k = block_of[i];
+    if (k < 0) continue;
+    const SphereTreeNode& node = nodes_[i];
+    float* b = block_bounds_.data() + static_cast<std::size_t>(k) * 4 * w;
+    std::uint8_t mask = 0;
+    for (std::size_t j = 0; j < w; ++j) {
+      if (static_cast<int>(j) < node.count) {
+        const std::size_t c = static_cast<std::size_t>(node.first) + j;
+        const SphereTreeNode& child = nodes_[c];
+        b[j] = child.x;
+        b[w + j] = child.y;
+        b[2 * w + j] = child.z;
+        b[3 * w + j] = child.radius;
+        block_child_[static_cast<std::size_t>(k) * w + j] = id_of(c);
+        if (child.is_leaf()) mask = static_cast<std::uint8_t>(mask | (1u << j));
+      } else {
+        b[j] = b[w + j] = b[2 * w + j] = 1e30f;
+        b[3 * w + j] = 0.f;
+        block_child_[static_cast<std::size_t>(k) * w + j] = ~0;
+      }
+    }
+    block_count_[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(node.count);
+    block_leaf_mask_[static_cast<std::size_t>(k)] = mask;
+  }
+}
 
 Status validate(const SphereTree& tree) {
   const auto nodes = tree.nodes();

@@ -1,9 +1,14 @@
 #include "uh/collette/volume_query.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "query_kernels.hpp"
 #include "uh/core/sphere_overlap.hpp"
@@ -26,30 +31,39 @@ VolumeQuery::VolumeQuery(const VolumeQueryOptions& options) : options_(options) 
   if (options_.collect_pairs) pairs_.resize(static_cast<std::size_t>(options_.pair_capacity));
 }
 
-const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) {
-  assert(!a.empty() && !b.empty() && "uh::collette::VolumeQuery::run(): empty tree");
-  result_ = VolumeQueryResult{};
-  const detail::FloatTransform xf = detail::FloatTransform::from(b_in_a);
-  const SphereTreeNode* const na = a.nodes().data();
-  const SphereTreeNode* const nb = b.nodes().data();
-  const bool collect = options_.collect_pairs;
-  const std::int32_t capacity = collect ? options_.pair_capacity : 0;
-  PairOverlap* const out = pairs_.data();
+namespace {
+
+constexpr int popcount8(std::uint32_t m) {
+  constexpr int kNibble[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+  return kNibble[m & 15u] + kNibble[(m >> 4) & 15u];
+}
+
+// Everything one traversal reads and writes, so that the width-specialised loop below keeps it in
+// registers or one cache line.
+struct Traversal {
+  SphereTree::Blocks a, b;
+  const Sphere* leaves_a;
+  detail::FloatTransform xf;
+  std::vector<VolumeQuery::StackEntry>* stack;
+  PairOverlap* out;
+  std::int32_t capacity;
   std::int32_t stored = 0;
   std::int64_t overlapping = 0;
   std::int64_t leaf_tests = 0;
   std::int64_t visited = 0;
   Totals sum;
 
-  // an overlapping leaf pair (dx, dy, dz = b - a in A's frame, d2 its squared length)
-  auto add_pair = [&](const SphereTreeNode& la, const SphereTreeNode& lb, float dx, float dy, float dz, float d2) {
-    const float d = std::sqrt(d2);
-    const float v = lens_volume(d, la.radius, lb.radius);
+  // an overlapping leaf pair: A's leaf la at (ax, ay, az, ar), B's leaf lb at (bx, by, bz, br) in A's frame
+  void add_pair(float ax, float ay, float az, float ar, float bx, float by, float bz, float br, std::int32_t la,
+                std::int32_t lb) {
+    const float dx = bx - ax, dy = by - ay, dz = bz - az;
+    const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    const float v = lens_volume(d, ar, br);
     if (!(v > 0.f)) return;
-    const float off = lens_centroid_offset(d, la.radius, lb.radius);
+    const float off = lens_centroid_offset(d, ar, br);
     const float inv = d > 0.f ? 1.f / d : 0.f;
     const float nx = dx * inv, ny = dy * inv, nz = dz * inv;
-    const float cx = la.x + nx * off, cy = la.y + ny * off, cz = la.z + nz * off;
+    const float cx = ax + nx * off, cy = ay + ny * off, cz = az + nz * off;
     const double vd = static_cast<double>(v);
     sum.volume += vd;
     sum.nx += vd * static_cast<double>(nx);
@@ -61,8 +75,8 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
     ++overlapping;
     if (stored < capacity) {
       PairOverlap& p = out[stored++];
-      p.leaf_a = la.first;
-      p.leaf_b = lb.first;
+      p.leaf_a = la;
+      p.leaf_b = lb;
       p.volume = v;
       p.normal[0] = nx;
       p.normal[1] = ny;
@@ -71,86 +85,163 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
       p.centroid[1] = cy;
       p.centroid[2] = cz;
     }
-  };
-
-  float rbx, rby, rbz;
-  xf.apply(nb[0].x, nb[0].y, nb[0].z, rbx, rby, rbz);
-  {
-    const float dx = rbx - na[0].x, dy = rby - na[0].y, dz = rbz - na[0].z;
-    const float d2 = dx * dx + dy * dy + dz * dz;
-    const float rs = na[0].radius + nb[0].radius;
-    if (d2 < rs * rs) {
-      if (na[0].is_leaf() && nb[0].is_leaf()) {
-        ++leaf_tests;
-        add_pair(na[0], nb[0], dx, dy, dz, d2);
-      } else {
-        stack_.push_back({0, 0, rbx, rby, rbz});
-      }
-    } else if (na[0].is_leaf() && nb[0].is_leaf()) {
-      ++leaf_tests;
-    }
   }
 
-  while (!stack_.empty()) {
-    const StackEntry e = stack_.back();
-    stack_.pop_back();
-    ++visited;
-    const SphereTreeNode& A = na[e.a];
-    const SphereTreeNode& B = nb[e.b];
-    // grow (rarely, outside steady state) before a batch of up to kMaxSphereTreeArity pushes
-    if (stack_.capacity() - stack_.size() < static_cast<std::size_t>(kMaxSphereTreeArity))
-      stack_.reserve(2 * stack_.capacity());
-    if (!A.is_leaf() && (B.is_leaf() || A.radius >= B.radius)) {
-      // split A: its children against B (whose centre is already in A's frame)
-      const bool b_leaf = B.is_leaf();
-      const SphereTreeNode* c = na + A.first;
-      for (std::int32_t i = 0; i < A.count; ++i) {
-        const float dx = e.bx - c[i].x, dy = e.by - c[i].y, dz = e.bz - c[i].z;
-        const float d2 = dx * dx + dy * dy + dz * dz;
-        const float rs = c[i].radius + B.radius;
-        const bool leaf_pair = b_leaf && c[i].is_leaf();
-        leaf_tests += leaf_pair ? 1 : 0;
-        if (d2 >= rs * rs) continue;
-        if (leaf_pair)
-          add_pair(c[i], B, dx, dy, dz, d2);
-        else
-          stack_.push_back({A.first + i, e.b, e.bx, e.by, e.bz});
+  // bit j set when lane j of the (x, y, z, r) lanes overlaps the sphere (px, py, pz, pr)
+  template <int W>
+  static std::uint32_t overlap_mask(const float* x, const float* y, const float* z, const float* r, float px, float py,
+                                    float pz, float pr) {
+    std::uint32_t hits = 0;
+#if defined(__SSE2__)
+    const __m128 bx = _mm_set1_ps(px), by = _mm_set1_ps(py), bz = _mm_set1_ps(pz), br = _mm_set1_ps(pr);
+    for (int k = 0; k < W; k += 4) {
+      const __m128 dx = _mm_sub_ps(bx, _mm_loadu_ps(x + k));
+      const __m128 dy = _mm_sub_ps(by, _mm_loadu_ps(y + k));
+      const __m128 dz = _mm_sub_ps(bz, _mm_loadu_ps(z + k));
+      const __m128 rs = _mm_add_ps(br, _mm_loadu_ps(r + k));
+      const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      hits |= static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(d2, _mm_mul_ps(rs, rs)))) << k;
+    }
+#else
+    for (int k = 0; k < W; ++k) {
+      const float dx = px - x[k], dy = py - y[k], dz = pz - z[k], rs = pr + r[k];
+      hits |= (dx * dx + dy * dy + dz * dz < rs * rs ? 1u : 0u) << k;
+    }
+#endif
+    return hits;
+  }
+
+  // B's children of block kb moved into A's frame: t[0..W) x, t[W..2W) y, t[2W..3W) z, t[3W..4W) r
+  template <int W>
+  void transform_block(std::int32_t kb, float* t) const {
+    const float* src = b.bounds + static_cast<std::size_t>(kb) * 4 * W;
+#if defined(__SSE2__)
+    const __m128 r00 = _mm_set1_ps(xf.r[0][0]), r01 = _mm_set1_ps(xf.r[0][1]), r02 = _mm_set1_ps(xf.r[0][2]);
+    const __m128 r10 = _mm_set1_ps(xf.r[1][0]), r11 = _mm_set1_ps(xf.r[1][1]), r12 = _mm_set1_ps(xf.r[1][2]);
+    const __m128 r20 = _mm_set1_ps(xf.r[2][0]), r21 = _mm_set1_ps(xf.r[2][1]), r22 = _mm_set1_ps(xf.r[2][2]);
+    const __m128 t0 = _mm_set1_ps(xf.t[0]), t1 = _mm_set1_ps(xf.t[1]), t2 = _mm_set1_ps(xf.t[2]);
+    for (int k = 0; k < W; k += 4) {
+      const __m128 x = _mm_loadu_ps(src + k), y = _mm_loadu_ps(src + W + k), z = _mm_loadu_ps(src + 2 * W + k);
+      _mm_storeu_ps(t + k, _mm_add_ps(_mm_add_ps(_mm_mul_ps(r00, x), _mm_mul_ps(r01, y)), _mm_add_ps(_mm_mul_ps(r02, z), t0)));
+      _mm_storeu_ps(t + W + k, _mm_add_ps(_mm_add_ps(_mm_mul_ps(r10, x), _mm_mul_ps(r11, y)), _mm_add_ps(_mm_mul_ps(r12, z), t1)));
+      _mm_storeu_ps(t + 2 * W + k, _mm_add_ps(_mm_add_ps(_mm_mul_ps(r20, x), _mm_mul_ps(r21, y)), _mm_add_ps(_mm_mul_ps(r22, z), t2)));
+      _mm_storeu_ps(t + 3 * W + k, _mm_loadu_ps(src + 3 * W + k));
+    }
+#else
+    for (int k = 0; k < W; ++k) xf.apply(src[k], src[W + k], src[2 * W + k], t[k], t[W + k], t[2 * W + k]);
+    for (int k = 0; k < W; ++k) t[3 * W + k] = src[3 * W + k];
+#endif
+  }
+
+  void push(std::int32_t ia, std::int32_t ib, float x, float y, float z, float r) { stack->push_back({ia, ib, x, y, z, r}); }
+
+  template <int W>
+  void run() {
+    std::vector<VolumeQuery::StackEntry>& st = *stack;
+    alignas(16) float tb[4 * W];
+    while (!st.empty()) {
+      const VolumeQuery::StackEntry e = st.back();
+      st.pop_back();
+      ++visited;
+      // grow (rarely, outside steady state) before a batch of up to W * W pushes
+      if (st.capacity() - st.size() < static_cast<std::size_t>(W * W)) st.reserve(2 * st.capacity() + W * W);
+      if (e.a < 0) {
+        // A is a leaf: B's children against it
+        const Sphere& s = leaves_a[~e.a];
+        transform_block<W>(e.b, tb);
+        const std::uint32_t count_b = b.count[e.b];
+        const std::uint32_t leaf_b = b.leaf_mask[e.b];
+        std::uint32_t hits = overlap_mask<W>(tb, tb + W, tb + 2 * W, tb + 3 * W, s.x, s.y, s.z, s.radius) & ((1u << count_b) - 1u);
+        leaf_tests += popcount8(leaf_b);
+        const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * W;
+        while (hits) {
+          const int j = std::countr_zero(hits);
+          hits &= hits - 1u;
+          if ((leaf_b >> j) & 1u)
+            add_pair(s.x, s.y, s.z, s.radius, tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j], ~e.a, ~cb[j]);
+          else
+            push(e.a, cb[j], tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j]);
+        }
+        continue;
       }
-    } else {
-      // split B: transform each child centre once and test it against A
-      const bool a_leaf = A.is_leaf();
-      const SphereTreeNode* c = nb + B.first;
-      for (std::int32_t i = 0; i < B.count; ++i) {
-        float x, y, z;
-        xf.apply(c[i].x, c[i].y, c[i].z, x, y, z);
-        const float dx = x - A.x, dy = y - A.y, dz = z - A.z;
-        const float d2 = dx * dx + dy * dy + dz * dz;
-        const float rs = A.radius + c[i].radius;
-        const bool leaf_pair = a_leaf && c[i].is_leaf();
-        leaf_tests += leaf_pair ? 1 : 0;
-        if (d2 >= rs * rs) continue;
-        if (leaf_pair) {
-          SphereTreeNode moved = c[i];
-          moved.x = x;
-          moved.y = y;
-          moved.z = z;
-          add_pair(A, moved, dx, dy, dz, d2);
-        } else {
-          stack_.push_back({e.a, B.first + i, x, y, z});
+      const float* ab = a.bounds + static_cast<std::size_t>(e.a) * 4 * W;
+      const std::int32_t* ca = a.child + static_cast<std::size_t>(e.a) * W;
+      const std::uint32_t leaf_a = a.leaf_mask[e.a];
+      if (e.b < 0) {
+        // B is a leaf: A's children against it (padding lanes of A never overlap)
+        std::uint32_t hits = overlap_mask<W>(ab, ab + W, ab + 2 * W, ab + 3 * W, e.bx, e.by, e.bz, e.br);
+        leaf_tests += popcount8(leaf_a);
+        while (hits) {
+          const int k = std::countr_zero(hits);
+          hits &= hits - 1u;
+          if ((leaf_a >> k) & 1u)
+            add_pair(ab[k], ab[W + k], ab[2 * W + k], ab[3 * W + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
+          else
+            push(ca[k], e.b, e.bx, e.by, e.bz, e.br);
+        }
+        continue;
+      }
+      // both inner: every child of B (moved once) against all children of A in one batch
+      transform_block<W>(e.b, tb);
+      const int count_b = b.count[e.b];
+      const std::uint32_t leaf_b = b.leaf_mask[e.b];
+      const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * W;
+      leaf_tests += popcount8(leaf_a) * popcount8(leaf_b);
+      for (int j = 0; j < count_b; ++j) {
+        std::uint32_t hits = overlap_mask<W>(ab, ab + W, ab + 2 * W, ab + 3 * W, tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j]);
+        const bool b_leaf = (leaf_b >> j) & 1u;
+        while (hits) {
+          const int k = std::countr_zero(hits);
+          hits &= hits - 1u;
+          if (b_leaf && ((leaf_a >> k) & 1u))
+            add_pair(ab[k], ab[W + k], ab[2 * W + k], ab[3 * W + k], tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j], ~ca[k], ~cb[j]);
+          else
+            push(ca[k], cb[j], tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j]);
         }
       }
     }
   }
+};
 
-  result_.total_volume = sum.volume;
-  result_.weighted_normal_sum = {sum.nx, sum.ny, sum.nz};
+}  // namespace
+
+const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) {
+  assert(!a.empty() && !b.empty() && "uh::collette::VolumeQuery::run(): empty tree");
+  result_ = VolumeQueryResult{};
+  Traversal t{a.blocks(), b.blocks(), a.leaves().data(), detail::FloatTransform::from(b_in_a), &stack_, pairs_.data(),
+              options_.collect_pairs ? options_.pair_capacity : 0, 0, 0, 0, 0, Totals{}};
+  stack_.clear();
+
+  // the roots: A's and B's root spheres, B's moved into A's frame
+  const SphereTreeNode& ra = a.root();
+  const SphereTreeNode& rb = b.root();
+  float x, y, z;
+  t.xf.apply(rb.x, rb.y, rb.z, x, y, z);
+  const float dx = x - ra.x, dy = y - ra.y, dz = z - ra.z;
+  const float rs = ra.radius + rb.radius;
+  if (ra.is_leaf() && rb.is_leaf()) ++t.leaf_tests;
+  if (dx * dx + dy * dy + dz * dz < rs * rs) {
+    if (ra.is_leaf() && rb.is_leaf())
+      t.add_pair(ra.x, ra.y, ra.z, ra.radius, x, y, z, rb.radius, ra.first, rb.first);
+    else
+      t.push(t.a.root, t.b.root, x, y, z, rb.radius);
+  }
+  // trees of different widths cannot share the specialised loop; both use the wider one
+  assert(t.a.width == t.b.width && "uh::collette::VolumeQuery::run(): trees built with block widths 4 and 8");
+  if (t.a.width == 4)
+    t.run<4>();
+  else
+    t.run<8>();
+
+  result_.total_volume = t.sum.volume;
+  result_.weighted_normal_sum = {t.sum.nx, t.sum.ny, t.sum.nz};
   result_.restoring_direction = normalized(result_.weighted_normal_sum);
-  if (sum.volume > 0.0) result_.volume_centroid = Vec3{sum.cx, sum.cy, sum.cz} / sum.volume;
-  result_.pair_count = stored;
-  result_.truncated = overlapping > stored && collect;
-  result_.stats.node_pairs_visited = visited;
-  result_.stats.leaf_pairs_tested = leaf_tests;
-  result_.stats.overlapping_pairs = overlapping;
+  if (t.sum.volume > 0.0) result_.volume_centroid = Vec3{t.sum.cx, t.sum.cy, t.sum.cz} / t.sum.volume;
+  result_.pair_count = t.stored;
+  result_.truncated = t.overlapping > t.stored && options_.collect_pairs;
+  result_.stats.node_pairs_visited = t.visited;
+  result_.stats.leaf_pairs_tested = t.leaf_tests;
+  result_.stats.overlapping_pairs = t.overlapping;
   return result_;
 }
 

@@ -42,8 +42,7 @@ class SphereTree {
  public:
   SphereTree() = default;
   /// Takes the arrays as they are; call validate() on data from outside (files, tests).
-  SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> leaves, int depth, int arity)
-      : nodes_(std::move(nodes)), leaves_(std::move(leaves)), depth_(depth), arity_(arity) {}
+  SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> leaves, int depth, int arity);
 
   std::span<const SphereTreeNode> nodes() const { return nodes_; }
   /// The leaf spheres in their original (packing) order; leaf nodes refer to them by index.
@@ -59,7 +58,31 @@ class SphereTree {
   /// Sum of the leaf sphere volumes [length^3].
   double total_volume() const { return nodes_.empty() ? 0.0 : static_cast<double>(nodes_.front().volume); }
 
+  /// Derived, traversal-friendly copy of the hierarchy used by the queries (built by the
+  /// constructor; read-only). Every inner node owns one "block" holding its children's spheres as
+  /// structure of arrays, `width` lanes each (4 for arity <= 4, else 8): one or two cache lines
+  /// per node visit. A child is named by a traversal id: >= 0 the block of an inner child,
+  /// < 0 a leaf child, ~id being its index into leaves(). Unused lanes hold a far-away centre
+  /// (1e30) and radius 0 so that they never overlap anything finite.
+  struct Blocks {
+    const float* bounds = nullptr;          ///< block k: x[width], y[width], z[width], r[width]
+    const std::int32_t* child = nullptr;    ///< block k: traversal ids of its children [width]
+    const std::uint8_t* count = nullptr;    ///< block k: number of children
+    const std::uint8_t* leaf_mask = nullptr;///< block k: bit j set when child j is a leaf
+    int width = 4;
+    std::int32_t root = 0;                  ///< traversal id of the root
+  };
+  Blocks blocks() const {
+    return {block_bounds_.data(), block_child_.data(), block_count_.data(), block_leaf_mask_.data(), block_width_, root_id_};
+  }
+
  private:
+  std::vector<float> block_bounds_;
+  std::vector<std::int32_t> block_child_;
+  std::vector<std::uint8_t> block_count_;
+  std::vector<std::uint8_t> block_leaf_mask_;
+  int block_width_ = 4;
+  std::int32_t root_id_ = 0;
   std::vector<SphereTreeNode> nodes_;
   std::vector<Sphere> leaves_;
   int depth_ = 0;

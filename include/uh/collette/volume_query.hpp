@@ -84,12 +84,13 @@ class VolumeQuery {
   std::span<const PairOverlap> pairs() const { return {pairs_.data(), static_cast<std::size_t>(result_.pair_count)}; }
   const VolumeQueryOptions& options() const { return options_; }
 
-  /// One entry of the traversal stack: a node pair known to overlap, with B's node centre already
-  /// in A's frame (so each B node is transformed once per visit).
+  /// One entry of the traversal stack: a node pair known to overlap, as traversal ids
+  /// (SphereTree::Blocks), with B's node sphere already in A's frame (so each B node is
+  /// transformed once per visit).
   struct StackEntry {
     std::int32_t a;
     std::int32_t b;
-    float bx, by, bz;
+    float bx, by, bz, br;
   };
 
  private:

@@ -1,0 +1,367 @@
+// Sphere-tree queries against FCL and Bullet on the same poses, in the same run.
+//
+// Scene (as in the shared peer figures): two copies of the 69,666-triangle bunny, B rotated
+// 30 degrees about Y around its box centre and moved along X; "shallow" = 2 % of the x-extent past
+// first contact, "deep" = 25 %; a small deterministic wobble per query. First contact is found by
+// bisection with FCL's boolean query on the meshes. The 10,000-sphere tree is packed once and
+// cached as a .ist file in the build directory.
+//
+// Counters per benchmark: median_us, p99_us, max_us per query; the FCL and Bullet rows also carry
+// the ratio of their median to this module's volume-query median on the same case.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <btBulletCollisionCommon.h>
+#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/geometry/bvh/BVH_model.h>
+
+#include "uh/collette/ist_file.hpp"
+#include "uh/collette/mesh_import.hpp"
+#include "uh/collette/sphere_packing.hpp"
+#include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/collette/time_critical_query.hpp"
+#include "uh/collette/volume_query.hpp"
+#include "uh/collette/distance_query.hpp"
+
+namespace {
+
+using namespace uh;
+using namespace uh::collette;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kSpheres = 10000;
+constexpr int kWobblePoses = 64;
+
+struct Scene {
+  TriangleMesh mesh;
+  SphereTree tree;
+  Vec3 box_centre{};
+  double extent_x = 0.0;
+  double first_contact_x = 0.0;  // x-shift of B's box centre at first contact
+  std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> fcl_model;
+  std::vector<Pose> poses[2];    // [shallow, deep] wobbled poses of B in A
+};
+
+fcl::Transform3d to_fcl(const Pose& p) {
+  fcl::Transform3d t = fcl::Transform3d::Identity();
+  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).toRotationMatrix();
+  t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+  return t;
+}
+
+// B rotated by `rot` about its box centre, the centre then moved by `shift` from A's box centre.
+Pose pose_of_b(const Scene& s, const Quat& rot, const Vec3& shift) {
+  const Vec3 c = s.box_centre;
+  return {rot, c + shift - rotate(rot, c)};
+}
+
+bool fcl_touching(const Scene& s, const Pose& b_in_a) {
+  fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
+  fcl::CollisionObjectd b(s.fcl_model, to_fcl(b_in_a));
+  fcl::CollisionRequestd request;
+  fcl::CollisionResultd result;
+  fcl::collide(&a, &b, request, result);
+  return result.isCollision();
+}
+
+Result<SphereTree> load_or_build_tree(const TriangleMesh& mesh, const std::filesystem::path& mesh_path) {
+  const auto hash = [&]() -> std::uint64_t {
+    std::FILE* f = std::fopen(mesh_path.c_str(), "rb");
+    if (!f) return 0;
+    std::vector<std::byte> bytes(std::filesystem::file_size(mesh_path));
+    const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), f);
+    std::fclose(f);
+    bytes.resize(got);
+    return ist_hash_bytes(bytes);
+  }();
+  const std::filesystem::path cache = std::filesystem::path(UH_BENCH_CACHE_DIR) / "bunny_69k_10000.ist";
+  if (auto cached = load_ist(cache); cached && cached->meta.source_mesh_hash == hash && cached->tree.leaf_count() > 0)
+    return std::move(cached->tree);
+  std::fprintf(stderr, "packing %d spheres into %s (cached afterwards in %s)...\n", kSpheres, mesh_path.c_str(), cache.c_str());
+  PackingOptions options;
+  options.target_sphere_count = kSpheres;
+  auto packing = pack_spheres(mesh, options);
+  if (!packing) return packing.error();
+  auto tree = build_sphere_tree(packing->spheres);
+  if (!tree) return tree.error();
+  IstAsset asset{std::move(*tree), {}};
+  asset.meta = {.meters_per_unit = 1.0, .source_mesh_hash = hash, .coverage = packing->report.coverage,
+                .mesh_volume = packing->report.mesh_volume, .max_gap = packing->report.max_gap,
+                .build_seconds = packing->report.build_seconds};
+  std::fprintf(stderr, "packed: %lld spheres, coverage %.3f, max gap %.4g, %.1f s\n",
+               static_cast<long long>(packing->report.sphere_count), packing->report.coverage, packing->report.max_gap,
+               packing->report.build_seconds);
+  if (const Status saved = save_ist(cache, asset); !saved) std::fprintf(stderr, "%s\n", saved.error().message.c_str());
+  return std::move(asset.tree);
+}
+
+const Scene& scene() {
+  static const std::unique_ptr<Scene> s = [] {
+    auto sc = std::make_unique<Scene>();
+    const std::filesystem::path path = std::filesystem::path(UH_SHARED_ASSET_DIR) / "bunny_glmark2_69k.obj";
+    auto mesh = load_mesh(path);
+    if (!mesh) {
+      std::fprintf(stderr, "%s\n", mesh.error().message.c_str());
+      std::exit(1);
+    }
+    sc->mesh = std::move(*mesh);
+    auto tree = load_or_build_tree(sc->mesh, path);
+    if (!tree) {
+      std::fprintf(stderr, "%s\n", tree.error().message.c_str());
+      std::exit(1);
+    }
+    sc->tree = std::move(*tree);
+    const Aabb box = mesh_bounds(sc->mesh);
+    sc->box_centre = 0.5 * (box.min + box.max);
+    sc->extent_x = box.max.x - box.min.x;
+
+    std::vector<fcl::Vector3d> v;
+    for (const Vec3& p : sc->mesh.vertices) v.emplace_back(p.x, p.y, p.z);
+    std::vector<fcl::Triangle> t;
+    for (const auto& f : sc->mesh.triangles)
+      t.emplace_back(static_cast<std::size_t>(f[0]), static_cast<std::size_t>(f[1]), static_cast<std::size_t>(f[2]));
+    sc->fcl_model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+    sc->fcl_model->beginModel();
+    sc->fcl_model->addSubModel(v, t);
+    sc->fcl_model->endModel();
+
+    // first contact along +x: bisection between touching (0) and apart (2 extents)
+    const Quat rot = quat_from_axis_angle({0, 1, 0}, 30.0 * kPi / 180.0);
+    double lo = 0.0, hi = 2.0 * sc->extent_x;
+    for (int i = 0; i < 40; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (fcl_touching(*sc, pose_of_b(*sc, rot, {mid, 0, 0})) ? lo : hi) = mid;
+    }
+    sc->first_contact_x = hi;
+    const double depth_fraction[2] = {0.02, 0.25};
+    for (int c = 0; c < 2; ++c) {
+      const double x = sc->first_contact_x - depth_fraction[c] * sc->extent_x;
+      for (int k = 0; k < kWobblePoses; ++k) {
+        // wobble: +-0.5 degree about a turning axis, +-0.2 % of the extent
+        const double ph = 2.0 * kPi * k / kWobblePoses;
+        const Quat wob = quat_from_axis_angle({std::cos(ph), 1.0, std::sin(ph)}, 0.5 * kPi / 180.0 * std::sin(3 * ph));
+        const Vec3 dx{0.002 * sc->extent_x * std::sin(ph), 0.002 * sc->extent_x * std::cos(2 * ph), 0.0};
+        sc->poses[c].push_back(pose_of_b(*sc, wob * rot, Vec3{x, 0, 0} + dx));
+      }
+    }
+    std::fprintf(stderr, "scene: %zu triangles, %d spheres, %d nodes, depth %d, x-extent %.4g, first contact at x %.4g\n",
+                 sc->mesh.triangles.size(), sc->tree.leaf_count(), sc->tree.node_count(), sc->tree.depth(), sc->extent_x,
+                 sc->first_contact_x);
+    return sc;
+  }();
+  return *s;
+}
+
+// per-query wall times -> counters; returns the median [s]
+double report(benchmark::State& state, std::vector<double>& times) {
+  if (times.empty()) return 0.0;
+  std::sort(times.begin(), times.end());
+  const auto at = [&](double q) { return times[std::min(times.size() - 1, static_cast<std::size_t>(q * static_cast<double>(times.size())))]; };
+  const double median = at(0.5);
+  state.counters["median_us"] = median * 1e6;
+  state.counters["p99_us"] = at(0.99) * 1e6;
+  state.counters["max_us"] = times.back() * 1e6;
+  return median;
+}
+
+std::map<std::string, double> g_ist_median;  // case name -> volume query median [s]
+const char* case_name(int c) { return c == 0 ? "shallow" : "deep"; }
+
+void BM_IstVolumeQuery(benchmark::State& state) {
+  const Scene& s = scene();
+  const int c = static_cast<int>(state.range(0));
+  const bool collect = state.range(1) != 0;
+  VolumeQuery query({.collect_pairs = collect});
+  std::vector<double> times;
+  times.reserve(1 << 16);
+  std::size_t k = 0;
+  VolumeQueryResult last{};
+  for (auto _ : state) {
+    const Pose& p = s.poses[c][k++ % kWobblePoses];
+    const auto t0 = Clock::now();
+    last = query.run(s.tree, s.tree, p);
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    benchmark::DoNotOptimize(last);
+    state.SetIterationTime(dt);
+    times.push_back(dt);
+  }
+  const double median = report(state, times);
+  if (collect) g_ist_median[case_name(c)] = median;
+  state.counters["overlapping_pairs"] = static_cast<double>(last.stats.overlapping_pairs);
+  state.counters["node_pairs"] = static_cast<double>(last.stats.node_pairs_visited);
+  state.counters["leaf_tests"] = static_cast<double>(last.stats.leaf_pairs_tested);
+  state.counters["volume"] = last.total_volume;
+  state.SetLabel(std::string(case_name(c)) + (collect ? " pairs+totals" : " totals only"));
+}
+BENCHMARK(BM_IstVolumeQuery)->ArgsProduct({{0, 1}, {1, 0}})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(2.0);
+
+void BM_IstTimeCriticalQuery(benchmark::State& state) {
+  const Scene& s = scene();
+  const int c = static_cast<int>(state.range(0));
+  const std::int64_t budget = state.range(1);
+  TimeCriticalQuery query;
+  VolumeQuery exact({.collect_pairs = false});
+  std::vector<double> times;
+  times.reserve(1 << 16);
+  double err_sum = 0.0;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Pose& p = s.poses[c][k % kWobblePoses];
+    const auto t0 = Clock::now();
+    const TimeCriticalResult& r = query.run(s.tree, s.tree, p, {.max_expansions = budget});
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    state.SetIterationTime(dt);
+    times.push_back(dt);
+    if (k < kWobblePoses) {
+      const double e = exact.run(s.tree, s.tree, p).total_volume;
+      err_sum += std::abs(r.volume_estimate - e) / e;
+    }
+    ++k;
+  }
+  report(state, times);
+  state.counters["rel_volume_error"] = err_sum / static_cast<double>(std::min<std::size_t>(k, kWobblePoses));
+  state.SetLabel(std::string(case_name(c)) + " budget " + std::to_string(budget) + " expansions");
+}
+BENCHMARK(BM_IstTimeCriticalQuery)
+    ->ArgsProduct({{1}, {500, 2000, 8000}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->MinTime(1.0);
+
+void BM_IstDistanceQuery(benchmark::State& state) {
+  const Scene& s = scene();
+  const bool warm = state.range(0) != 0;
+  DistanceQuery query({.warm_start = warm});
+  // apart by 5 % of the extent, with the wobble
+  std::vector<Pose> poses;
+  const Quat rot = quat_from_axis_angle({0, 1, 0}, 30.0 * kPi / 180.0);
+  for (int k = 0; k < kWobblePoses; ++k) {
+    const double ph = 2.0 * kPi * k / kWobblePoses;
+    poses.push_back(pose_of_b(s, rot, {s.first_contact_x + s.extent_x * (0.05 + 0.002 * std::sin(ph)), 0.0, 0.0}));
+  }
+  std::vector<double> times;
+  std::size_t k = 0;
+  double d = 0.0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    d = query.run(s.tree, s.tree, poses[k++ % kWobblePoses]).distance;
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    state.SetIterationTime(dt);
+    times.push_back(dt);
+  }
+  report(state, times);
+  state.counters["distance_over_extent"] = d / s.extent_x;
+  state.SetLabel(warm ? "apart 5% warm start" : "apart 5% cold");
+}
+BENCHMARK(BM_IstDistanceQuery)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+
+void BM_FclMeshMesh(benchmark::State& state) {
+  const Scene& s = scene();
+  const int c = static_cast<int>(state.range(0));
+  const bool all = state.range(1) != 0;
+  fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
+  fcl::CollisionObjectd b(s.fcl_model, fcl::Transform3d::Identity());
+  fcl::CollisionRequestd request(all ? 1000000 : 1, all);
+  std::vector<double> times;
+  std::size_t k = 0;
+  std::size_t contacts = 0;
+  for (auto _ : state) {
+    b.setTransform(to_fcl(s.poses[c][k++ % kWobblePoses]));
+    fcl::CollisionResultd result;
+    const auto t0 = Clock::now();
+    fcl::collide(&a, &b, request, result);
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    contacts = result.numContacts();
+    state.SetIterationTime(dt);
+    times.push_back(dt);
+  }
+  const double median = report(state, times);
+  state.counters["contacts"] = static_cast<double>(contacts);
+  if (all && g_ist_median.count(case_name(c)) && g_ist_median[case_name(c)] > 0.0)
+    state.counters["ratio_fcl_over_ist"] = median / g_ist_median[case_name(c)];
+  state.SetLabel(std::string(case_name(c)) + (all ? " all contacts" : " boolean"));
+}
+BENCHMARK(BM_FclMeshMesh)->ArgsProduct({{0, 1}, {1, 0}})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+
+struct CountContacts : btCollisionWorld::ContactResultCallback {
+  int count = 0;
+  btScalar addSingleResult(btManifoldPoint&, const btCollisionObjectWrapper*, int, int, const btCollisionObjectWrapper*, int,
+                           int) override {
+    ++count;
+    return 0;
+  }
+};
+
+void BM_BulletGImpact(benchmark::State& state) {
+  const Scene& s = scene();
+  const int c = static_cast<int>(state.range(0));
+  std::vector<btScalar> verts;
+  for (const Vec3& p : s.mesh.vertices) {
+    verts.push_back(static_cast<btScalar>(p.x));
+    verts.push_back(static_cast<btScalar>(p.y));
+    verts.push_back(static_cast<btScalar>(p.z));
+  }
+  std::vector<int> idx;
+  for (const auto& f : s.mesh.triangles) idx.insert(idx.end(), {f[0], f[1], f[2]});
+  btTriangleIndexVertexArray array(static_cast<int>(s.mesh.triangles.size()), idx.data(), 3 * static_cast<int>(sizeof(int)),
+                                   static_cast<int>(s.mesh.vertices.size()), verts.data(), 3 * static_cast<int>(sizeof(btScalar)));
+  btGImpactMeshShape shape(&array);
+  shape.updateBound();
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher(&config);
+  btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
+  // without a closest-points function for GImpact, contactPairTest finds nothing
+  static btGImpactCollisionAlgorithm::CreateFunc gimpact_cf;
+  for (int i = 0; i < MAX_BROADPHASE_COLLISION_TYPES; ++i) {
+    dispatcher.registerClosestPointsCreateFunc(GIMPACT_SHAPE_PROXYTYPE, i, &gimpact_cf);
+    dispatcher.registerClosestPointsCreateFunc(i, GIMPACT_SHAPE_PROXYTYPE, &gimpact_cf);
+  }
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world(&dispatcher, &broadphase, &config);
+  btCollisionObject a, b;
+  a.setCollisionShape(&shape);
+  b.setCollisionShape(&shape);
+  auto to_bt = [](const Pose& p) {
+    btTransform t;
+    t.setRotation(btQuaternion(static_cast<btScalar>(p.rotation.x), static_cast<btScalar>(p.rotation.y),
+                               static_cast<btScalar>(p.rotation.z), static_cast<btScalar>(p.rotation.w)));
+    t.setOrigin(btVector3(static_cast<btScalar>(p.position.x), static_cast<btScalar>(p.position.y),
+                          static_cast<btScalar>(p.position.z)));
+    return t;
+  };
+  a.setWorldTransform(to_bt(Pose{}));
+  std::vector<double> times;
+  std::size_t k = 0;
+  int contacts = 0;
+  for (auto _ : state) {
+    b.setWorldTransform(to_bt(s.poses[c][k++ % kWobblePoses]));
+    CountContacts cb;
+    const auto t0 = Clock::now();
+    world.contactPairTest(&a, &b, cb);
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    contacts = cb.count;
+    state.SetIterationTime(dt);
+    times.push_back(dt);
+  }
+  const double median = report(state, times);
+  state.counters["contacts"] = contacts;
+  if (g_ist_median.count(case_name(c)) && g_ist_median[case_name(c)] > 0.0)
+    state.counters["ratio_bullet_over_ist"] = median / g_ist_median[case_name(c)];
+  state.SetLabel(std::string(case_name(c)) + " contactPairTest");
+}
+BENCHMARK(BM_BulletGImpact)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();
