@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "allocation_counter.hpp"
+#include "uh/haptico/sim_hand_device.hpp"
 #include "uh/haptico/sim_line_device.hpp"
 
 namespace uh::haptico {
@@ -307,6 +309,21 @@ TEST(HapticManager, TickTimeIsSteadyClockInThreadedSessions) {
   const double after = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   EXPECT_GE(seen.load(), before);
   EXPECT_LE(seen.load(), after);
+}
+
+TEST(HapticManager, TickDoesNotAllocate) {
+  HapticManager manager(std::make_unique<SimHandDevice>(SimHandOptions{}), {.trace_capacity = 64});
+  ASSERT_TRUE(manager.open());
+  Vec3 seen{};
+  manager.move_on_haptic_tick().add_delegate([&](const DeviceState& s) { seen = s.position; });
+  manager.force_on_haptic_tick().add_delegate([](const DeviceState& s, DeviceCommand& cmd) {
+    cmd.force += 500.0 * (Vec3{0, 0, -0.01} - s.position);
+  });
+  manager.step(0.0);  // warm-up outside the counted region
+  uh::test::AllocationCounter counter;
+  for (int i = 1; i <= 100; ++i) manager.step(0.001 * i);  // includes trace drops once the queue is full
+  EXPECT_EQ(counter.count(), 0u);
+  EXPECT_NE(seen, Vec3{});
 }
 
 TEST(HapticManager, DestructorSendsZeroAndCloses) {
