@@ -8,7 +8,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libeigen3-dev libassimp-dev libpng-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libreaderwriterqueue-dev
-  libfcl-dev libbullet-dev
+  libfcl-dev libbullet-dev libcairo2-dev
   clang libclang-rt-14-dev
 )
 

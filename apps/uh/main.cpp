@@ -1,5 +1,30 @@
+// uh: the command-line program of UnrealHaptics.
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
-int main() {
-  std::puts("uh: command-line program of UnrealHaptics (subcommands land with their modules)");
-  return 0;
+
+#include "commands.hpp"
+
+namespace uh::cli {
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "uh: %s\n", message.c_str());
+  return 1;
+}
+
+}  // namespace uh::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"uh: build Inner Sphere Trees, query them, and run haptic sessions"};
+  app.require_subcommand(1);
+  uh::cli::CommandRunner runner;
+  uh::cli::add_ist_commands(app, runner);
+  uh::cli::add_query_command(app, runner);
+  uh::cli::add_run_command(app, runner);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  return runner ? runner() : 2;
 }

@@ -90,12 +90,14 @@ Status CollisionWorld::start() {
   max_pairs_.store(0);
   stop_requested_.store(false);
   if (options_.rate_hz > 0.0) {
-    return loop_.start([this](const TickInfo& tick) { run_step(tick.time_s); });
+    // frames are stamped on the steady clock [s since its epoch], the clock the haptic thread uses
+    return loop_.start([this](const TickInfo& tick) {
+      run_step(std::chrono::duration<double>(tick.start_time.time_since_epoch()).count());
+    });
   }
   free_running_.store(true);
   free_thread_ = std::thread([this] {
-    const double start = now_seconds();
-    while (!stop_requested_.load(std::memory_order_relaxed)) run_step(now_seconds() - start);
+    while (!stop_requested_.load(std::memory_order_relaxed)) run_step(now_seconds());
     free_running_.store(false);
   });
   return Ok{};

@@ -1,4 +1,5 @@
 # the collision world and its thread
 list(APPEND UH_COLLETTE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/collision_world.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/ist_builder.cpp
 )

@@ -16,6 +16,10 @@
 ///  - read_contact(watcher, ...) is called by exactly one reader thread per watcher; real-time safe;
 ///  - stats() from any thread, lock-free.
 ///
+/// Time: the collision thread stamps each frame's time_s with the steady clock in seconds since
+/// its epoch (the clock HapticManager ticks on), so a consumer can tell the age of a frame;
+/// step(time_s) stamps the time it is given.
+///
 /// Broad phase: the bounding spheres of the two roots at their current poses; the tree traversal
 /// runs only when they overlap. When apart, `distance` is filled (upper bound on the separation)
 /// if the options ask for it.

@@ -1,0 +1,195 @@
+// uh ist build | info | preview
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "progress_bar.hpp"
+#include "uh/collette/ist_builder.hpp"
+#include "uh/collette/ist_file.hpp"
+#include "uh/collette/packing_preview.hpp"
+
+namespace uh::cli {
+namespace {
+
+struct IstBuildArgs {
+  std::string mesh;
+  std::string out;
+  std::int64_t spheres = 10000;
+  double voxel = 0.0;
+  double meters_per_unit = 1.0;
+  std::string preview;
+  bool json = false;
+  bool allow_open = false;
+};
+
+struct IstInfoArgs {
+  std::string file;
+  bool json = false;
+};
+
+struct IstPreviewArgs {
+  std::string file;
+  std::string out;
+  bool section = false;
+  int width = 800;
+  int height = 800;
+};
+
+std::string mesh_assumptions(const collette::MeshReport& r) {
+  std::string text;
+  if (r.welded_vertices > 0) text += fmt::format("welded {} duplicate vertices; ", r.welded_vertices);
+  if (r.winding_flipped) text += "inverted winding fixed (all triangles flipped); ";
+  if (r.assumed_open)
+    text += fmt::format("accepted an open mesh ({} boundary edges): inside tests use the winding number; ", r.boundary_edges);
+  if (r.degenerate_faces > 0) text += fmt::format("dropped {} degenerate faces; ", r.degenerate_faces);
+  if (!text.empty()) text.resize(text.size() - 2);
+  return text;
+}
+
+int run_build(const IstBuildArgs& args) {
+  if (std::filesystem::path(args.out).extension() != ".ist")
+    return fail(fmt::format("{}: the output file must end in .ist", args.out));
+  ProgressBar bar("packing");
+  collette::IstBuildOptions options{.sphere_count = args.spheres,
+                                    .voxel_size = args.voxel,
+                                    .meters_per_unit = args.meters_per_unit,
+                                    .progress = [&bar](double f) { bar.update(f); }};
+  options.mesh.allow_open = args.allow_open;
+  auto built = collette::build_ist_asset(args.mesh, options);
+  bar.finish();
+  if (!built) return fail(built.error().message);
+  if (auto saved = collette::save_ist(args.out, built->asset); !saved) return fail(saved.error().message);
+  if (!args.preview.empty()) {
+    std::vector<Sphere> leaves(built->asset.tree.leaves().begin(), built->asset.tree.leaves().end());
+    if (auto png = collette::write_packing_preview(leaves, args.preview, {}); !png) return fail(png.error().message);
+  }
+  const auto& p = built->packing;
+  const auto& tree = built->asset.tree;
+  const std::string assumed = mesh_assumptions(built->mesh);
+  if (args.json) {
+    nlohmann::json j = {{"mesh", args.mesh},
+                        {"output", args.out},
+                        {"triangles", built->mesh.triangle_count},
+                        {"spheres", p.sphere_count},
+                        {"mesh_volume", p.mesh_volume},
+                        {"sphere_volume", p.sphere_volume},
+                        {"coverage", p.coverage},
+                        {"max_gap", p.max_gap},
+                        {"build_seconds", built->asset.meta.build_seconds},
+                        {"packing_seconds", p.build_seconds},
+                        {"tree_seconds", built->tree_seconds},
+                        {"voxel_size", p.voxel_size},
+                        {"min_radius", p.min_radius},
+                        {"max_radius", p.max_radius},
+                        {"nodes", tree.node_count()},
+                        {"depth", tree.depth()},
+                        {"arity", tree.arity()},
+                        {"assumed", assumed}};
+    if (!args.preview.empty()) j["preview"] = args.preview;
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("%s: %lld triangles -> %s\n", args.mesh.c_str(), static_cast<long long>(built->mesh.triangle_count),
+                args.out.c_str());
+    if (!assumed.empty()) std::printf("  assumed: %s\n", assumed.c_str());
+    std::printf("  spheres %lld, coverage %.1f%% (sphere volume %.6g of %.6g), max gap %.4g\n",
+                static_cast<long long>(p.sphere_count), 100.0 * p.coverage, p.sphere_volume, p.mesh_volume, p.max_gap);
+    std::printf("  radii %.4g..%.4g, voxel %.4g; tree: %d nodes, depth %d; built in %.2f s\n", p.min_radius,
+                p.max_radius, p.voxel_size, tree.node_count(), tree.depth(), built->asset.meta.build_seconds);
+  }
+  return 0;
+}
+
+int run_info(const IstInfoArgs& args) {
+  auto asset = collette::load_ist(args.file);
+  if (!asset) return fail(asset.error().message);
+  const auto& tree = asset->tree;
+  const auto& m = asset->meta;
+  const auto& root = tree.root();
+  double min_r = 1e300, max_r = 0.0;
+  for (const Sphere& s : tree.leaves()) {
+    min_r = std::min(min_r, static_cast<double>(s.radius));
+    max_r = std::max(max_r, static_cast<double>(s.radius));
+  }
+  if (args.json) {
+    nlohmann::json j = {{"file", args.file},
+                        {"format_version", collette::kIstFormatVersion},
+                        {"spheres", tree.leaf_count()},
+                        {"nodes", tree.node_count()},
+                        {"depth", tree.depth()},
+                        {"arity", tree.arity()},
+                        {"sphere_volume", tree.total_volume()},
+                        {"mesh_volume", m.mesh_volume},
+                        {"coverage", m.coverage},
+                        {"max_gap", m.max_gap},
+                        {"build_seconds", m.build_seconds},
+                        {"meters_per_unit", m.meters_per_unit},
+                        {"source_mesh_hash", fmt::format("{:016x}", m.source_mesh_hash)},
+                        {"min_radius", min_r},
+                        {"max_radius", max_r},
+                        {"bounding_sphere", {root.x, root.y, root.z, root.radius}}};
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("%s: Inner Sphere Tree, format %u\n", args.file.c_str(), collette::kIstFormatVersion);
+    std::printf("  spheres %d (radii %.4g..%.4g), nodes %d, depth %d, arity %d\n", tree.leaf_count(), min_r, max_r,
+                tree.node_count(), tree.depth(), tree.arity());
+    std::printf("  coverage %.1f%% (sphere volume %.6g of mesh volume %.6g), max gap %.4g\n", 100.0 * m.coverage,
+                tree.total_volume(), m.mesh_volume, m.max_gap);
+    std::printf("  units: %g m per unit; source mesh hash %016llx; built in %.2f s\n", m.meters_per_unit,
+                static_cast<unsigned long long>(m.source_mesh_hash), m.build_seconds);
+  }
+  return 0;
+}
+
+int run_preview(const IstPreviewArgs& args) {
+  auto asset = collette::load_ist(args.file);
+  if (!asset) return fail(asset.error().message);
+  std::vector<Sphere> leaves(asset->tree.leaves().begin(), asset->tree.leaves().end());
+  collette::PreviewOptions options;
+  options.width = args.width;
+  options.height = args.height;
+  options.section = args.section;
+  if (auto png = collette::write_packing_preview(leaves, args.out, options); !png) return fail(png.error().message);
+  std::printf("%s: %zu spheres%s -> %s\n", args.file.c_str(), leaves.size(), args.section ? " (half section)" : "",
+              args.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_ist_commands(CLI::App& app, CommandRunner& runner) {
+  auto* ist = app.add_subcommand("ist", "build, inspect and picture Inner Sphere Tree (.ist) files");
+  ist->require_subcommand(1);
+
+  static IstBuildArgs build;
+  auto* b = ist->add_subcommand("build", "fill a closed mesh with spheres and write the tree to a .ist file");
+  b->add_option("mesh", build.mesh, "mesh file (OBJ, STL, PLY, OFF, ... anything assimp reads)")->required()->check(CLI::ExistingFile);
+  b->add_option("-o,--output", build.out, "output .ist file (written atomically)")->required();
+  b->add_option("--spheres", build.spheres, "target number of spheres")->default_val(10000)->check(CLI::Range(1, 10000000));
+  b->add_option("--voxel", build.voxel, "distance-field voxel size in mesh units (0 = automatic)")->default_val(0.0)->check(CLI::NonNegativeNumber);
+  b->add_option("--meters-per-unit", build.meters_per_unit, "length of one mesh unit in metres")->default_val(1.0)->check(CLI::PositiveNumber);
+  b->add_option("--preview", build.preview, "also write a PNG picture of the packing");
+  b->add_flag("--allow-open", build.allow_open, "accept slightly open meshes (inside test by winding number)");
+  b->add_flag("--json", build.json, "print one JSON object");
+  b->callback([&runner] { runner = [] { return run_build(build); }; });
+
+  static IstInfoArgs info;
+  auto* i = ist->add_subcommand("info", "print what a .ist file holds");
+  i->add_option("file", info.file, ".ist file")->required()->check(CLI::ExistingFile);
+  i->add_flag("--json", info.json, "print one JSON object");
+  i->callback([&runner] { runner = [] { return run_info(info); }; });
+
+  static IstPreviewArgs preview;
+  auto* p = ist->add_subcommand("preview", "draw the packing of a .ist file to a PNG");
+  p->add_option("file", preview.file, ".ist file")->required()->check(CLI::ExistingFile);
+  p->add_option("-o,--output", preview.out, "output PNG")->required();
+  p->add_flag("--section", preview.section, "cut the packing in half to show the inside");
+  p->add_option("--width", preview.width, "pixels")->default_val(800)->check(CLI::Range(16, 8192));
+  p->add_option("--height", preview.height, "pixels")->default_val(800)->check(CLI::Range(16, 8192));
+  p->callback([&runner] { runner = [] { return run_preview(preview); }; });
+}
+
+}  // namespace uh::cli

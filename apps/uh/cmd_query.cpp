@@ -1,0 +1,150 @@
+// uh query A.ist B.ist --poses POSES.csv [--out RESULTS.csv] [--json] [--budget-us N]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "poses_csv.hpp"
+#include "uh/collette/distance_query.hpp"
+#include "uh/collette/ist_file.hpp"
+#include "uh/collette/time_critical_query.hpp"
+#include "uh/collette/volume_query.hpp"
+
+namespace uh::cli {
+namespace {
+
+struct QueryArgs {
+  std::string a;
+  std::string b;
+  std::string poses;
+  std::string out;
+  bool json = false;
+  double budget_us = 0.0;
+};
+
+struct QueryRow {
+  std::string id;
+  double volume = 0.0;
+  Vec3 normal{};
+  std::int64_t pairs = 0;
+  double distance = 0.0;
+  double time_us = 0.0;
+};
+
+// Writes next to the target, then renames, so an existing results file is never left half-written.
+Status write_results_csv(const std::filesystem::path& path, const std::vector<QueryRow>& rows) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) return Error{fmt::format("{}: cannot write (is the directory there and writable?)", path.string())};
+    out << "id,volume,nx,ny,nz,pairs,distance,time_us\n";
+    for (const QueryRow& r : rows)
+      out << fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.3f}\n", r.id, r.volume, r.normal.x, r.normal.y,
+                         r.normal.z, r.pairs, r.distance, r.time_us);
+    out.flush();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      return Error{fmt::format("{}: write failed", path.string())};
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return Error{fmt::format("{}: cannot replace the file: {}", path.string(), ec.message())};
+  return Ok{};
+}
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size())));
+  return values[std::clamp<std::size_t>(rank, 1, values.size()) - 1];
+}
+
+int run_query(const QueryArgs& args) {
+  auto a = collette::load_ist(args.a);
+  if (!a) return fail(a.error().message);
+  auto b = collette::load_ist(args.b);
+  if (!b) return fail(b.error().message);
+  auto poses = read_poses_csv(args.poses);
+  if (!poses) return fail(poses.error().message);
+
+  collette::VolumeQuery volume_query;
+  collette::TimeCriticalQuery time_critical_query;
+  collette::DistanceQuery distance_query;
+  const collette::TimeCriticalBudget budget{.max_seconds = args.budget_us * 1e-6};
+  std::vector<QueryRow> rows;
+  rows.reserve(poses->size());
+  for (const PoseRow& pose : *poses) {
+    QueryRow row{.id = pose.id};
+    const auto start = std::chrono::steady_clock::now();
+    if (args.budget_us > 0.0) {
+      const auto& r = time_critical_query.run(a->tree, b->tree, pose.b_in_a, budget);
+      row.volume = r.volume_estimate;
+      row.normal = r.restoring_direction;
+      row.pairs = r.stats.overlapping_pairs;
+    } else {
+      const auto& r = volume_query.run(a->tree, b->tree, pose.b_in_a);
+      row.volume = r.total_volume;
+      row.normal = r.restoring_direction;
+      row.pairs = r.stats.overlapping_pairs;
+    }
+    if (row.volume <= 0.0) row.distance = distance_query.run(a->tree, b->tree, pose.b_in_a).distance;
+    row.time_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    rows.push_back(std::move(row));
+  }
+
+  if (!args.out.empty())
+    if (auto written = write_results_csv(args.out, rows); !written) return fail(written.error().message);
+
+  std::vector<double> times;
+  for (const QueryRow& r : rows) times.push_back(r.time_us);
+  if (args.json) {
+    nlohmann::json results = nlohmann::json::array();
+    for (const QueryRow& r : rows)
+      results.push_back({{"id", r.id}, {"volume", r.volume}, {"nx", r.normal.x}, {"ny", r.normal.y}, {"nz", r.normal.z},
+                         {"pairs", r.pairs}, {"distance", r.distance}, {"time_us", r.time_us}});
+    nlohmann::json j = {{"a", args.a},
+                        {"b", args.b},
+                        {"poses", rows.size()},
+                        {"mode", args.budget_us > 0.0 ? "time-critical" : "exact"},
+                        {"time_us", {{"median", percentile(times, 0.5)}, {"p99", percentile(times, 0.99)},
+                                     {"max", percentile(times, 1.0)}}},
+                        {"results", results}};
+    if (args.budget_us > 0.0) j["budget_us"] = args.budget_us;
+    if (!args.out.empty()) j["out"] = args.out;
+    std::printf("%s\n", j.dump(2).c_str());
+  } else if (args.out.empty()) {
+    std::printf("id,volume,nx,ny,nz,pairs,distance,time_us\n");
+    for (const QueryRow& r : rows)
+      std::printf("%s,%.9g,%.9g,%.9g,%.9g,%lld,%.9g,%.3f\n", r.id.c_str(), r.volume, r.normal.x, r.normal.y, r.normal.z,
+                  static_cast<long long>(r.pairs), r.distance, r.time_us);
+  } else {
+    std::printf("%zu poses -> %s; time_us median %.1f, p99 %.1f, max %.1f\n", rows.size(), args.out.c_str(),
+                percentile(times, 0.5), percentile(times, 0.99), percentile(times, 1.0));
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_query_command(CLI::App& app, CommandRunner& runner) {
+  static QueryArgs args;
+  auto* q = app.add_subcommand("query", "intersection volume, restoring direction and distance of B against A per pose");
+  q->add_option("a", args.a, "A.ist")->required()->check(CLI::ExistingFile);
+  q->add_option("b", args.b, "B.ist")->required()->check(CLI::ExistingFile);
+  q->add_option("--poses", args.poses, "CSV id,tx,ty,tz,qw,qx,qy,qz: pose of B's mesh frame in A's")->required()->check(CLI::ExistingFile);
+  q->add_option("--out", args.out, "write id,volume,nx,ny,nz,pairs,distance,time_us to this CSV");
+  q->add_flag("--json", args.json, "print a JSON summary (median, p99, max time_us) with the results");
+  q->add_option("--budget-us", args.budget_us, "time-critical query with this budget per pose [us]")->check(CLI::PositiveNumber);
+  q->callback([&runner] { runner = [] { return run_query(args); }; });
+}
+
+}  // namespace uh::cli

@@ -1,0 +1,135 @@
+// uh run [SCENE] [--seconds S] [--json] [--trace OUT.csv] [--plot OUT.png]
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "progress_bar.hpp"
+#include "session_plot.hpp"
+#include "uh/controllers/haptic_session.hpp"
+#include "uh/controllers/scene.hpp"
+
+namespace uh::cli {
+namespace {
+
+struct RunArgs {
+  std::string scene;
+  double seconds = 0.0;
+  bool json = false;
+  std::string trace;
+  std::string plot;
+  double haptic_hz = 0.0;
+  double collision_hz = -1.0;
+  bool held_forces = false;
+  bool stepped = false;
+  int ticks_per_collision = 4;
+  bool realtime = false;
+};
+
+void print_summary(const controllers::SessionReport& r) {
+  std::printf("scene %s: %.1f s %s\n", r.scene.c_str(), r.seconds, r.stepped ? "(stepped, simulated time)" : "");
+  std::printf("  haptic    %.1f Hz (target %.0f), %llu ticks, %llu missed deadlines, jitter p50 %.1f us, p99 %.1f us, max %.1f us\n",
+              r.haptic_rate_hz, r.haptic_target_hz, static_cast<unsigned long long>(r.haptic_ticks),
+              static_cast<unsigned long long>(r.haptic_missed_deadlines), r.jitter_p50_us, r.jitter_p99_us, r.jitter_max_us);
+  std::printf("  collision median %.0f Hz, min %.0f Hz (target %.0f); query median %.1f us, p99 %.1f us, max %.1f us; up to %lld pairs\n",
+              r.collision_rate_median_hz, r.collision_rate_min_hz, r.collision_target_hz, r.query_median_us, r.query_p99_us,
+              r.query_max_us, static_cast<long long>(r.max_pairs));
+  std::printf("  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu clamped, %llu non-finite\n",
+              r.force_max_n, r.torque_max_nm, r.force_max_step_n, r.multi_rate ? "multi-rate" : "held forces",
+              static_cast<unsigned long long>(r.force_clamped), static_cast<unsigned long long>(r.force_nonfinite));
+  std::printf("  contact   %llu ticks in contact; energy into the hand %.4f J%s\n",
+              static_cast<unsigned long long>(r.contact_ticks), r.work_on_hand_j, r.coupling ? " (virtual coupling)" : "");
+}
+
+int run_session(const RunArgs& args) {
+  const std::filesystem::path cache = controllers::default_cache_dir();
+  auto scene = args.scene.empty() ? controllers::default_scene(cache) : controllers::load_scene(args.scene);
+  if (!scene) return fail(scene.error().message);
+
+  controllers::SessionOptions options;
+  if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
+  if (args.collision_hz >= 0.0) options.collision_hz = args.collision_hz;
+  if (args.held_forces) options.multi_rate = false;
+  options.raise_priority = args.realtime;
+  options.cache_dir = cache;
+  std::unique_ptr<ProgressBar> bar;
+  std::string bar_label;
+  options.build_progress = [&](const std::string& what, double fraction) {
+    if (what != bar_label) {
+      bar = std::make_unique<ProgressBar>(what);
+      bar_label = what;
+    }
+    bar->update(fraction);
+  };
+  auto session = controllers::HapticSession::create(*scene, options);
+  bar.reset();
+  if (!session) return fail(session.error().message);
+
+  std::ofstream trace_file;
+  std::string trace_tmp;
+  if (!args.trace.empty()) {
+    trace_tmp = args.trace + ".tmp";
+    trace_file.open(trace_tmp);
+    if (!trace_file) return fail(fmt::format("{}: cannot write the trace", args.trace));
+  }
+  std::ostream* trace = args.trace.empty() ? nullptr : &trace_file;
+  const double seconds = args.seconds > 0.0 ? args.seconds : scene->seconds;
+  const char* ci = std::getenv("CI");
+  const bool live = !args.json && isatty(STDERR_FILENO) == 1 && (ci == nullptr || *ci == '\0');
+
+  Status ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
+                            : (*session)->run(seconds,
+                                              [live](const controllers::LiveStatus& s) {
+                                                if (!live) return;
+                                                std::fprintf(stderr, "\r  t %5.1f s | haptic %6.0f Hz | collision %6.0f Hz | force %5.2f N | pairs %6d ",
+                                                             s.time_s, s.haptic_rate_hz, s.collision_rate_hz, s.force_n, s.pairs);
+                                              },
+                                              trace);
+  if (live) std::fputc('\n', stderr);
+  if (!ran) return fail(ran.error().message);
+  if (trace != nullptr) {
+    trace_file.close();
+    std::error_code ec;
+    std::filesystem::rename(trace_tmp, args.trace, ec);
+    if (ec) return fail(fmt::format("{}: cannot write the trace: {}", args.trace, ec.message()));
+  }
+  const auto& report = (*session)->report();
+  if (!args.plot.empty())
+    if (auto plotted = write_session_plot(report, args.plot); !plotted) return fail(plotted.error().message);
+  if (args.json) {
+    std::printf("%s\n", controllers::session_report_json(report).c_str());
+  } else {
+    print_summary(report);
+    if (!args.trace.empty()) std::printf("  trace -> %s\n", args.trace.c_str());
+    if (!args.plot.empty()) std::printf("  plot  -> %s\n", args.plot.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, CommandRunner& runner) {
+  static RunArgs args;
+  auto* r = app.add_subcommand("run", "run a haptic session: device, haptic thread, collision thread, forces");
+  r->add_option("scene", args.scene, "scene file (JSON); default: the embedded bunny sweep")->check(CLI::ExistingFile);
+  r->add_option("--seconds", args.seconds, "session length [s] (default: the scene's)")->check(CLI::PositiveNumber);
+  r->add_flag("--json", args.json, "print one JSON object with the session's figures");
+  r->add_option("--trace", args.trace, "write every haptic tick (state, requested and sent force) to this CSV");
+  r->add_option("--plot", args.plot, "write a PNG of force, torque and collision rate over time");
+  r->add_option("--haptic-hz", args.haptic_hz, "override the haptic rate [Hz]")->check(CLI::Range(1.0, 10000.0));
+  r->add_option("--collision-hz", args.collision_hz, "override the collision rate [Hz] (0 = free-running)")->check(CLI::Range(0.0, 10000.0));
+  r->add_flag("--held-forces", args.held_forces, "hold each collision frame's force instead of re-evaluating every tick");
+  r->add_flag("--stepped", args.stepped, "deterministic run on one thread in simulated time");
+  r->add_option("--ticks-per-collision", args.ticks_per_collision, "with --stepped: haptic ticks per collision step")
+      ->default_val(4)->check(CLI::Range(1, 1000));
+  r->add_flag("--realtime", args.realtime, "ask for SCHED_FIFO for the haptic and collision threads");
+  r->callback([&runner] { runner = [] { return run_session(args); }; });
+}
+
+}  // namespace uh::cli

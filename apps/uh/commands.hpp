@@ -1,0 +1,22 @@
+#pragma once
+/// \file
+/// The subcommands of `uh`. Each registers its options on a CLI11 app and returns the exit code
+/// of its run: 0 success, 1 a user-facing error (already printed to stderr), 2 bad usage.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace uh::cli {
+
+/// Runs after parsing; returns the process exit code.
+using CommandRunner = std::function<int()>;
+
+void add_ist_commands(CLI::App& app, CommandRunner& runner);
+void add_query_command(CLI::App& app, CommandRunner& runner);
+void add_run_command(CLI::App& app, CommandRunner& runner);
+
+/// Prints "uh: <message>" to stderr and returns 1.
+int fail(const std::string& message);
+
+}  // namespace uh::cli

@@ -1,0 +1,177 @@
+#include "session_plot.hpp"
+
+#include <cairo.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "uh/core/math.hpp"
+
+namespace uh::cli {
+namespace {
+
+struct Series {
+  std::vector<double> t;
+  std::vector<double> v;
+};
+
+struct Panel {
+  std::string title;
+  std::string unit;
+  std::vector<Series> series;
+  std::vector<std::array<double, 3>> colours;
+  std::vector<std::string> labels;
+  double target = -1.0;  // a dashed reference line (e.g. the target rate), < 0 for none
+};
+
+// A "nice" step for about `count` grid lines over `range`.
+double nice_step(double range, int count) {
+  const double raw = range / count;
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (raw <= m * power) return m * power;
+  return 10.0 * power;
+}
+
+void draw_panel(cairo_t* cr, const Panel& p, double x0, double y0, double w, double h, double t_max) {
+  double v_max = p.target > 0 ? p.target * 1.1 : 0.0;
+  for (const auto& s : p.series)
+    for (double v : s.v) v_max = std::max(v_max, v);
+  if (!(v_max > 0.0)) v_max = 1.0;
+  v_max *= 1.05;
+  const double left = x0 + 70, right = x0 + w - 20, top = y0 + 28, bottom = y0 + h - 30;
+  const auto X = [&](double t) { return left + (right - left) * (t_max > 0 ? t / t_max : 0.0); };
+  const auto Y = [&](double v) { return bottom - (bottom - top) * v / v_max; };
+
+  cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_font_size(cr, 14);
+  cairo_move_to(cr, left, y0 + 18);
+  cairo_show_text(cr, p.title.c_str());
+
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, 11);
+  cairo_set_line_width(cr, 1.0);
+  const double vs = nice_step(v_max, 5);
+  for (double v = 0; v <= v_max + 1e-12; v += vs) {
+    cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
+    cairo_move_to(cr, left, Y(v));
+    cairo_line_to(cr, right, Y(v));
+    cairo_stroke(cr);
+    cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+    const std::string label = fmt::format("{:g}", v);
+    cairo_move_to(cr, left - 8 - 6.0 * static_cast<double>(label.size()), Y(v) + 4);
+    cairo_show_text(cr, label.c_str());
+  }
+  const double ts = nice_step(std::max(t_max, 1e-3), 8);
+  for (double t = 0; t <= t_max + 1e-12; t += ts) {
+    cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+    const std::string label = fmt::format("{:g}", t);
+    cairo_move_to(cr, X(t) - 3.0 * static_cast<double>(label.size()), bottom + 16);
+    cairo_show_text(cr, label.c_str());
+  }
+  cairo_move_to(cr, right - 40, bottom + 28);
+  cairo_show_text(cr, "time [s]");
+  cairo_save(cr);
+  cairo_move_to(cr, x0 + 14, (top + bottom) / 2 + 20);
+  cairo_rotate(cr, -kPi / 2);
+  cairo_show_text(cr, p.unit.c_str());
+  cairo_restore(cr);
+
+  cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
+  cairo_rectangle(cr, left, top, right - left, bottom - top);
+  cairo_stroke(cr);
+
+  if (p.target > 0) {
+    const double dashes[] = {6.0, 4.0};
+    cairo_set_dash(cr, dashes, 2, 0);
+    cairo_set_source_rgb(cr, 0.5, 0.5, 0.5);
+    cairo_move_to(cr, left, Y(p.target));
+    cairo_line_to(cr, right, Y(p.target));
+    cairo_stroke(cr);
+    cairo_set_dash(cr, nullptr, 0, 0);
+  }
+  for (std::size_t k = 0; k < p.series.size(); ++k) {
+    const Series& s = p.series[k];
+    cairo_set_source_rgb(cr, p.colours[k][0], p.colours[k][1], p.colours[k][2]);
+    cairo_set_line_width(cr, 1.2);
+    for (std::size_t i = 0; i < s.t.size(); ++i) {
+      if (i == 0) cairo_move_to(cr, X(s.t[i]), Y(s.v[i]));
+      else cairo_line_to(cr, X(s.t[i]), Y(s.v[i]));
+    }
+    cairo_stroke(cr);
+    cairo_move_to(cr, right - 300, top + 16 + 14.0 * static_cast<double>(k));
+    cairo_show_text(cr, p.labels[k].c_str());
+  }
+}
+
+// At most ~4000 points per series: the per-bucket maximum keeps every peak visible.
+Series decimate(const std::vector<double>& t, const std::vector<double>& v) {
+  Series out;
+  const std::size_t n = t.size();
+  const std::size_t bucket = std::max<std::size_t>(1, n / 4000);
+  for (std::size_t i = 0; i < n; i += bucket) {
+    double m = 0.0;
+    const std::size_t end = std::min(n, i + bucket);
+    for (std::size_t k = i; k < end; ++k) m = std::max(m, v[k]);
+    out.t.push_back(t[i]);
+    out.v.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace
+
+Status write_session_plot(const controllers::SessionReport& report, const std::filesystem::path& png) {
+  std::vector<double> t, f, tq;
+  for (const auto& s : report.timeline) {
+    t.push_back(s.time_s);
+    f.push_back(s.force_n);
+    tq.push_back(s.torque_nm);
+  }
+  double t_max = report.seconds;
+  for (double x : t) t_max = std::max(t_max, x);
+
+  Panel force{.title = fmt::format("Force sent to the device ({}, {} Hz haptic)", report.scene, report.haptic_target_hz),
+              .unit = "|F| [N]", .series = {decimate(t, f)}, .colours = {{0.80, 0.20, 0.15}}, .labels = {"|force|"}};
+  Panel torque{.title = "Torque sent to the device", .unit = "|tau| [N m]", .series = {decimate(t, tq)},
+               .colours = {{0.15, 0.35, 0.75}}, .labels = {"|torque|"}};
+  Series rate;
+  for (const auto& s : report.collision_rates) {
+    rate.t.push_back(s.time_s);
+    rate.v.push_back(s.rate_hz);
+  }
+  Panel collision{.title = fmt::format("Collision thread rate (median {:.0f} Hz, min {:.0f} Hz)",
+                                       report.collision_rate_median_hz, report.collision_rate_min_hz),
+                  .unit = "rate [Hz]", .series = {rate}, .colours = {{0.15, 0.55, 0.25}},
+                  .labels = {"collision steps / s (100 ms windows)"},
+                  .target = report.collision_target_hz > 0 ? report.collision_target_hz : -1.0};
+
+  constexpr int kWidth = 1200, kPanelHeight = 260;
+  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, kWidth, 3 * kPanelHeight);
+  cairo_t* cr = cairo_create(surface);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  draw_panel(cr, force, 0, 0, kWidth, kPanelHeight, t_max);
+  draw_panel(cr, torque, 0, kPanelHeight, kWidth, kPanelHeight, t_max);
+  draw_panel(cr, collision, 0, 2 * kPanelHeight, kWidth, kPanelHeight, t_max);
+  cairo_destroy(cr);
+  const std::filesystem::path tmp = png.string() + ".tmp";
+  const cairo_status_t status = cairo_surface_write_to_png(surface, tmp.c_str());
+  cairo_surface_destroy(surface);
+  if (status != CAIRO_STATUS_SUCCESS) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    return Error{fmt::format("{}: cannot write the plot: {}", png.string(), cairo_status_to_string(status))};
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, png, ec);
+  if (ec) return Error{fmt::format("{}: cannot write the plot: {}", png.string(), ec.message())};
+  return Ok{};
+}
+
+}  // namespace uh::cli

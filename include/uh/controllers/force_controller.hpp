@@ -1,0 +1,130 @@
+#pragma once
+/// \file
+/// ForceController: hands contact data from the collision thread to the haptic thread and turns it
+/// into the device force every haptic tick (the paper's ForceController, section 3.2.5).
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "uh/collette/collision_world.hpp"
+#include "uh/controllers/workspace_mapping.hpp"
+#include "uh/core/contact.hpp"
+#include "uh/core/delegator.hpp"
+#include "uh/core/latest_value.hpp"
+#include "uh/forcecomp/force_component.hpp"
+#include "uh/forcecomp/force_safety.hpp"
+#include "uh/forcecomp/held_contact_set.hpp"
+#include "uh/forcecomp/virtual_coupling.hpp"
+#include "uh/haptico/haptic_manager.hpp"
+
+namespace uh::controllers {
+
+/// Options of a ForceController (aggregate; designated initialisers).
+struct ForceControllerOptions {
+  /// Re-evaluate the held pair set at the current tool pose every haptic tick (multi-rate). When
+  /// false, the force computed from the newest collision frame is held until the next frame.
+  bool multi_rate = true;
+  /// Limits, NaN guard and contact-age watchdog applied before the command leaves the controller.
+  forcecomp::ForceSafetyOptions safety{};
+  /// Optional spring-damper between the handle and a simulated tool (proxy).
+  bool use_coupling = false;
+  forcecomp::VirtualCouplingOptions coupling{};
+};
+
+/// What the controller did so far; a snapshot, plain data.
+struct ForceControllerStats {
+  std::uint64_t ticks = 0;              ///< force ticks run
+  std::uint64_t contact_ticks = 0;      ///< ticks with at least one held pair of positive volume
+  std::uint64_t frames_received = 0;    ///< contact frames taken over from the collision thread
+  double max_force_n = 0.0;             ///< largest |force| sent to the device [N]
+  double max_torque_nm = 0.0;           ///< largest |torque| sent [N m]
+  double max_force_step_n = 0.0;        ///< largest tick-to-tick change of the contact force before limits [N]
+  double last_force_n = 0.0;            ///< |force| of the last tick [N]
+  std::int32_t last_pairs = 0;          ///< pairs used in the last tick
+  double work_on_hand_j = 0.0;          ///< sum of F_sent . v_handle dt: energy the device put into the hand [J]
+  forcecomp::ForceSafetyCounters safety{};
+};
+
+/// Binds OnCollision (collision thread) and ForceOnHapticTick (haptic thread).
+///
+/// On the collision thread, on_collision() copies each frame about the tool into a lock-free
+/// LatestValue per watched pair. On the haptic thread, on_force() takes the newest frame, holds its
+/// pairs, evaluates the volumetric penalty force and torque on the tool (ForceComponent, eq. 1-2),
+/// optionally through a virtual coupling, applies ForceSafety (limits, NaN guard, watchdog on the
+/// age of the contact data) and adds the result, in the device frame, to the command.
+///
+/// Threads: construct, add_watched() and bind() on the controlling thread before the threads start;
+/// stats() from any thread. Memory for all watched pairs is allocated in add_watched(); the tick
+/// never allocates, locks, throws or logs.
+class ForceController {
+ public:
+  ForceController(collette::ObjectId tool, const forcecomp::ForceComponent& tool_component,
+                  const WorkspaceMapping& mapping, const ForceControllerOptions& options = {});
+  ~ForceController();
+  ForceController(const ForceController&) = delete;
+  ForceController& operator=(const ForceController&) = delete;
+
+  /// Takes forces from the watched pair (object, tool) of the world. Controlling thread, before bind().
+  void add_watched(collette::ObjectId object);
+
+  /// Connects to the world's OnCollision and the manager's ForceOnHapticTick. The coupling's proxy
+  /// is placed at the handle on the first tick. Controlling thread, before the threads start.
+  void bind(collette::CollisionWorld& world, haptico::HapticManager& manager);
+
+  /// OnCollision handler: collision thread; real-time safe.
+  void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
+  /// ForceOnHapticTick handler: haptic thread; real-time safe.
+  void on_force(const haptico::DeviceState& state, haptico::DeviceCommand& command);
+
+  /// The coupling (null without one); the BridgingController reads its proxy pose.
+  const forcecomp::VirtualCoupling* coupling() const { return options_.use_coupling ? &coupling_ : nullptr; }
+  /// True once the coupling's proxy has been placed at the handle (haptic thread only).
+  bool proxy_placed() const { return proxy_placed_; }
+  /// Zero force from the next tick on (ForceSafety::stop). Any thread.
+  void stop() { safety_.stop(); }
+  ForceControllerStats stats() const;
+  const ForceControllerOptions& options() const { return options_; }
+
+ private:
+  struct Watched {
+    collette::ObjectId object = -1;
+    LatestValue<ContactFrame> inbox;           // collision thread -> haptic thread
+    forcecomp::HeldContactSet held;            // haptic thread
+    Pose world_from_object{};                  // object pose used by the held frame's query
+    forcecomp::Wrench held_wrench{};           // force of the newest frame (held-force mode)
+    std::int32_t held_pairs = 0;
+    Watched() : held(ContactFrame::kMaxPairs) {}
+  };
+
+  collette::ObjectId tool_;
+  forcecomp::ForceComponent component_;
+  WorkspaceMapping mapping_;
+  ForceControllerOptions options_;
+  forcecomp::ForceSafety safety_;
+  forcecomp::VirtualCoupling coupling_;
+  std::vector<std::unique_ptr<Watched>> watched_;
+  haptico::HapticManager* manager_ = nullptr;
+  ScopedConnection collision_connection_;
+  ScopedConnection force_connection_;
+
+  // haptic thread state
+  double last_tick_s_ = 0.0;
+  bool have_last_tick_ = false;
+  bool proxy_placed_ = false;
+  Vec3 last_contact_force_{};
+
+  // published to stats() readers
+  std::atomic<std::uint64_t> ticks_{0};
+  std::atomic<std::uint64_t> contact_ticks_{0};
+  std::atomic<std::uint64_t> frames_received_{0};
+  std::atomic<double> max_force_n_{0.0};
+  std::atomic<double> max_torque_nm_{0.0};
+  std::atomic<double> max_force_step_n_{0.0};
+  std::atomic<double> last_force_n_{0.0};
+  std::atomic<std::int32_t> last_pairs_{0};
+  std::atomic<double> work_on_hand_j_{0.0};
+};
+
+}  // namespace uh::controllers

@@ -1,0 +1,92 @@
+#pragma once
+/// \file
+/// Scene files: the objects, the tool and its device, the watched pairs, rates and safety limits of
+/// a haptic session, as JSON. The CLI (`uh run SCENE`), the tests and the benchmarks use the same
+/// files (scenes/*.json). Format: docs/scenes.md.
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "uh/collette/sphere_tree.hpp"
+#include "uh/controllers/force_controller.hpp"
+#include "uh/controllers/workspace_mapping.hpp"
+#include "uh/core/math.hpp"
+#include "uh/core/result.hpp"
+#include "uh/forcecomp/force_params.hpp"
+#include "uh/haptico/device_config.hpp"
+
+namespace uh::controllers {
+
+/// Where an object's Inner Sphere Tree comes from: a mesh (packed on first use, cached) or a .ist file.
+struct SceneShape {
+  std::filesystem::path mesh;        ///< mesh file (absolute after loading), or empty when `ist` is set
+  std::filesystem::path ist;         ///< prebuilt .ist file, or empty
+  std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
+  double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
+};
+
+/// A static object of the scene.
+struct SceneObject {
+  std::string name;
+  SceneShape shape;
+  Pose pose{};                       ///< world_from_object [m]
+};
+
+/// The device a tool is bound to: a registered driver name and its settings.
+struct SceneDevice {
+  std::string driver = "sim-line";
+  haptico::DeviceConfig config;
+};
+
+/// The tool: a shape moved by the device, with its force component.
+struct SceneTool {
+  std::string name = "tool";
+  SceneShape shape;
+  forcecomp::ForceParams force{};
+  forcecomp::ForceMode mode = forcecomp::ForceMode::k6Dof;
+  SceneDevice device;
+  WorkspaceMapping workspace{};
+};
+
+/// A whole session description.
+struct Scene {
+  std::string name;                    ///< for messages and reports
+  std::string source;                  ///< file the scene came from ("<embedded>" for the default)
+  std::vector<SceneObject> objects;
+  SceneTool tool;
+  std::vector<std::string> watch;      ///< object names watched against the tool
+  double haptic_hz = 1000.0;           ///< haptic thread rate [Hz]
+  double collision_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running
+  double seconds = 10.0;               ///< default session length [s]
+  ForceControllerOptions force{};      ///< multi-rate, safety limits, watchdog, coupling
+};
+
+/// Reads a scene file. Errors name the file, the field (as a JSON path such as
+/// `tool.device.driver`) and what is expected; unknown fields are errors too (typos).
+/// Relative mesh and .ist paths are resolved against the scene file's directory.
+Result<Scene> load_scene(const std::filesystem::path& path);
+
+/// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
+Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);
+
+/// The embedded default scene: the bunny explored by a stylus on a raster sweep into deep contact.
+/// Its meshes are written into `cache_dir` on first use.
+Result<Scene> default_scene(const std::filesystem::path& cache_dir);
+
+/// Where built .ist files are cached: $UH_CACHE_DIR, else $XDG_CACHE_HOME/unrealhaptics, else
+/// ~/.cache/unrealhaptics, else a folder in the system temp directory.
+std::filesystem::path default_cache_dir();
+
+/// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the
+/// mesh file's hash and the sphere count), building and caching it on first use. `progress` gets
+/// the packing progress when a build is needed. Setup only.
+Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(
+    const SceneShape& shape, const std::filesystem::path& cache_dir,
+    const std::function<void(const std::string& what, double fraction)>& progress = {});
+
+}  // namespace uh::controllers

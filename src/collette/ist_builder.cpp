@@ -1,0 +1,76 @@
+#include "uh/collette/ist_builder.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace uh::collette {
+
+Result<std::uint64_t> hash_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{fmt::format("{}: cannot open the file", path.string())};
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return Error{fmt::format("{}: read error", path.string())};
+  return ist_hash_bytes(std::as_bytes(std::span<const char>(bytes)));
+}
+
+SphereTree scale_sphere_tree(const SphereTree& tree, double factor) {
+  const auto f = static_cast<float>(factor);
+  const auto f3 = static_cast<float>(factor * factor * factor);
+  std::vector<SphereTreeNode> nodes(tree.nodes().begin(), tree.nodes().end());
+  for (auto& n : nodes) {
+    n.x *= f;
+    n.y *= f;
+    n.z *= f;
+    n.radius *= f;
+    n.volume *= f3;
+  }
+  std::vector<Sphere> leaves(tree.leaves().begin(), tree.leaves().end());
+  for (auto& s : leaves) {
+    s.x *= f;
+    s.y *= f;
+    s.z *= f;
+    s.radius *= f;
+  }
+  return SphereTree(std::move(nodes), std::move(leaves), tree.depth(), tree.arity());
+}
+
+Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path, const IstBuildOptions& options) {
+  if (options.sphere_count <= 0)
+    return Error{fmt::format("{}: the sphere count must be positive (got {})", mesh_path.string(), options.sphere_count)};
+  if (!(options.meters_per_unit > 0.0))
+    return Error{fmt::format("{}: meters per unit must be positive (got {})", mesh_path.string(), options.meters_per_unit)};
+  const auto start = std::chrono::steady_clock::now();
+
+  auto mesh = load_mesh(mesh_path, options.mesh);
+  if (!mesh) return mesh.error();
+  auto hash = hash_file(mesh_path);
+  if (!hash) return hash.error();
+
+  PackingOptions packing_options;
+  packing_options.target_sphere_count = options.sphere_count;
+  packing_options.voxel_size = options.voxel_size;
+  packing_options.progress = options.progress;
+  auto packing = pack_spheres(*mesh, packing_options);
+  if (!packing) return Error{fmt::format("{}: {}", mesh_path.string(), packing.error().message)};
+
+  const auto tree_start = std::chrono::steady_clock::now();
+  auto tree = build_sphere_tree(packing->spheres, options.tree);
+  if (!tree) return Error{fmt::format("{}: sphere tree: {}", mesh_path.string(), tree.error().message)};
+  const auto end = std::chrono::steady_clock::now();
+
+  IstBuildResult result{.asset = {std::move(tree).value(), {}}, .mesh = mesh->report, .packing = packing->report};
+  result.tree_seconds = std::chrono::duration<double>(end - tree_start).count();
+  result.asset.meta = IstMetadata{.meters_per_unit = options.meters_per_unit,
+                                  .source_mesh_hash = *hash,
+                                  .coverage = packing->report.coverage,
+                                  .mesh_volume = packing->report.mesh_volume,
+                                  .max_gap = packing->report.max_gap,
+                                  .build_seconds = std::chrono::duration<double>(end - start).count()};
+  return result;
+}
+
+}  // namespace uh::collette

@@ -1,0 +1,145 @@
+#include "uh/controllers/force_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace uh::controllers {
+namespace {
+
+// Raises an atomic maximum written by one thread (the haptic thread) and read by others.
+void raise_max(std::atomic<double>& max, double value) {
+  if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
+}
+
+}  // namespace
+
+ForceController::ForceController(collette::ObjectId tool, const forcecomp::ForceComponent& tool_component,
+                                 const WorkspaceMapping& mapping, const ForceControllerOptions& options)
+    : tool_(tool),
+      component_(tool_component),
+      mapping_(mapping),
+      options_(options),
+      safety_(options.safety),
+      coupling_(options.coupling) {}
+
+ForceController::~ForceController() = default;
+
+void ForceController::add_watched(collette::ObjectId object) {
+  auto w = std::make_unique<Watched>();
+  w->object = object;
+  watched_.push_back(std::move(w));
+}
+
+void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManager& manager) {
+  manager_ = &manager;
+  collision_connection_ = world.on_collision().connect<&ForceController::on_collision>(*this);
+  force_connection_ = manager.force_on_haptic_tick().connect<&ForceController::on_force>(*this);
+}
+
+void ForceController::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
+  if (b != tool_) return;  // the tool is always B of its watched pairs: forces push B out of A
+  for (auto& w : watched_) {
+    if (w->object != a) continue;
+    copy_contact_frame(frame, w->inbox.write_buffer());
+    w->inbox.publish();
+    return;
+  }
+}
+
+void ForceController::on_force(const haptico::DeviceState& state, haptico::DeviceCommand& command) {
+  const double now = manager_ != nullptr ? manager_->tick_time_s() : state.time_s;
+  const double dt = have_last_tick_ ? std::max(0.0, now - last_tick_s_) : 0.0;
+  last_tick_s_ = now;
+  have_last_tick_ = true;
+
+  const Pose world_from_handle_tool = mapping_.world_from_tool(state);
+  if (options_.use_coupling && !proxy_placed_) {
+    coupling_.reset(world_from_handle_tool);
+    proxy_placed_ = true;
+  }
+  const Vec3 handle_velocity = mapping_.tool_velocity_world(state);
+  const Vec3 handle_angular_velocity = mapping_.angular_velocity_world(state);
+  const Pose world_from_tool = options_.use_coupling ? coupling_.world_from_proxy() : world_from_handle_tool;
+  const forcecomp::BodyMotion tool_motion =
+      component_.body_motion(world_from_tool, handle_velocity, handle_angular_velocity);
+
+  forcecomp::Wrench contact{};
+  std::int32_t pairs = 0;
+  double oldest_data_s = now;
+  for (auto& w : watched_) {
+    if (w->inbox.update()) {
+      const ContactFrame& frame = w->inbox.read_buffer();
+      frames_received_.fetch_add(1, std::memory_order_relaxed);
+      if (frame.pair_count > 0) {
+        w->held.hold(frame);
+        w->world_from_object = frame.world_from_a;
+        const auto r = component_.evaluate(frame, tool_motion);
+        w->held_wrench = r.wrench;
+        w->held_pairs = r.pair_count;
+      } else {
+        w->held.clear();
+        w->held_wrench = {};
+        w->held_pairs = 0;
+      }
+    }
+    if (w->held.empty()) continue;
+    oldest_data_s = std::min(oldest_data_s, w->held.time_s());
+    if (options_.multi_rate) {
+      const auto r = component_.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion);
+      contact.force += r.wrench.force;
+      contact.torque += r.wrench.torque;
+      pairs += r.pair_count;
+    } else {
+      contact.force += w->held_wrench.force;
+      contact.torque += w->held_wrench.torque;
+      pairs += w->held_pairs;
+    }
+  }
+
+  const double step = norm(contact.force - last_contact_force_);
+  if (std::isfinite(step)) raise_max(max_force_step_n_, step);
+  last_contact_force_ = contact.force;
+
+  forcecomp::Wrench to_device = contact;
+  if (options_.use_coupling) {
+    // the coupling takes the contact torque about the proxy's origin, the penalty gives it about the CoM
+    forcecomp::Wrench on_proxy = contact;
+    on_proxy.torque += cross(tool_motion.center_of_mass_world - world_from_tool.position, contact.force);
+    to_device = coupling_.step(world_from_handle_tool, handle_velocity, handle_angular_velocity, on_proxy, dt)
+                    .device_wrench;
+  }
+  const forcecomp::Wrench safe = safety_.apply(to_device, now, oldest_data_s);
+  const Vec3 force_device = mapping_.to_device(safe.force);
+  const Vec3 torque_device = mapping_.to_device(safe.torque);
+  command.force += force_device;
+  command.torque += torque_device;
+
+  ticks_.fetch_add(1, std::memory_order_relaxed);
+  if (pairs > 0) contact_ticks_.fetch_add(1, std::memory_order_relaxed);
+  const double force_n = norm(force_device);
+  raise_max(max_force_n_, force_n);
+  raise_max(max_torque_nm_, norm(torque_device));
+  last_force_n_.store(force_n, std::memory_order_relaxed);
+  last_pairs_.store(pairs, std::memory_order_relaxed);
+  // energy the device puts into the hand: force on the hand times the hand's velocity
+  const double work = dot(force_device, state.linear_velocity) * dt;
+  if (std::isfinite(work))
+    work_on_hand_j_.store(work_on_hand_j_.load(std::memory_order_relaxed) + work, std::memory_order_relaxed);
+}
+
+ForceControllerStats ForceController::stats() const {
+  ForceControllerStats s;
+  s.ticks = ticks_.load(std::memory_order_relaxed);
+  s.contact_ticks = contact_ticks_.load(std::memory_order_relaxed);
+  s.frames_received = frames_received_.load(std::memory_order_relaxed);
+  s.max_force_n = max_force_n_.load(std::memory_order_relaxed);
+  s.max_torque_nm = max_torque_nm_.load(std::memory_order_relaxed);
+  s.max_force_step_n = max_force_step_n_.load(std::memory_order_relaxed);
+  s.last_force_n = last_force_n_.load(std::memory_order_relaxed);
+  s.last_pairs = last_pairs_.load(std::memory_order_relaxed);
+  s.work_on_hand_j = work_on_hand_j_.load(std::memory_order_relaxed);
+  s.safety = safety_.counters();
+  return s;
+}
+
+}  // namespace uh::controllers

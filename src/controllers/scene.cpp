@@ -1,0 +1,434 @@
+#include "uh/controllers/scene.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "embedded_assets.hpp"
+#include "uh/collette/ist_builder.hpp"
+#include "uh/collette/ist_file.hpp"
+
+namespace uh::controllers {
+namespace {
+
+using nlohmann::json;
+
+// Reads typed fields out of a JSON object, naming the file and the JSON path in every error.
+class FieldReader {
+ public:
+  explicit FieldReader(std::string source) : source_(std::move(source)) {}
+
+  Error error(const std::string& path, const std::string& what) const {
+    return Error{fmt::format("{}: field '{}': {}", source_, path, what)};
+  }
+
+  Status require_object(const json& j, const std::string& path) const {
+    if (!j.is_object()) return error(path, fmt::format("expected an object, got {}", j.type_name()));
+    return Ok{};
+  }
+
+  Status check_keys(const json& j, const std::string& path, std::initializer_list<std::string_view> known) const {
+    for (const auto& [key, value] : j.items()) {
+      bool ok = false;
+      for (std::string_view k : known) ok = ok || key == k;
+      if (!ok) {
+        std::string list;
+        for (std::string_view k : known) list += fmt::format("{}{}", list.empty() ? "" : ", ", k);
+        return error(join(path, key), fmt::format("unknown field (known here: {})", list));
+      }
+    }
+    return Ok{};
+  }
+
+  static std::string join(const std::string& path, std::string_view key) {
+    return path.empty() ? std::string(key) : fmt::format("{}.{}", path, key);
+  }
+
+  Status number(const json& parent, const std::string& path, std::string_view key, double& out, double min,
+                double max) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) return Ok{};
+    const std::string p = join(path, key);
+    if (!it->is_number()) return error(p, fmt::format("expected a number, got {}", it->type_name()));
+    const double v = it->get<double>();
+    if (!std::isfinite(v) || v < min || v > max) return error(p, fmt::format("expected a number in [{}, {}], got {}", min, max, v));
+    out = v;
+    return Ok{};
+  }
+
+  Status integer(const json& parent, const std::string& path, std::string_view key, std::int64_t& out,
+                 std::int64_t min, std::int64_t max) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) return Ok{};
+    const std::string p = join(path, key);
+    if (!it->is_number_integer()) return error(p, fmt::format("expected a whole number, got {}", it->dump()));
+    const auto v = it->get<std::int64_t>();
+    if (v < min || v > max) return error(p, fmt::format("expected a whole number in [{}, {}], got {}", min, max, v));
+    out = v;
+    return Ok{};
+  }
+
+  Status boolean(const json& parent, const std::string& path, std::string_view key, bool& out) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) return Ok{};
+    if (!it->is_boolean()) return error(join(path, key), fmt::format("expected true or false, got {}", it->dump()));
+    out = it->get<bool>();
+    return Ok{};
+  }
+
+  Status string(const json& parent, const std::string& path, std::string_view key, std::string& out, bool required) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) {
+      if (required) return error(join(path, key), "missing (expected a string)");
+      return Ok{};
+    }
+    if (!it->is_string() || it->get<std::string>().empty())
+      return error(join(path, key), fmt::format("expected a non-empty string, got {}", it->dump()));
+    out = it->get<std::string>();
+    return Ok{};
+  }
+
+  Status vec3(const json& parent, const std::string& path, std::string_view key, Vec3& out) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) return Ok{};
+    const std::string p = join(path, key);
+    if (!it->is_array() || it->size() != 3) return error(p, fmt::format("expected [x, y, z], got {}", it->dump()));
+    double v[3];
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (!(*it)[i].is_number()) return error(p, fmt::format("expected [x, y, z] of numbers, got {}", it->dump()));
+      v[i] = (*it)[i].get<double>();
+      if (!std::isfinite(v[i])) return error(p, "expected finite numbers");
+    }
+    out = {v[0], v[1], v[2]};
+    return Ok{};
+  }
+
+  Status quat(const json& parent, const std::string& path, std::string_view key, Quat& out) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) return Ok{};
+    const std::string p = join(path, key);
+    if (!it->is_array() || it->size() != 4)
+      return error(p, fmt::format("expected a quaternion [w, x, y, z], got {}", it->dump()));
+    double v[4];
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (!(*it)[i].is_number()) return error(p, fmt::format("expected [w, x, y, z] of numbers, got {}", it->dump()));
+      v[i] = (*it)[i].get<double>();
+    }
+    const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+    if (!(n > 1e-9) || !std::isfinite(n)) return error(p, "expected a non-zero quaternion [w, x, y, z]");
+    out = {v[0] / n, v[1] / n, v[2] / n, v[3] / n};
+    return Ok{};
+  }
+
+  Status pose(const json& parent, const std::string& path, std::string_view key, Pose& out) const {
+    const auto it = parent.find(std::string(key));
+    if (it == parent.end()) return Ok{};
+    const std::string p = join(path, key);
+    if (auto s = require_object(*it, p); !s) return s;
+    if (auto s = check_keys(*it, p, {"position", "rotation"}); !s) return s;
+    if (auto s = vec3(*it, p, "position", out.position); !s) return s;
+    return quat(*it, p, "rotation", out.rotation);
+  }
+
+  const std::string& source() const { return source_; }
+
+ private:
+  std::string source_;
+};
+
+#define UH_CHECK(expr)          \
+  do {                          \
+    if (auto s_ = (expr); !s_) return s_.error(); \
+  } while (false)
+
+Status read_shape(const FieldReader& r, const json& j, const std::string& path, const std::filesystem::path& base_dir,
+                  SceneShape& shape) {
+  std::string mesh, ist;
+  UH_CHECK(r.string(j, path, "mesh", mesh, false));
+  UH_CHECK(r.string(j, path, "ist", ist, false));
+  if (mesh.empty() == ist.empty())
+    return r.error(path, "give exactly one of 'mesh' (a mesh file, packed on first use) or 'ist' (a .ist file)");
+  const auto resolve = [&](const std::string& p) {
+    const std::filesystem::path fp(p);
+    return fp.is_absolute() ? fp : (base_dir / fp).lexically_normal();
+  };
+  if (!mesh.empty()) {
+    shape.mesh = resolve(mesh);
+    if (!std::filesystem::exists(shape.mesh))
+      return r.error(FieldReader::join(path, "mesh"), fmt::format("file not found: {}", shape.mesh.string()));
+  } else {
+    shape.ist = resolve(ist);
+    if (!std::filesystem::exists(shape.ist))
+      return r.error(FieldReader::join(path, "ist"), fmt::format("file not found: {}", shape.ist.string()));
+  }
+  UH_CHECK(r.integer(j, path, "spheres", shape.spheres, 1, 2'000'000));
+  UH_CHECK(r.number(j, path, "meters_per_unit", shape.meters_per_unit, 1e-9, 1e6));
+  return Ok{};
+}
+
+// Device settings are text in haptico::DeviceConfig; JSON numbers and [x, y, z] arrays are converted.
+Status read_device(const FieldReader& r, const json& j, const std::string& path, const std::filesystem::path& base_dir,
+                   SceneDevice& device) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(j, path, {"driver", "config"}));
+  UH_CHECK(r.string(j, path, "driver", device.driver, true));
+  const auto it = j.find("config");
+  if (it == j.end()) return Ok{};
+  const std::string cpath = FieldReader::join(path, "config");
+  UH_CHECK(r.require_object(*it, cpath));
+  for (const auto& [key, value] : it->items()) {
+    if (value.is_number()) {
+      device.config.set(key, value.get<double>());
+    } else if (value.is_boolean()) {
+      device.config.set(key, value.get<bool>() ? 1.0 : 0.0);
+    } else if (value.is_string()) {
+      std::string text = value.get<std::string>();
+      // a trajectory file is relative to the scene, like meshes
+      if (key == "file" && !std::filesystem::path(text).is_absolute()) text = (base_dir / text).lexically_normal().string();
+      device.config.set(key, text);
+    } else if (value.is_array() && value.size() == 3 && value[0].is_number() && value[1].is_number() &&
+               value[2].is_number()) {
+      device.config.set(key, Vec3{value[0].get<double>(), value[1].get<double>(), value[2].get<double>()});
+    } else {
+      return r.error(FieldReader::join(cpath, key),
+                     fmt::format("expected a number, a string, a boolean or [x, y, z], got {}", value.dump()));
+    }
+  }
+  return Ok{};
+}
+
+Status read_force_params(const FieldReader& r, const json& j, const std::string& path, SceneTool& tool) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(j, path, {"mode", "force_scale", "damping", "mass_kg", "center_of_mass", "max_force_n", "max_torque_nm"}));
+  std::string mode = "6dof";
+  UH_CHECK(r.string(j, path, "mode", mode, false));
+  if (mode == "6dof") {
+    tool.mode = forcecomp::ForceMode::k6Dof;
+  } else if (mode == "3dof") {
+    tool.mode = forcecomp::ForceMode::k3Dof;
+  } else {
+    return r.error(FieldReader::join(path, "mode"), fmt::format("expected \"3dof\" or \"6dof\", got \"{}\"", mode));
+  }
+  auto& f = tool.force;
+  UH_CHECK(r.number(j, path, "force_scale", f.force_scale, 0.0, 1e15));
+  UH_CHECK(r.number(j, path, "damping", f.damping, 0.0, 1e6));
+  UH_CHECK(r.number(j, path, "mass_kg", f.mass_kg, 1e-6, 1e4));
+  UH_CHECK(r.vec3(j, path, "center_of_mass", f.center_of_mass_body));
+  UH_CHECK(r.number(j, path, "max_force_n", f.max_force_n, 1e-6, 1e4));
+  UH_CHECK(r.number(j, path, "max_torque_nm", f.max_torque_nm, 1e-6, 1e3));
+  return Ok{};
+}
+
+Status read_workspace(const FieldReader& r, const json& j, const std::string& path, WorkspaceMapping& w) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(j, path, {"scale", "offset", "rotation", "tool_offset"}));
+  UH_CHECK(r.number(j, path, "scale", w.scale, 1e-6, 1e6));
+  UH_CHECK(r.vec3(j, path, "offset", w.world_from_device_base.position));
+  UH_CHECK(r.quat(j, path, "rotation", w.world_from_device_base.rotation));
+  UH_CHECK(r.vec3(j, path, "tool_offset", w.handle_from_tool.position));
+  return Ok{};
+}
+
+Status read_force_options(const FieldReader& r, const json& j, const std::string& path, ForceControllerOptions& o) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(j, path, {"multi_rate", "safety", "coupling"}));
+  UH_CHECK(r.boolean(j, path, "multi_rate", o.multi_rate));
+  if (const auto it = j.find("safety"); it != j.end()) {
+    const std::string p = FieldReader::join(path, "safety");
+    UH_CHECK(r.require_object(*it, p));
+    UH_CHECK(r.check_keys(*it, p, {"max_force_n", "max_torque_nm", "watchdog_max_age_s", "watchdog_ramp_s"}));
+    UH_CHECK(r.number(*it, p, "max_force_n", o.safety.max_force_n, 1e-6, 1e4));
+    UH_CHECK(r.number(*it, p, "max_torque_nm", o.safety.max_torque_nm, 1e-6, 1e3));
+    UH_CHECK(r.number(*it, p, "watchdog_max_age_s", o.safety.watchdog.max_age_s, 1e-4, 10.0));
+    UH_CHECK(r.number(*it, p, "watchdog_ramp_s", o.safety.watchdog.ramp_s, 1e-4, 10.0));
+  }
+  if (const auto it = j.find("coupling"); it != j.end()) {
+    const std::string p = FieldReader::join(path, "coupling");
+    UH_CHECK(r.require_object(*it, p));
+    UH_CHECK(r.check_keys(*it, p, {"enabled", "stiffness", "damping", "device_damping", "angular_stiffness",
+                                   "angular_damping", "device_angular_damping", "passivity_margin", "proxy_mass_kg",
+                                   "proxy_inertia_kg_m2"}));
+    auto& c = o.coupling;
+    UH_CHECK(r.boolean(*it, p, "enabled", o.use_coupling));
+    UH_CHECK(r.number(*it, p, "stiffness", c.stiffness, 0.0, 1e7));
+    UH_CHECK(r.number(*it, p, "damping", c.damping, 0.0, 1e5));
+    UH_CHECK(r.number(*it, p, "device_damping", c.device_damping, 0.0, 1e5));
+    UH_CHECK(r.number(*it, p, "angular_stiffness", c.angular_stiffness, 0.0, 1e5));
+    UH_CHECK(r.number(*it, p, "angular_damping", c.angular_damping, 0.0, 1e5));
+    UH_CHECK(r.number(*it, p, "device_angular_damping", c.device_angular_damping, 0.0, 1e5));
+    UH_CHECK(r.number(*it, p, "passivity_margin", c.passivity_margin, 1e-3, 1.0));
+    UH_CHECK(r.number(*it, p, "proxy_mass_kg", c.proxy_mass_kg, 1e-6, 1e4));
+    UH_CHECK(r.number(*it, p, "proxy_inertia_kg_m2", c.proxy_inertia_kg_m2, 1e-12, 1e3));
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir) {
+  json root;
+  try {
+    root = json::parse(json_text);
+  } catch (const json::parse_error& e) {
+    return Error{fmt::format("{}: not valid JSON: {}", source, e.what())};
+  }
+  const FieldReader r(source);
+  if (!root.is_object()) return Error{fmt::format("{}: expected a JSON object at the top level", source)};
+  UH_CHECK(r.check_keys(root, "", {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force"}));
+
+  Scene scene;
+  scene.source = source;
+  scene.name = std::filesystem::path(source).stem().string();
+  UH_CHECK(r.string(root, "", "name", scene.name, false));
+  UH_CHECK(r.number(root, "", "seconds", scene.seconds, 0.0, 86400.0));
+  if (const auto it = root.find("rates"); it != root.end()) {
+    UH_CHECK(r.require_object(*it, "rates"));
+    UH_CHECK(r.check_keys(*it, "rates", {"haptic_hz", "collision_hz"}));
+    UH_CHECK(r.number(*it, "rates", "haptic_hz", scene.haptic_hz, 1.0, 10000.0));
+    UH_CHECK(r.number(*it, "rates", "collision_hz", scene.collision_hz, 0.0, 10000.0));
+  }
+
+  const auto objects = root.find("objects");
+  if (objects == root.end()) return r.error("objects", "missing (expected a list of objects)");
+  if (!objects->is_array() || objects->empty()) return r.error("objects", "expected a non-empty list of objects");
+  for (std::size_t i = 0; i < objects->size(); ++i) {
+    const json& o = (*objects)[i];
+    const std::string path = fmt::format("objects[{}]", i);
+    UH_CHECK(r.require_object(o, path));
+    UH_CHECK(r.check_keys(o, path, {"name", "mesh", "ist", "spheres", "meters_per_unit", "pose"}));
+    SceneObject object;
+    UH_CHECK(r.string(o, path, "name", object.name, true));
+    for (const auto& existing : scene.objects)
+      if (existing.name == object.name) return r.error(path + ".name", fmt::format("duplicate object name '{}'", object.name));
+    UH_CHECK(read_shape(r, o, path, base_dir, object.shape));
+    UH_CHECK(r.pose(o, path, "pose", object.pose));
+    scene.objects.push_back(std::move(object));
+  }
+
+  const auto tool = root.find("tool");
+  if (tool == root.end()) return r.error("tool", "missing (expected the tool object)");
+  UH_CHECK(r.require_object(*tool, "tool"));
+  UH_CHECK(r.check_keys(*tool, "tool", {"name", "mesh", "ist", "spheres", "meters_per_unit", "force", "device", "workspace"}));
+  UH_CHECK(r.string(*tool, "tool", "name", scene.tool.name, false));
+  UH_CHECK(read_shape(r, *tool, "tool", base_dir, scene.tool.shape));
+  if (const auto it = tool->find("force"); it != tool->end()) UH_CHECK(read_force_params(r, *it, "tool.force", scene.tool));
+  const auto device = tool->find("device");
+  if (device == tool->end()) return r.error("tool.device", "missing (expected {\"driver\": ..., \"config\": {...}})");
+  UH_CHECK(read_device(r, *device, "tool.device", base_dir, scene.tool.device));
+  if (const auto it = tool->find("workspace"); it != tool->end())
+    UH_CHECK(read_workspace(r, *it, "tool.workspace", scene.tool.workspace));
+
+  if (const auto it = root.find("watch"); it != root.end()) {
+    if (!it->is_array()) return r.error("watch", "expected a list of object names");
+    for (std::size_t i = 0; i < it->size(); ++i) {
+      const json& name = (*it)[i];
+      const std::string path = fmt::format("watch[{}]", i);
+      if (!name.is_string()) return r.error(path, "expected an object name");
+      bool known = false;
+      for (const auto& o : scene.objects) known = known || o.name == name.get<std::string>();
+      if (!known) return r.error(path, fmt::format("no object is named '{}'", name.get<std::string>()));
+      scene.watch.push_back(name.get<std::string>());
+    }
+  } else {
+    for (const auto& o : scene.objects) scene.watch.push_back(o.name);
+  }
+
+  if (const auto it = root.find("force"); it != root.end()) UH_CHECK(read_force_options(r, *it, "force", scene.force));
+  scene.force.coupling.period_s = 1.0 / scene.haptic_hz;
+  return scene;
+}
+
+Result<Scene> load_scene(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) return Error{fmt::format("{}: cannot open the scene file", path.string())};
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path.string(), path.parent_path());
+}
+
+std::filesystem::path default_cache_dir() {
+  if (const char* dir = std::getenv("UH_CACHE_DIR"); dir != nullptr && *dir != '\0') return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0')
+    return std::filesystem::path(xdg) / "unrealhaptics";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
+    return std::filesystem::path(home) / ".cache" / "unrealhaptics";
+  return std::filesystem::temp_directory_path() / "unrealhaptics-cache";
+}
+
+namespace {
+
+// Writes `text` to `path` unless the file already holds exactly that text (atomic replace).
+Status write_if_changed(const std::filesystem::path& path, std::string_view text) {
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (in) {
+      std::stringstream existing;
+      existing << in.rdbuf();
+      if (existing.str() == text) return Ok{};
+    }
+  }
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!out) return Error{fmt::format("{}: cannot write", tmp.string())};
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return Error{fmt::format("{}: cannot write: {}", path.string(), ec.message())};
+  return Ok{};
+}
+
+}  // namespace
+
+Result<Scene> default_scene(const std::filesystem::path& cache_dir) {
+  std::error_code ec;
+  const std::filesystem::path dir = cache_dir / "default-scene";
+  std::filesystem::create_directories(dir / "scenes", ec);
+  std::filesystem::create_directories(dir / "assets" / "meshes", ec);
+  if (ec) return Error{fmt::format("{}: cannot create the cache folder: {}", dir.string(), ec.message())};
+  for (const auto& file : embedded::files())
+    if (auto s = write_if_changed(dir / file.path, file.text); !s) return s.error();
+  return parse_scene(embedded::default_scene_json(), "<embedded default scene>", dir / "scenes");
+}
+
+Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(
+    const SceneShape& shape, const std::filesystem::path& cache_dir,
+    const std::function<void(const std::string& what, double fraction)>& progress) {
+  collette::IstAsset asset;
+  if (!shape.ist.empty()) {
+    auto loaded = collette::load_ist(shape.ist);
+    if (!loaded) return loaded.error();
+    asset = std::move(loaded).value();
+  } else {
+    auto hash = collette::hash_file(shape.mesh);
+    if (!hash) return hash.error();
+    std::error_code ec;
+    std::filesystem::create_directories(cache_dir, ec);
+    if (ec) return Error{fmt::format("{}: cannot create the cache folder: {}", cache_dir.string(), ec.message())};
+    const std::filesystem::path cached =
+        cache_dir / fmt::format("{}-{:016x}-{}.ist", shape.mesh.stem().string(), *hash, shape.spheres);
+    auto loaded = collette::load_ist(cached);
+    if (loaded && loaded->meta.source_mesh_hash == *hash) {
+      asset = std::move(loaded).value();
+    } else {
+      // absent, unreadable or stale: build it again (only the cache file is replaced)
+      const std::string what = fmt::format("packing {} ({} spheres)", shape.mesh.filename().string(), shape.spheres);
+      collette::IstBuildOptions options{.sphere_count = shape.spheres, .meters_per_unit = shape.meters_per_unit};
+      if (progress) options.progress = [&](double f) { progress(what, f); };
+      auto built = collette::build_ist_asset(shape.mesh, options);
+      if (!built) return built.error();
+      if (auto saved = collette::save_ist(cached, built->asset); !saved) return saved.error();
+      asset = std::move(built->asset);
+    }
+  }
+  const double scale = shape.ist.empty() ? shape.meters_per_unit : asset.meta.meters_per_unit;
+  return std::make_shared<const collette::SphereTree>(collette::scale_sphere_tree(asset.tree, scale));
+}
+
+}  // namespace uh::controllers
