@@ -7,6 +7,7 @@
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
 #include "uh/forcecomp/force_params.hpp"
+#include "uh/forcecomp/force_safety.hpp"
 #include "uh/forcecomp/penalty_force.hpp"
 
 namespace uh::forcecomp {
@@ -49,6 +50,11 @@ class ForceComponent {
   /// force (HeldContactSet::evaluate). `held` is not const: it writes its preallocated scratch.
   PenaltyResult evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
                          const BodyMotion& self, const BodyMotion& other = {}) const;
+
+  /// Options for a ForceSafety stage using this object's max_force_n and max_torque_nm.
+  ForceSafetyOptions safety_options(const ContactWatchdogOptions& watchdog = {}) const {
+    return ForceSafetyOptions{options_.params.max_force_n, options_.params.max_torque_nm, watchdog};
+  }
 
   /// The PenaltyInput this component uses for the given motions.
   PenaltyInput penalty_input(const BodyMotion& self, const BodyMotion& other) const;
