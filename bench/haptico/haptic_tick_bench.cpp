@@ -3,7 +3,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "uh/haptico/haptic_manager.hpp"
@@ -60,6 +62,33 @@ void BM_SimHandDeviceTick(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SimHandDeviceTick);
+
+// A threaded session of one second at the given rate: how well the haptic thread keeps time on
+// this machine (with a simulated hand device and a spring delegate), from the loop statistics.
+void BM_HapticLoopThreaded(benchmark::State& state) {
+  const double rate = static_cast<double>(state.range(0));
+  HapticStats stats;
+  for (auto _ : state) {
+    HapticManager manager(std::make_unique<SimHandDevice>(SimHandOptions{.device = {.rate_hz = rate}}),
+                          {.rate_hz = rate});
+    manager.force_on_haptic_tick().add_delegate(
+        [](const DeviceState& s, DeviceCommand& cmd) { cmd.force += 300.0 * (Vec3{0, 0, -0.01} - s.position); });
+    if (!manager.start()) {
+      state.SkipWithError("start failed");
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    manager.stop();
+    stats = manager.stats();
+  }
+  state.counters["achieved_hz"] = stats.loop.achieved_rate_hz;
+  state.counters["period_err_p50_us"] = stats.loop.period_error.p50_ns * 1e-3;
+  state.counters["period_err_p99_us"] = stats.loop.period_error.p99_ns * 1e-3;
+  state.counters["period_err_max_us"] = stats.loop.period_error.max_ns * 1e-3;
+  state.counters["callback_p99_us"] = stats.loop.callback_duration.p99_ns * 1e-3;
+  state.counters["missed"] = static_cast<double>(stats.loop.missed_deadlines);
+}
+BENCHMARK(BM_HapticLoopThreaded)->Arg(1000)->Arg(4000)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -77,8 +77,9 @@ Result<std::vector<TrajectorySample>> SimReplayDevice::parse_csv(std::istream& i
       }
     }
     const double qn = std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
-    if (qn < 1e-6) {
-      return Error{fmt::format("{}:{}: quaternion (qw,qx,qy,qz) has zero length", source_name, line_number)};
+    if (!(qn >= 1e-6) || !std::isfinite(qn)) {
+      return Error{fmt::format("{}:{}: quaternion (qw,qx,qy,qz) must have a finite, non-zero length", source_name,
+                               line_number)};
     }
     if (!samples.empty() && !(v[0] > samples.back().time_s)) {
       return Error{fmt::format("{}:{}: time {} s is not after the previous sample's {} s (times must increase)",

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -43,7 +44,10 @@ TEST(SimReplayDevice, ErrorsNameFileAndLine) {
   EXPECT_EQ(error_of("t,x,y,z\n"),
             "demo.csv:1: header 't,x,y,z' does not match the expected columns 'time_s,x,y,z,qw,qx,qy,qz'");
   EXPECT_EQ(error_of("# nothing\n"), "demo.csv: no samples (expected lines of 'time_s,x,y,z,qw,qx,qy,qz')");
-  EXPECT_EQ(error_of("0,0,0,0,0,0,0,0\n"), "demo.csv:1: quaternion (qw,qx,qy,qz) has zero length");
+  EXPECT_EQ(error_of("0,0,0,0,0,0,0,0\n"), "demo.csv:1: quaternion (qw,qx,qy,qz) must have a finite, non-zero length");
+  // components that are finite but whose length overflows are refused too, not turned into zero
+  EXPECT_EQ(error_of("0,0,0,0,1e300,1e300,0,0\n"),
+            "demo.csv:1: quaternion (qw,qx,qy,qz) must have a finite, non-zero length");
   EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\n1,nan,0,0,1,0,0,0\n"), "demo.csv:2: field 2 ('nan') is not a finite number");
   // a header is only allowed before the first row
   EXPECT_EQ(error_of("0,0,0,0,1,0,0,0\ntime_s,x,y,z,qw,qx,qy,qz\n"),
@@ -94,6 +98,69 @@ TEST(SimReplayDevice, InterpolatesOrientationTheShortWay) {
   const Quat q = d.read_state().orientation;
   const double angle = 2.0 * std::atan2(std::abs(q.z), std::abs(q.w));
   EXPECT_NEAR(angle, kPi / 4, 1e-6);
+}
+
+TEST(SimReplayDevice, RoundTripsRandomTrajectories) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::ostringstream csv;
+    csv.precision(17);
+    std::vector<TrajectorySample> written;
+    double t = u(rng);
+    for (int i = 0; i < 30; ++i) {
+      t += 0.001 + 0.01 * (u(rng) + 1.0);
+      const Quat q = normalized(Quat{u(rng), u(rng), u(rng), u(rng)});
+      const Vec3 p{u(rng), u(rng), u(rng)};
+      written.push_back({t, Pose{q, p}});
+      csv << t << "," << p.x << "," << p.y << "," << p.z << "," << q.w << "," << q.x << "," << q.y << "," << q.z
+          << "\n";
+    }
+    auto r = parse(csv.str());
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ(r->size(), written.size());
+    for (std::size_t i = 0; i < written.size(); ++i) {
+      EXPECT_EQ((*r)[i].time_s, written[i].time_s);
+      EXPECT_EQ((*r)[i].pose.position, written[i].pose.position);
+      EXPECT_NEAR((*r)[i].pose.rotation.w, written[i].pose.rotation.w, 1e-15);
+    }
+  }
+}
+
+TEST(SimReplayDevice, GarbageNeverCrashesAndErrorsNameTheSource) {
+  // property: any mutation of a valid file either parses or gives an error that starts with the
+  // file name (and, for row errors, the line)
+  const std::string valid = "time_s,x,y,z,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.5,0.1,0.2,0.3,1,0,0,0\n1,0.1,0.2,0.3,0,1,0,0\n";
+  const std::string alphabet = "0123456789.,-+eE\n #abcnaif";
+  std::mt19937 rng(17);
+  int errors = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::string text = valid;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t pos = rng() % (text.size() + 1);
+      const char c = alphabet[rng() % alphabet.size()];
+      switch (rng() % 3) {
+        case 0: text.insert(pos, 1, c); break;
+        case 1: if (pos < text.size()) text.erase(pos, 1); break;
+        default: if (pos < text.size()) text[pos] = c; break;
+      }
+    }
+    auto r = parse(text);
+    if (!r) {
+      ++errors;
+      EXPECT_EQ(r.error().message.rfind("demo.csv:", 0), 0u) << r.error().message;
+    } else {
+      for (const TrajectorySample& s : *r) {
+        EXPECT_TRUE(std::isfinite(s.time_s));
+        EXPECT_TRUE(is_finite(s.pose.position));
+        EXPECT_NEAR(s.pose.rotation.w * s.pose.rotation.w + s.pose.rotation.x * s.pose.rotation.x +
+                        s.pose.rotation.y * s.pose.rotation.y + s.pose.rotation.z * s.pose.rotation.z,
+                    1.0, 1e-9);
+      }
+    }
+  }
+  EXPECT_GT(errors, 100);
 }
 
 }  // namespace
