@@ -24,8 +24,8 @@ namespace uh::controllers {
 
 /// Where an object's Inner Sphere Tree comes from: a mesh (packed on first use, cached) or a .ist file.
 struct SceneShape {
-  std::filesystem::path mesh;        ///< mesh file (absolute after loading), or empty when `ist` is set
-  std::filesystem::path ist;         ///< prebuilt .ist file, or empty
+  std::filesystem::path mesh{};      ///< mesh file (absolute after loading), or empty when `ist` is set
+  std::filesystem::path ist{};       ///< prebuilt .ist file, or empty
   std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
   double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
 };

@@ -1,0 +1,147 @@
+#include "uh/controllers/haptic_session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "scene_test_support.hpp"
+#include "uh/core/sphere_overlap.hpp"
+
+namespace uh::controllers {
+namespace {
+
+using testing::small_scene_json;
+using testing::test_assets;
+
+struct SessionFixture : ::testing::Test {
+  static void SetUpTestSuite() { cache_ = new std::filesystem::path(testing::fresh_cache("session")); }
+  static void TearDownTestSuite() {
+    std::filesystem::remove_all(*cache_);
+    delete cache_;
+  }
+  static std::unique_ptr<HapticSession> make(const std::string& json, SessionOptions options = {}) {
+    auto scene = parse_scene(json, "small.json", test_assets());
+    EXPECT_TRUE(scene.has_value()) << scene.error().message;
+    options.cache_dir = *cache_;
+    auto session = HapticSession::create(*scene, options);
+    EXPECT_TRUE(session.has_value()) << session.error().message;
+    return session ? std::move(session).value() : nullptr;
+  }
+  static std::filesystem::path* cache_;
+};
+std::filesystem::path* SessionFixture::cache_ = nullptr;
+
+TEST_F(SessionFixture, SteppedSessionPushesTheToolOutAndIsDeterministic) {
+  auto first = make(small_scene_json());
+  ASSERT_TRUE(first);
+  std::ostringstream trace_a;
+  ASSERT_TRUE(first->run_stepped(1.0, 4, &trace_a).has_value());
+  const SessionReport a = first->report();
+
+  EXPECT_EQ(a.haptic_ticks, 1000u);
+  EXPECT_EQ(a.collision_steps, 250u);
+  EXPECT_GT(a.contact_ticks, 100u) << "the stylus goes 2.5 cm into the bunny";
+  EXPECT_LT(a.contact_ticks, 1000u) << "and starts above it";
+  EXPECT_GT(a.force_max_n, 0.5);
+  EXPECT_LE(a.force_max_n, 6.0 + 1e-9) << "never above the scene's limit";
+  EXPECT_EQ(a.force_nonfinite, 0u);
+  ASSERT_EQ(a.timeline.size(), 1000u);
+
+  auto second = make(small_scene_json());
+  ASSERT_TRUE(second);
+  std::ostringstream trace_b;
+  ASSERT_TRUE(second->run_stepped(1.0, 4, &trace_b).has_value());
+  const SessionReport& b = second->report();
+  EXPECT_EQ(trace_a.str(), trace_b.str()) << "a stepped session is bit-for-bit repeatable";
+  EXPECT_EQ(a.force_max_n, b.force_max_n);
+  EXPECT_EQ(a.contact_ticks, b.contact_ticks);
+  EXPECT_EQ(a.work_on_hand_j, b.work_on_hand_j);
+}
+
+TEST_F(SessionFixture, ForceOnTheStylusPointsUpOutOfTheBunny) {
+  auto session = make(small_scene_json());
+  ASSERT_TRUE(session);
+  std::ostringstream trace;
+  ASSERT_TRUE(session->run_stepped(0.5, 1, &trace).has_value());
+  // columns: see haptico::write_trace_header; find the sent force columns by name
+  std::istringstream in(trace.str());
+  std::string header;
+  std::getline(in, header);
+  std::vector<std::string> names;
+  {
+    std::istringstream h(header);
+    for (std::string name; std::getline(h, name, ',');) names.push_back(name);
+  }
+  const auto column = [&](const std::string& name) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return static_cast<int>(i);
+    return -1;
+  };
+  const int fx = column("fx"), fz = column("fz");
+  ASSERT_GE(fz, 0) << header;
+  ASSERT_GE(fx, 0) << header;
+  int pushing = 0, contact = 0;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<double> v;
+    std::istringstream l(line);
+    for (std::string cell; std::getline(l, cell, ',');) v.push_back(std::atof(cell.c_str()));
+    const double force_z = v[static_cast<std::size_t>(fz)];
+    const double force_x = v[static_cast<std::size_t>(fx)];
+    if (std::abs(force_z) + std::abs(force_x) < 1e-3) continue;
+    ++contact;
+    if (force_z > std::abs(force_x)) ++pushing;
+  }
+  EXPECT_GT(contact, 50);
+  EXPECT_GT(pushing, contact * 9 / 10) << "the force lifts the stylus out of the bunny";
+}
+
+TEST_F(SessionFixture, MultiRateReevaluationSmoothsTheForceOfASlowCollisionThread) {
+  // collision every 8 ticks (125 Hz at a 1 kHz haptic rate): held forces step, re-evaluated ones follow
+  auto multi = make(small_scene_json(true));
+  auto held = make(small_scene_json(false));
+  ASSERT_TRUE(multi && held);
+  ASSERT_TRUE(multi->run_stepped(1.0, 8).has_value());
+  ASSERT_TRUE(held->run_stepped(1.0, 8).has_value());
+  EXPECT_GT(held->report().force_max_step_n, 0.0);
+  EXPECT_LT(multi->report().force_max_step_n, 0.5 * held->report().force_max_step_n)
+      << "multi-rate " << multi->report().force_max_step_n << " N vs held " << held->report().force_max_step_n << " N";
+}
+
+TEST_F(SessionFixture, CouplingRendersThroughTheProxyAndStaysWithinLimits) {
+  auto session = make(small_scene_json(true, true));
+  ASSERT_TRUE(session);
+  ASSERT_TRUE(session->run_stepped(1.0, 2).has_value());
+  const auto& r = session->report();
+  EXPECT_TRUE(r.coupling);
+  EXPECT_GT(r.contact_ticks, 0u);
+  EXPECT_GT(r.force_max_n, 0.1);
+  EXPECT_LE(r.force_max_n, 6.0 + 1e-9);
+  EXPECT_EQ(r.force_nonfinite, 0u);
+}
+
+TEST_F(SessionFixture, UnknownDriverIsAnErrorNamingTheScene) {
+  std::string json = small_scene_json();
+  json.replace(json.find("sim-line"), 8, "phantom-omni");
+  auto scene = parse_scene(json, "small.json", test_assets());
+  ASSERT_TRUE(scene.has_value());
+  SessionOptions options;
+  options.cache_dir = *cache_;
+  auto session = HapticSession::create(*scene, options);
+  ASSERT_FALSE(session.has_value());
+  EXPECT_NE(session.error().message.find("small.json: tool.device: unknown device driver 'phantom-omni'"), std::string::npos)
+      << session.error().message;
+}
+
+TEST_F(SessionFixture, ReportJsonHasTheDocumentedFields) {
+  auto session = make(small_scene_json());
+  ASSERT_TRUE(session);
+  ASSERT_TRUE(session->run_stepped(0.2, 4).has_value());
+  const std::string json = session_report_json(session->report());
+  for (const char* key : {"\"target_hz\"", "\"rate_hz\"", "\"ticks\"", "\"missed_deadlines\"", "\"jitter_us\"", "\"p50\"",
+                          "\"p99\"", "\"max\"", "\"min\"", "\"median\"", "\"query_us\"", "\"max_n\"", "\"max_torque_nm\"",
+                          "\"nonfinite\"", "\"clamped\"", "\"contact\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key;
+}
+
+}  // namespace
+}  // namespace uh::controllers

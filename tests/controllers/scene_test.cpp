@@ -1,0 +1,133 @@
+#include "uh/controllers/scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "scene_test_support.hpp"
+#include "uh/collette/ist_file.hpp"
+
+namespace uh::controllers {
+namespace {
+
+using testing::small_scene_json;
+using testing::test_assets;
+
+Result<Scene> parse(const std::string& text) { return parse_scene(text, "test.json", test_assets() / "scenes"); }
+
+void expect_error(const std::string& text, const std::string& needle) {
+  const auto scene = parse(text);
+  ASSERT_FALSE(scene.has_value()) << "expected an error containing: " << needle;
+  EXPECT_NE(scene.error().message.find(needle), std::string::npos) << scene.error().message;
+  EXPECT_EQ(scene.error().message.rfind("test.json", 0), 0u) << "errors start with the file name: " << scene.error().message;
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+TEST(Scene, ParsesTheSmallTestScene) {
+  const auto scene = parse_scene(small_scene_json(), "small.json", test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  ASSERT_EQ(scene->objects.size(), 1u);
+  EXPECT_EQ(scene->objects[0].name, "bunny");
+  EXPECT_EQ(scene->objects[0].shape.spheres, 600);
+  EXPECT_DOUBLE_EQ(scene->objects[0].shape.meters_per_unit, 0.01);
+  EXPECT_NEAR(scene->objects[0].pose.rotation.x, std::sqrt(0.5), 1e-6);
+  EXPECT_EQ(scene->tool.device.driver, "sim-line");
+  EXPECT_EQ(scene->tool.device.config.text("end", ""), "0,0,0.045");
+  EXPECT_DOUBLE_EQ(scene->tool.force.force_scale, 8.0e6);
+  EXPECT_EQ(scene->watch, std::vector<std::string>{"bunny"});
+  EXPECT_TRUE(scene->force.multi_rate);
+}
+
+TEST(Scene, ReportsFileFieldAndExpectation) {
+  const std::string good = small_scene_json();
+  // the test scene's paths are relative to assets/, so parse() (base assets/scenes) must not find them
+  expect_error(good, "field 'objects[0].mesh': file not found");
+  const auto base = test_assets();
+  const auto with_base = [&](const std::string& text, const std::string& needle) {
+    const auto scene = parse_scene(text, "test.json", base);
+    ASSERT_FALSE(scene.has_value()) << needle;
+    EXPECT_NE(scene.error().message.find(needle), std::string::npos) << scene.error().message;
+  };
+  with_base(replaced(good, R"("haptic_hz": 1000)", R"("haptic_hz": "fast")"), "field 'rates.haptic_hz': expected a number");
+  with_base(replaced(good, R"("haptic_hz": 1000)", R"("haptic_hz": 50000)"), "field 'rates.haptic_hz': expected a number in [1, 10000]");
+  with_base(replaced(good, R"("spheres": 600)", R"("sphers": 600)"), "field 'objects[0].sphers': unknown field");
+  with_base(replaced(good, R"("spheres": 600)", R"("spheres": 2.5)"), "field 'objects[0].spheres': expected a whole number");
+  with_base(replaced(good, R"("name": "bunny",)", ""), "field 'objects[0].name': missing");
+  with_base(replaced(good, R"("rotation": [0.70710678, 0.70710678, 0, 0])", R"("rotation": [0, 0, 0, 0])"),
+            "field 'objects[0].pose.rotation': expected a non-zero quaternion");
+  with_base(replaced(good, R"("mode": "6dof")", R"("mode": "7dof")"), "field 'tool.force.mode': expected \"3dof\" or \"6dof\"");
+  with_base(replaced(good, R"("watch": ["bunny"])", R"("watch": ["dragon"])"), "field 'watch[0]': no object is named 'dragon'");
+  with_base(replaced(good, R"("driver": "sim-line",)", R"("driver": 7,)"), "field 'tool.device.driver': expected a non-empty string");
+  with_base(replaced(good, R"("mesh": "meshes/stylus.obj",)", R"("mesh": "meshes/stylus.obj", "ist": "x.ist",)"),
+            "field 'tool': give exactly one of 'mesh'");
+  with_base("[1, 2]", "expected a JSON object at the top level");
+  with_base("{ \"objects\": ", "not valid JSON");
+  with_base(R"({ "tool": {} })", "field 'objects': missing");
+}
+
+TEST(Scene, LoadSceneNamesAMissingFile) {
+  const auto scene = load_scene("/nonexistent/scene.json");
+  ASSERT_FALSE(scene.has_value());
+  EXPECT_NE(scene.error().message.find("/nonexistent/scene.json: cannot open"), std::string::npos);
+}
+
+TEST(Scene, TheRepositoryScenesParse) {
+  for (const char* name : {"bunny_sweep.json", "bunny_deep_throttled.json", "bunny_coupling_circle.json"}) {
+    const auto path = test_assets().parent_path() / "scenes" / name;
+    if (!std::filesystem::exists(path)) continue;  // scenes added later are covered once they exist
+    const auto scene = load_scene(path);
+    EXPECT_TRUE(scene.has_value()) << name << ": " << scene.error().message;
+  }
+  const auto main_scene = load_scene(test_assets().parent_path() / "scenes" / "bunny_sweep.json");
+  ASSERT_TRUE(main_scene.has_value()) << main_scene.error().message;
+}
+
+TEST(Scene, DefaultSceneIsEmbeddedAndWritesItsMeshes) {
+  const auto cache = testing::fresh_cache("default");
+  const auto scene = default_scene(cache);
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  EXPECT_EQ(scene->name, "bunny-sweep");
+  EXPECT_TRUE(std::filesystem::exists(scene->objects.at(0).shape.mesh));
+  EXPECT_TRUE(std::filesystem::exists(scene->tool.shape.mesh));
+  std::filesystem::remove_all(cache);
+}
+
+TEST(Scene, ShapeTreesAreBuiltOnceThenLoadedFromTheCacheInMetres) {
+  const auto cache = testing::fresh_cache("tree-cache");
+  SceneShape shape{.mesh = test_assets() / "meshes" / "stylus.obj", .spheres = 120, .meters_per_unit = 0.01};
+  int progress_calls = 0;
+  const auto first = load_shape_tree(shape, cache, [&](const std::string&, double) { ++progress_calls; });
+  ASSERT_TRUE(first.has_value()) << first.error().message;
+  EXPECT_GT(progress_calls, 0) << "a build reports progress";
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(cache)) files += entry.path().extension() == ".ist";
+  EXPECT_EQ(files, 1);
+  // stylus: 5 cm long capsule of radius 4 mm; the root sphere encloses it
+  EXPECT_NEAR((*first)->root().radius, 0.025, 0.003);
+
+  progress_calls = 0;
+  const auto second = load_shape_tree(shape, cache, [&](const std::string&, double) { ++progress_calls; });
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(progress_calls, 0) << "the cached .ist is loaded, not rebuilt";
+  EXPECT_EQ((*second)->leaf_count(), (*first)->leaf_count());
+
+  // a corrupted cache file is rebuilt, not trusted
+  for (const auto& entry : std::filesystem::directory_iterator(cache)) {
+    std::fstream f(entry.path(), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(200);
+    f.put('\x5a');
+  }
+  const auto third = load_shape_tree(shape, cache, [&](const std::string&, double) { ++progress_calls; });
+  ASSERT_TRUE(third.has_value()) << third.error().message;
+  EXPECT_GT(progress_calls, 0);
+  std::filesystem::remove_all(cache);
+}
+
+}  // namespace
+}  // namespace uh::controllers
