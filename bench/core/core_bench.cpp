@@ -93,12 +93,14 @@ void BM_StdFunctionLoop(benchmark::State& state) {
 BENCHMARK(BM_StdFunctionLoop)->Arg(1)->Arg(4)->Arg(16)->Arg(64);
 
 // Runs a FixedRateLoop with an empty callback for g_loop_seconds. range(0) = rate [Hz],
-// range(1) = 1 to keep the other core busy with a spinning thread started here, range(2) = 1 to
-// ask for SCHED_FIFO.
+// range(1) = 1 to keep the other core busy with a spinning thread started here (a second
+// std::thread incrementing a counter until the loop stops), range(2) = 1 to ask for SCHED_FIFO,
+// range(3) = spin_us, the busy-wait before each deadline [us].
 void BM_FixedRateLoop(benchmark::State& state) {
   const double rate = static_cast<double>(state.range(0));
   const bool busy = state.range(1) != 0;
   const bool fifo = state.range(2) != 0;
+  const auto spin_us = static_cast<double>(state.range(3));
   for (auto _ : state) {
     std::atomic<bool> stop_busy{false};
     std::thread hog;
@@ -108,7 +110,7 @@ void BM_FixedRateLoop(benchmark::State& state) {
         while (!stop_busy.load(std::memory_order_relaxed)) benchmark::DoNotOptimize(++x);
       });
     }
-    uh::FixedRateLoop loop({.rate_hz = rate, .raise_priority = fifo, .name = "bench-loop"});
+    uh::FixedRateLoop loop({.rate_hz = rate, .raise_priority = fifo, .spin_us = spin_us, .name = "bench-loop"});
     if (!loop.start([](const uh::TickInfo& t) { benchmark::DoNotOptimize(t.index); })) {
       state.SkipWithError("FixedRateLoop::start failed");
       break;
@@ -132,12 +134,14 @@ void BM_FixedRateLoop(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_FixedRateLoop)
-    ->ArgNames({"hz", "busy", "fifo"})
-    ->Args({1000, 0, 0})
-    ->Args({4000, 0, 0})
-    ->Args({1000, 1, 0})
-    ->Args({4000, 1, 0})
-    ->Args({1000, 1, 1})
+    ->ArgNames({"hz", "busy", "fifo", "spin_us"})
+    ->Args({1000, 0, 0, 80})
+    ->Args({4000, 0, 0, 80})
+    ->Args({1000, 1, 0, 80})
+    ->Args({4000, 1, 0, 80})
+    ->Args({1000, 1, 1, 80})
+    ->Args({4000, 1, 1, 80})
+    ->Args({1000, 1, 1, 300})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
