@@ -48,7 +48,10 @@ void ForceController::on_collision(collette::ObjectId a, collette::ObjectId b, c
 
 void ForceController::on_force(const haptico::DeviceState& state, haptico::DeviceCommand& command) {
   const double now = manager_ != nullptr ? manager_->tick_time_s() : state.time_s;
-  const double dt = have_last_tick_ ? std::max(0.0, now - last_tick_s_) : 0.0;
+  // a late tick must not make the proxy integration take one huge step (it would go unstable):
+  // integrate at most two nominal periods per tick
+  const double elapsed = have_last_tick_ ? std::max(0.0, now - last_tick_s_) : 0.0;
+  const double dt = std::min(elapsed, 2.0 * options_.coupling.period_s);
   last_tick_s_ = now;
   have_last_tick_ = true;
 
@@ -122,7 +125,7 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   last_force_n_.store(force_n, std::memory_order_relaxed);
   last_pairs_.store(pairs, std::memory_order_relaxed);
   // energy the device puts into the hand: force on the hand times the hand's velocity
-  const double work = dot(force_device, state.linear_velocity) * dt;
+  const double work = dot(force_device, state.linear_velocity) * elapsed;
   if (std::isfinite(work))
     work_on_hand_j_.store(work_on_hand_j_.load(std::memory_order_relaxed) + work, std::memory_order_relaxed);
 }

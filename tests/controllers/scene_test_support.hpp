@@ -44,7 +44,7 @@ inline std::string small_scene_json(bool multi_rate = true, bool coupling = fals
                             "dof_actuated": 6, "max_force_n": 6 }} }}
   }},
   "watch": ["bunny"],
-  "force": {{ "multi_rate": {multi_rate}, "coupling": {{ "enabled": {coupling}, "stiffness": 800, "damping": 2.0 }} }}
+  "force": {{ "multi_rate": {multi_rate}, "coupling": {{ "enabled": {coupling}, "stiffness": 800, "damping": 0.2 }} }}
 }})",
                      fmt::arg("collision_hz", collision_hz), fmt::arg("multi_rate", multi_rate ? "true" : "false"),
                      fmt::arg("coupling", coupling ? "true" : "false"));
