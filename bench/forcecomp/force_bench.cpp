@@ -29,7 +29,9 @@ std::vector<SpherePairContact> make_pairs(int count, const Pose& world_from_a, c
   while (static_cast<int>(pairs.size()) < count) {
     SpherePairContact p;
     p.sphere_a_local = {pos(rng), pos(rng), pos(rng), rad(rng)};
-    const Vec3 ca = transform_point(world_from_a, {p.sphere_a_local.x, p.sphere_a_local.y, p.sphere_a_local.z});
+    const Vec3 a_local{static_cast<double>(p.sphere_a_local.x), static_cast<double>(p.sphere_a_local.y),
+                       static_cast<double>(p.sphere_a_local.z)};
+    const Vec3 ca = transform_point(world_from_a, a_local);
     const float rb = rad(rng);
     const double dist = static_cast<double>(off(rng) * (p.sphere_a_local.radius + rb));
     const Vec3 dir = normalized(Vec3{static_cast<double>(pos(rng)), static_cast<double>(pos(rng)), 0.05});
