@@ -5,6 +5,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace {
@@ -347,3 +348,26 @@ TEST_F(DelegatorTest, SinkBindsAndRemovesOnly) {
   emitter.emit(2);
   EXPECT_EQ(trace, (std::vector<std::string>{"free_a:1", "member:1", "scoped:1", "member:2"}));
 }
+
+TEST_F(DelegatorTest, NoArgumentEvents) {
+  uh::Delegator<> d;
+  int calls = 0;
+  d.add_delegate([&calls] { ++calls; });
+  d.broadcast();
+  d.broadcast();
+  EXPECT_EQ(calls, 2);
+}
+
+// compile-time contracts: a sink cannot broadcast; connections move but do not copy; a delegator
+// neither copies nor moves (sinks and connections point at it)
+template <typename T>
+concept CanBroadcastInt = requires(T t) { t.broadcast(1); };
+static_assert(!CanBroadcastInt<uh::DelegateSink<int>>);
+static_assert(CanBroadcastInt<uh::Delegator<int>>);
+static_assert(std::is_nothrow_move_constructible_v<uh::ScopedConnection>);
+static_assert(!std::is_copy_constructible_v<uh::ScopedConnection>);
+static_assert(!std::is_copy_constructible_v<uh::Delegator<int>>);
+static_assert(!std::is_move_constructible_v<uh::Delegator<int>>);
+// arguments reach delegates by reference: the thunk signature shows it
+static_assert(std::is_same_v<uh::Delegator<std::string>::Thunk, void (*)(void*, const std::string&)>);
+static_assert(std::is_same_v<uh::Delegator<double&>::Thunk, void (*)(void*, double&)>);

@@ -14,6 +14,7 @@
 /// (try_pop, front, pop) at a time; size_approx() from either. After construction every call is
 /// real-time safe (no allocation, no lock) provided T's copy/move constructors are.
 
+#include <cassert>
 #include <cstddef>
 #include <utility>
 
@@ -38,7 +39,9 @@ template <typename T>
 class SpscQueue {
  public:
   /// Allocates room for at least `capacity` elements (> 0). Not real-time safe.
-  explicit SpscQueue(std::size_t capacity) : capacity_(capacity), queue_(capacity) {}
+  explicit SpscQueue(std::size_t capacity) : capacity_(capacity), queue_(capacity) {
+    assert(capacity > 0 && "uh::SpscQueue::SpscQueue(): capacity must be > 0");
+  }
   SpscQueue(const SpscQueue&) = delete;
   SpscQueue& operator=(const SpscQueue&) = delete;
 
