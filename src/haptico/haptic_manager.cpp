@@ -102,7 +102,18 @@ TraceSample HapticManager::tick(double now_s) {
   TraceSample sample;
   sample.tick_time_s = now_s;
   sample.state = device_->read_state();
-  if (sample.state.status != DeviceStatus::kOk) {
+  // a driver that keeps returning the same sample has stalled: its pose is no longer the hand's
+  bool frozen = false;
+  if (options_.max_frozen_ticks > 0 && sample.state.status == DeviceStatus::kOk) {
+    if (has_device_time_ && !(sample.state.time_s > last_device_time_s_)) {
+      frozen = ++frozen_ticks_ >= options_.max_frozen_ticks;
+    } else {
+      frozen_ticks_ = 0;
+    }
+    last_device_time_s_ = sample.state.time_s;
+    has_device_time_ = true;
+  }
+  if (sample.state.status != DeviceStatus::kOk || frozen) {
     device_errors_.increment();
     faulted_.store(true, std::memory_order_release);
     sample.flags |= kTraceDeviceError;

@@ -39,7 +39,8 @@ class FakeDevice final : public HapticDevice {
   DeviceState read_state() override {
     if (log_) log_->push_back("read");
     DeviceState s;
-    s.time_s = 0.001 * static_cast<double>(reads++);
+    s.time_s = frozen ? frozen_time : 0.001 * static_cast<double>(reads);
+    ++reads;
     s.position = {0.01, 0.02, 0.03};
     s.status = status;
     return s;
@@ -52,6 +53,8 @@ class FakeDevice final : public HapticDevice {
 
   DeviceInfo info_{};
   bool fail_open = false;
+  bool frozen = false;  // keep returning the same timestamp
+  double frozen_time = 0.0;
   DeviceStatus status = DeviceStatus::kOk;
   DeviceCommand last{};
   int reads = 0;
@@ -208,6 +211,25 @@ TEST(HapticManager, SoftStartFadesForceIn) {
   f.device->status = DeviceStatus::kOk;
   f.manager->clear_fault();
   EXPECT_NEAR(f.manager->step(0.031).sent.force.z, 0.2, 1e-12);
+}
+
+TEST(HapticManager, FrozenDeviceCountsAsDeviceError) {
+  Fixture f({.soft_start_s = 0.0, .max_frozen_ticks = 3});
+  ASSERT_TRUE(f.manager->open());
+  f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {1, 0, 0}; });
+  f.device->frozen = true;
+  f.device->frozen_time = 0.0005;
+  // the first sample and two repeats are tolerated (a device may be sampled faster than it updates)
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(f.manager->step(0.001 * i).sent.force, (Vec3{1, 0, 0})) << i;
+  const TraceSample t = f.manager->step(0.003);
+  EXPECT_EQ(t.flags, kTraceDeviceError | kTraceZeroed);
+  EXPECT_EQ(f.device->last.force, Vec3{});
+  EXPECT_EQ(f.manager->stats().device_errors, 1u);
+  EXPECT_TRUE(f.manager->stats().faulted);
+  // a live device again, and the fault cleared: forces come back
+  f.device->frozen = false;
+  f.manager->clear_fault();
+  EXPECT_EQ(f.manager->step(0.004).sent.force, (Vec3{1, 0, 0}));
 }
 
 TEST(HapticManager, OpenFailuresAreErrors) {

@@ -20,7 +20,10 @@ enum class DeviceStatus : std::uint8_t {
 /// (no per-field getters with different sampling times). Frame: the device's base frame.
 /// Trivially copyable.
 struct DeviceState {
-  double time_s = 0.0;              ///< when the sample was taken [s] (device clock; simulated devices: simulated time)
+  /// When the sample was taken [s] (device clock; simulated devices: simulated time). Must
+  /// increase from one tick to the next while the device is live: HapticManager treats a time
+  /// that stops advancing (HapticManagerOptions::max_frozen_ticks) as a stalled device.
+  double time_s = 0.0;
   Vec3 position{};                  ///< handle position [m]
   Quat orientation{};               ///< handle orientation (unit quaternion)
   Vec3 linear_velocity{};           ///< [m/s]

@@ -29,6 +29,9 @@ struct HapticManagerOptions {
   /// that starts inside an object does not jolt the hand; counted in ticks at rate_hz (also in
   /// stepped sessions). 0 disables the fade.
   double soft_start_s = 0.05;
+  /// Consecutive ticks whose DeviceState::time_s does not advance before the device counts as
+  /// frozen (a stalled driver repeating an old pose): treated as a device error. 0 disables.
+  int max_frozen_ticks = 50;
 };
 
 /// Counters of a HapticManager; a snapshot, plain data.
@@ -46,7 +49,8 @@ struct HapticStats {
 };
 
 /// Runs the haptic loop for one device. Every tick, on the haptic thread:
-///   1. state = device.read_state();
+///   1. state = device.read_state(); an error status, or a time_s that has not advanced for
+///      max_frozen_ticks ticks, is a device error;
 ///   2. MoveOnHapticTick.broadcast(state)            (e.g. move the tool in the scene);
 ///   3. ForceOnHapticTick.broadcast(state, command)  (each delegate adds its force to `command`,
 ///      which starts at zero);
@@ -135,7 +139,10 @@ class HapticManager {
   Delegator<const DeviceState&, DeviceCommand&> force_event_;
   std::unique_ptr<SpscQueue<TraceSample>> trace_;
   double tick_time_s_ = 0.0;
-  std::int64_t fade_count_ = 0;  // ticks since the fade-in restarted (haptic thread)
+  std::int64_t fade_count_ = 0;
+  int frozen_ticks_ = 0;          // consecutive ticks with the same device time (haptic thread)
+  double last_device_time_s_ = 0.0;
+  bool has_device_time_ = false;  // ticks since the fade-in restarted (haptic thread)
   double fade_ticks_ = 1.0;      // ticks the fade-in takes, >= 1
   std::atomic<bool> restart_fade_{false};
   std::atomic<bool> halted_{false};
