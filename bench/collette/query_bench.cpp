@@ -85,8 +85,9 @@ Result<SphereTree> load_or_build_tree(const TriangleMesh& mesh, const std::files
     bytes.resize(got);
     return ist_hash_bytes(bytes);
   }();
-  const std::filesystem::path cache = std::filesystem::path(UH_BENCH_CACHE_DIR) / "bunny_69k_10000.ist";
-  if (auto cached = load_ist(cache); cached && cached->meta.source_mesh_hash == hash && cached->tree.leaf_count() > 0)
+  const std::filesystem::path cache = std::filesystem::path(UH_BENCH_CACHE_DIR) / "bunny_69k_10000_arity8.ist";
+  if (auto cached = load_ist(cache); cached && cached->meta.source_mesh_hash == hash && cached->tree.leaf_count() > 0 &&
+                                     cached->tree.arity() == SphereTreeBuildOptions{}.arity)
     return std::move(cached->tree);
   std::fprintf(stderr, "packing %d spheres into %s (cached afterwards in %s)...\n", kSpheres, mesh_path.c_str(), cache.c_str());
   PackingOptions options;

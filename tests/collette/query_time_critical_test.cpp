@@ -65,7 +65,7 @@ TEST(TimeCriticalQuery, ConvergesAsTheBudgetGrows) {
       previous = err;
     }
     if (budget >= full / 2) {
-      EXPECT_LT(err, 0.1) << "budget " << budget;
+      EXPECT_LT(err, 0.2) << "budget " << budget;
     }
     if (budget >= full) {
       EXPECT_TRUE(r.exact);

@@ -18,8 +18,8 @@ namespace uh::collette {
 
 /// Options for build_sphere_tree().
 struct SphereTreeBuildOptions {
-  int arity = 4;                ///< children per inner node, 2..kMaxSphereTreeArity
-  int kmeans_iterations = 8;    ///< Lloyd iterations per split
+  int arity = 8;                ///< children per inner node, 2..kMaxSphereTreeArity (8 measured fastest)
+  int kmeans_iterations = 30;   ///< most Lloyd iterations per split (stops early when stable)
   int enclosing_iterations = 48; ///< refinement steps of each enclosing sphere
 };
 
