@@ -64,6 +64,22 @@ TEST(FixedRateLoop, RunsNearItsRate) {
   EXPECT_FALSE(s.priority_raised) << "priority was not asked for";
 }
 
+TEST(FixedRateLoop, RunsAtEightKilohertz) {
+  // sanity only: the 125 us period is honoured as an upper bound and the loop makes progress
+  uh::FixedRateLoop loop({.rate_hz = 8000.0});
+  std::atomic<std::uint64_t> calls{0};
+  const auto begin = std::chrono::steady_clock::now();
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo&) { calls.fetch_add(1, std::memory_order_relaxed); }));
+  std::this_thread::sleep_for(200ms);
+  loop.stop();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const uh::FixedRateLoopStats s = loop.stats();
+  EXPECT_EQ(s.ticks, calls.load());
+  EXPECT_GT(s.ticks, 100u);
+  EXPECT_LE(static_cast<double>(s.ticks), wall_s * 8000.0 + 1.0) << "more ticks than the grid has points";
+  EXPECT_DOUBLE_EQ(s.rate_hz, 8000.0);
+}
+
 TEST(FixedRateLoop, KeepsAbsoluteDeadlines) {
   // scheduled(k) = origin + k * period for every tick, however late it starts, and no tick starts
   // before its deadline
