@@ -21,7 +21,10 @@ TEST(TraceCsvWriter, WritesEveryTickOfAThreadedRun) {
   auto writer = TraceCsvWriter::start(manager, path, {.drain_period_s = 0.01});
   ASSERT_TRUE(writer) << writer.error().message;
   ASSERT_TRUE(manager.start());
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (manager.stats().ticks < 100 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   manager.stop();
   (*writer)->stop();
   const HapticStats stats = manager.stats();
