@@ -219,12 +219,14 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
 
   const detail::TriangleBvh bvh(solid.vertices, solid.triangles);
 
-  // 1. classify voxel centres row by row: one ray along +x per (j, k) row, crossings sorted,
-  // parity. Rows whose ray grazes an edge or vertex (odd count, coincident crossings) fall back
-  // to a three-ray vote per voxel.
+  // 1. classify voxel centres row by row: one ray along +x per (j, k) row, crossings sorted;
+  // the winding number at a voxel is minus the sum of the crossing signs before it (the ray
+  // starts outside). Winding instead of parity keeps interpenetrating closed shells inside.
+  // Rows whose ray grazes an edge or vertex (signs not summing to zero, coincident crossings)
+  // fall back to a three-ray vote per voxel.
   std::vector<std::int32_t> interior_of(static_cast<std::size_t>(grid_size), -1);
   std::vector<std::int64_t> interior_cell;
-  std::vector<double> hits;
+  std::vector<std::pair<double, int>> hits;
   const double diag = norm(ext);
   for (std::int64_t k = 0; k < nz; ++k) {
     for (std::int64_t j = 0; j < ny; ++j) {
@@ -233,17 +235,22 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
       bvh.ray_hits(o, {1.0, 0.0, 0.0}, std::numeric_limits<double>::infinity(), hits);
       if (hits.empty()) continue;
       std::sort(hits.begin(), hits.end());
-      bool suspicious = hits.size() % 2 != 0;
-      for (std::size_t q = 1; q < hits.size() && !suspicious; ++q) suspicious = (hits[q] - hits[q - 1]) < 1e-9 * diag;
+      int total = 0;
+      for (const auto& hit : hits) total += hit.second;
+      bool suspicious = total != 0;
+      for (std::size_t q = 1; q < hits.size() && !suspicious; ++q) {
+        suspicious = (hits[q].first - hits[q - 1].first) < 1e-9 * diag;
+      }
       std::size_t next_hit = 0;
+      int winding = 0;
       for (std::int64_t i = 0; i < nx; ++i) {
         const double t = (static_cast<double>(i) + 0.5) * h + h;
         bool inside;
         if (suspicious) {
           inside = bvh.inside_vote(centre(i, j, k));
         } else {
-          while (next_hit < hits.size() && hits[next_hit] < t) ++next_hit;
-          inside = (next_hit % 2) == 1;
+          while (next_hit < hits.size() && hits[next_hit].first < t) winding -= hits[next_hit++].second;
+          inside = winding > 0;
         }
         if (inside) {
           const std::int64_t g = i + nx * (j + ny * k);

@@ -205,7 +205,8 @@ void TriangleBvh::ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& 
         const double v = dot(d, qv) * inv_det;
         if (v < 0.0 || u + v > 1.0) continue;
         const double tt = dot(e2, qv) * inv_det;
-        if (tt > 0.0 && tt < t_max) visit(tt);
+        // det = -dot(d, normal): negative when the ray leaves through the triangle
+        if (tt > 0.0 && tt < t_max) visit(tt, det < 0.0 ? 1 : -1);
       }
       continue;
     }
@@ -214,14 +215,14 @@ void TriangleBvh::ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& 
   }
 }
 
-void TriangleBvh::ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<double>& hits) const {
-  ray_visit(o, d, t_max, [&](double t) { hits.push_back(t); });
+void TriangleBvh::ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<std::pair<double, int>>& hits) const {
+  ray_visit(o, d, t_max, [&](double t, int w) { hits.emplace_back(t, w); });
 }
 
-int TriangleBvh::ray_crossings(const Vec3& o, const Vec3& d) const {
-  int n = 0;
-  ray_visit(o, d, 1e300, [&](double) { ++n; });
-  return n;
+int TriangleBvh::ray_winding(const Vec3& o, const Vec3& d) const {
+  int w = 0;
+  ray_visit(o, d, 1e300, [&](double, int s) { w += s; });
+  return w;
 }
 
 bool TriangleBvh::inside_vote(const Vec3& p) const {
@@ -231,7 +232,7 @@ bool TriangleBvh::inside_vote(const Vec3& p) const {
                                           {-0.2811437, 0.9137213, 0.2935071},
                                           {0.1931559, -0.3512873, 0.9162341}};
   int votes = 0;
-  for (const Vec3& d : kDirections) votes += ray_crossings(p, d) % 2;
+  for (const Vec3& d : kDirections) votes += ray_winding(p, d) > 0 ? 1 : 0;
   return votes >= 2;
 }
 

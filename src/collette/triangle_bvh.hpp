@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "uh/core/math.hpp"
@@ -34,12 +35,15 @@ class TriangleBvh {
   bool empty() const { return tris_.empty(); }
   /// Squared distance to the nearest triangle, with the nearest point; `max_d2` prunes the search.
   double closest(const Vec3& p, Vec3* nearest = nullptr, double max_d2 = 1e300) const;
-  /// Ray parameters t in (0, t_max) where the ray o + t d crosses a triangle, appended to hits.
-  void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<double>& hits) const;
-  /// Number of crossings of the ray o + t d, t > 0 (no allocation).
-  int ray_crossings(const Vec3& o, const Vec3& d) const;
-  /// Majority vote of ray parity along three fixed directions: a ray that grazes an edge or a
-  /// vertex (counting a crossing twice or not at all) is outvoted by the other two.
+  /// Crossings of the ray o + t d with 0 < t < t_max, appended as (t, w): w = +1 where the ray
+  /// leaves through a triangle (along its outward normal), -1 where it enters.
+  void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<std::pair<double, int>>& hits) const;
+  /// Winding number of a closed, outward-oriented mesh at o, counted along the ray o + t d,
+  /// t > 0: the sum of the crossing signs (no allocation). Interpenetrating closed shells give 2
+  /// where they overlap, which parity would call outside.
+  int ray_winding(const Vec3& o, const Vec3& d) const;
+  /// Majority vote of ray_winding() > 0 along three fixed directions: a ray that grazes an edge
+  /// or a vertex (counting a crossing twice or not at all) is outvoted by the other two.
   bool inside_vote(const Vec3& p) const;
   /// Exact generalised winding number (sum over all triangles).
   double winding_number(const Vec3& p) const;

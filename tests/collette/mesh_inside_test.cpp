@@ -89,3 +89,27 @@ TEST(MeshInside, OpenMeshUsesTheWindingNumber) {
 
 }  // namespace
 }  // namespace uh::collette
+
+namespace uh::collette {
+namespace {
+
+TEST(MeshInside, OverlapOfInterpenetratingShellsIsInside) {
+  // two closed cubes sharing the slab 0.5 < x < 1: winding number 2 there, which parity calls outside
+  TriangleMesh two = test::unit_cube();
+  const TriangleMesh second = test::unit_cube();
+  for (const Vec3& v : second.vertices) two.vertices.push_back(v + Vec3{0.5, 0.0, 0.0});
+  for (const auto& t : second.triangles) two.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+  two.source_name = "two cubes";
+  const auto m = validate_mesh(two);
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_EQ(m->report.components, 2);
+  const MeshInside inside(*m);
+  EXPECT_NEAR(test::brute_winding(*m, {0.75, 0.3, 0.6}), 2.0, 1e-9);
+  EXPECT_TRUE(inside.contains({0.75, 0.3, 0.6}));
+  EXPECT_TRUE(inside.contains({0.25, 0.3, 0.6}));
+  EXPECT_TRUE(inside.contains({1.25, 0.3, 0.6}));
+  EXPECT_FALSE(inside.contains({1.75, 0.3, 0.6}));
+}
+
+}  // namespace
+}  // namespace uh::collette

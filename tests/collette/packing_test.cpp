@@ -150,6 +150,23 @@ TEST(SpherePacking, OpenMeshIsFilledUsingTheWindingNumber) {
   }
 }
 
+TEST(SpherePacking, FillsTheOverlapOfInterpenetratingShells) {
+  TriangleMesh two = test::unit_cube();
+  const TriangleMesh second = test::unit_cube();
+  for (const Vec3& v : second.vertices) two.vertices.push_back(v + Vec3{0.5, 0.0, 0.0});
+  for (const auto& t : second.triangles) two.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+  const TriangleMesh m = validated(two);
+  const auto p = pack_spheres(m, {.target_sphere_count = 300});
+  ASSERT_TRUE(p) << p.error().message;
+  int in_overlap = 0;
+  for (const Sphere& s : p->spheres) {
+    ASSERT_GT(test::brute_winding(m, centre(s)), 0.5);
+    ASSERT_GT(test::brute_distance(m, centre(s)), static_cast<double>(s.radius));
+    in_overlap += (s.x > 0.5f && s.x < 1.0f) ? 1 : 0;
+  }
+  EXPECT_GT(in_overlap, 10);
+}
+
 TEST(SpherePacking, RejectsBadInput) {
   TriangleMesh empty;
   empty.source_name = "nothing";

@@ -10,8 +10,10 @@ namespace uh::collette {
 
 /// Point queries against one mesh, accelerated by a triangle BVH built in the constructor.
 ///
-/// contains() uses ray parity with three axis rays and a majority vote for closed meshes
-/// (robust when a ray grazes an edge or vertex), and the generalised winding number
+/// contains() counts signed ray crossings (the winding number along a ray, so interpenetrating
+/// closed shells count as inside) along three fixed rays and takes the majority, which is robust
+/// when a ray grazes an edge or vertex; for meshes accepted with report.assumed_open it uses the
+/// generalised winding number
 /// (> 0.5 means inside) for meshes accepted with report.assumed_open. distance() is the exact
 /// Euclidean distance to the nearest triangle. Keeps its own copy of the geometry. Const queries
 /// are thread-safe and allocation-free, but not bounded-time: keep them off the haptic thread.
