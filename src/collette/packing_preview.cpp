@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
@@ -148,7 +149,10 @@ Status write_packing_preview(const std::vector<Sphere>& spheres, const std::file
 
   // write next to the target and rename, so a failure never leaves a half-written file there
   const std::filesystem::path dir = png.has_parent_path() ? png.parent_path() : std::filesystem::path(".");
-  const std::filesystem::path tmp = dir / fmt::format(".{}.tmp{}", png.filename().string(), static_cast<long>(::getpid()));
+  // process id plus a per-process counter: concurrent writers never share a temporary file
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path tmp =
+      dir / fmt::format(".{}.tmp{}-{}", png.filename().string(), static_cast<long>(::getpid()), counter.fetch_add(1));
   Status st = write_png(tmp, w, h, rgb);
   std::error_code ec;
   if (!st) {
