@@ -5,6 +5,6 @@ set -euo pipefail
 source "$(dirname "$0")/common.sh"
 bash "$uh_root/scripts/install-deps.sh"
 echo "== build (Release) =="
-uh_build build/release uh_cli -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF
+uh_build build/main uh_cli -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF
 echo "== uh run =="
-"$uh_root/build/release/apps/uh/uh" run "$@"
+"$uh_root/build/main/apps/uh/uh" run "$@"
