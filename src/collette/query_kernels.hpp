@@ -30,7 +30,4 @@ struct FloatTransform {
   }
 };
 
-/// 4/3 pi: sphere volume factor.
-inline constexpr float kFourThirdsPi = 4.18879020478639098f;
-
 }  // namespace uh::collette::detail

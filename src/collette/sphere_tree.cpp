@@ -25,6 +25,13 @@ SphereTree::SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> le
     : nodes_(std::move(nodes)), leaves_(std::move(leaves)), depth_(depth), arity_(arity) {
   const std::size_t n = nodes_.size();
   if (n == 0) return;
+  density_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const SphereTreeNode& node = nodes_[i];
+    const double r = static_cast<double>(node.radius);
+    const double ball = 4.0 / 3.0 * 3.14159265358979323846 * r * r * r;
+    density_[i] = node.is_leaf() || !(ball > 0.0) ? 1.f : static_cast<float>(std::min(1.0, static_cast<double>(node.volume) / ball));
+  }
   // the blocks are only built for well-formed child ranges; validate() reports the others and
   // the queries require a validated tree
   int widest = 1;

@@ -13,12 +13,6 @@ namespace {
 
 bool heap_less(const TimeCriticalQuery::HeapEntry& l, const TimeCriticalQuery::HeapEntry& r) { return l.key < r.key; }
 
-float density(const SphereTreeNode& n) {
-  if (n.is_leaf()) return 1.f;
-  const float r = n.radius;
-  return std::min(1.f, n.volume / (detail::kFourThirdsPi * r * r * r));
-}
-
 struct Sums {
   double v = 0.0, nx = 0.0, ny = 0.0, nz = 0.0, cx = 0.0, cy = 0.0, cz = 0.0;
 
@@ -54,6 +48,8 @@ const TimeCriticalResult& TimeCriticalQuery::run(const SphereTree& a, const Sphe
   const detail::FloatTransform xf = detail::FloatTransform::from(b_in_a);
   const SphereTreeNode* const na = a.nodes().data();
   const SphereTreeNode* const nb = b.nodes().data();
+  const float* const density_a = a.density().data();
+  const float* const density_b = b.density().data();
   Sums exact;
   QueryStats stats;
 
@@ -76,7 +72,7 @@ const TimeCriticalResult& TimeCriticalQuery::run(const SphereTree& a, const Sphe
       return;
     }
     if (heap_.size() == heap_.capacity()) heap_.reserve(2 * heap_.capacity());
-    heap_.push_back({density(A) * density(B) * lens, ia, ib, x, y, z});
+    heap_.push_back({density_a[ia] * density_b[ib] * lens, ia, ib, x, y, z});
     std::push_heap(heap_.begin(), heap_.end(), heap_less);
   };
 

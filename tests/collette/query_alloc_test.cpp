@@ -17,6 +17,17 @@ namespace {
 thread_local long g_allocations = 0;
 }  // namespace
 
+#if defined(__SANITIZE_ADDRESS__)
+// Shared libraries keep using AddressSanitizer's operator new while their deletes may reach the
+// replacement below (or the other way round): both end in malloc/free, so the pairing is sound.
+extern "C" const char* __asan_default_options() { return "alloc_dealloc_mismatch=0"; }
+#endif
+
+// gcc flags free() inside a replacement operator delete as mismatched; here it is the point
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
 void* operator new(std::size_t n) {
   ++g_allocations;
   if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
@@ -31,6 +42,9 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 namespace uh::collette {
 namespace {

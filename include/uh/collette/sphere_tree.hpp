@@ -72,6 +72,10 @@ class SphereTree {
     int width = 4;
     std::int32_t root = 0;                  ///< traversal id of the root
   };
+  /// Packing density of each node: leaf volume below / volume of its sphere, in (0, 1]; 1 for a
+  /// leaf. Derived by the constructor for the time-critical query's expected overlaps.
+  std::span<const float> density() const { return density_; }
+
   Blocks blocks() const {
     return {block_bounds_.data(), block_child_.data(), block_count_.data(), block_leaf_mask_.data(), block_width_, root_id_};
   }
@@ -81,6 +85,7 @@ class SphereTree {
   std::vector<std::int32_t> block_child_;
   std::vector<std::uint8_t> block_count_;
   std::vector<std::uint8_t> block_leaf_mask_;
+  std::vector<float> density_;
   int block_width_ = 4;
   std::int32_t root_id_ = 0;
   std::vector<SphereTreeNode> nodes_;

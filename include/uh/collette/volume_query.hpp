@@ -74,7 +74,9 @@ class VolumeQuery {
   /// Runs the query for A and B at their world poses and fills `out` in the world frame:
   /// totals, restoring direction, centroid, the pairs (up to ContactFrame::kMaxPairs, then
   /// `truncated`), `distance` = 0, `query_seconds`. Leaves `sequence`, `time_s` and the object ids
-  /// for the caller. Real-time safe in steady state.
+  /// for the caller. Pairs are copied from the query's pair buffer, so construct the query with
+  /// `collect_pairs` (the default) and `pair_capacity >= ContactFrame::kMaxPairs` (the default) to
+  /// get all of them. Real-time safe in steady state.
   void run(const SphereTree& a, const SphereTree& b, const Pose& world_from_a, const Pose& world_from_b,
            ContactFrame& out);
 
