@@ -29,7 +29,7 @@ struct RunArgs {
   bool held_forces = false;
   bool stepped = false;
   int ticks_per_collision = 4;
-  bool realtime = false;
+  bool no_realtime = false;
 };
 
 void print_summary(const controllers::SessionReport& r) {
@@ -56,7 +56,7 @@ int run_session(const RunArgs& args) {
   if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
   if (args.collision_hz >= 0.0) options.collision_hz = args.collision_hz;
   if (args.held_forces) options.multi_rate = false;
-  options.raise_priority = args.realtime;
+  options.raise_priority = !args.no_realtime;
   options.cache_dir = cache;
   std::unique_ptr<ProgressBar> bar;
   std::string bar_label;
@@ -128,7 +128,8 @@ void add_run_command(CLI::App& app, CommandRunner& runner) {
   r->add_flag("--stepped", args.stepped, "deterministic run on one thread in simulated time");
   r->add_option("--ticks-per-collision", args.ticks_per_collision, "with --stepped: haptic ticks per collision step")
       ->default_val(4)->check(CLI::Range(1, 1000));
-  r->add_flag("--realtime", args.realtime, "ask for SCHED_FIFO for the haptic and collision threads");
+  r->add_flag("--no-realtime", args.no_realtime,
+              "do not ask for SCHED_FIFO for the haptic and collision threads (asked by default; refused without privileges)");
   r->callback([&runner] { runner = [] { return run_session(args); }; });
 }
 

@@ -32,6 +32,7 @@ CollisionWorld::CollisionWorld(CollisionWorldOptions options)
       empty_frame_(std::make_unique<ContactFrame>()),
       loop_(FixedRateLoopOptions{.rate_hz = options_.rate_hz > 0.0 ? options_.rate_hz : 1000.0,
                                  .raise_priority = options_.raise_priority,
+                                 .fifo_priority = options_.fifo_priority,
                                  .name = options_.thread_name}) {}
 
 CollisionWorld::~CollisionWorld() { stop(); }

@@ -51,6 +51,7 @@ using WatcherId = std::int32_t;
 struct CollisionWorldOptions {
   double rate_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running (as fast as it can)
   bool raise_priority = false;    ///< ask for SCHED_FIFO for the collision thread (reported, not fatal)
+  int fifo_priority = 70;         ///< SCHED_FIFO priority when raised: below the haptic thread's 80
   bool compute_distance = true;   ///< fill ContactFrame::distance when a watched pair is apart
   std::string thread_name = "uh-collision";
 };
