@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The haptic pipeline's figures (issue "Haptico, ForceComp and the haptic pipeline"): runs `uh run`
+# on the repository's scenes and prints a Markdown table for docs/benchmarks.md.
+#   bash scripts/bench-pipeline.sh [SECONDS]      (default 60 s for the long runs)
+# Needs a Release build of uh (scripts/run.sh or scripts/test.sh makes one). Not part of the tests:
+# timings on a shared machine vary; run it on a quiet one.
+set -euo pipefail
+source "$(dirname "$0")/common.sh"
+seconds=${1:-60}
+uh_build build/main uh_cli -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF >/dev/null
+uh="$uh_root/build/main/apps/uh/uh"
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+run() {  # name, args...
+  local name=$1; shift
+  echo "running: uh run $*" >&2
+  "$uh" run "$@" --json >"$out/$name.json"
+}
+run deep1k --seconds "$seconds"
+run deep4k --seconds "$seconds" --haptic-hz 4000
+run descent_multi "$uh_root/scenes/bunny_descent.json" --collision-hz 250
+run descent_held "$uh_root/scenes/bunny_descent.json" --collision-hz 250 --held-forces
+run circle_stepped "$uh_root/scenes/bunny_coupling_circle.json" --stepped --ticks-per-collision 1
+run circle_threaded "$uh_root/scenes/bunny_coupling_circle.json"
+
+python3 - "$out" <<'PY'
+import json, sys, os
+d = sys.argv[1]
+j = {n[:-5]: json.load(open(os.path.join(d, n))) for n in os.listdir(d)}
+print("| run | haptic rate [Hz] | missed | jitter p50 / p99 / max [us] | collision median / min [Hz] | query median / p99 / max [us] | max pairs | max force [N] | clamped |")
+print("|---|---|---|---|---|---|---|---|---|")
+for name, label in [("deep1k", "default scene, 1 kHz"), ("deep4k", "default scene, 4 kHz")]:
+    r = j[name]; h = r["haptic"]; c = r["collision"]; f = r["force"]
+    print(f"| {label}, {r['seconds']:.0f} s | {h['rate_hz']:.1f} | {h['missed_deadlines']} | "
+          f"{h['jitter_us']['p50']:.1f} / {h['jitter_us']['p99']:.1f} / {h['jitter_us']['max']:.1f} | "
+          f"{c['rate_hz']['median']:.0f} / {c['rate_hz']['min']:.0f} | {c['query_us']['median']:.0f} / {c['query_us']['p99']:.0f} / {c['query_us']['max']:.0f} | "
+          f"{c['max_pairs']} | {f['max_n']:.2f} | {f['clamped']} |")
+print()
+m, h = j["descent_multi"]["force"]["max_step_n"], j["descent_held"]["force"]["max_step_n"]
+print("| force continuity, collision throttled to 250 Hz (bunny_descent) | largest tick-to-tick force step [N] |")
+print("|---|---|")
+print(f"| held forces | {h:.4f} |")
+print(f"| multi-rate re-evaluation | {m:.4f} |")
+print(f"| ratio held / multi-rate | {h / m if m > 0 else float('inf'):.1f}x |")
+print()
+print("| passivity, closed circle through the surface with the virtual coupling | energy into the hand [J] | max force [N] |")
+print("|---|---|---|")
+for name, label in [("circle_stepped", "stepped (simulated time, collision every tick)"), ("circle_threaded", "threaded")]:
+    r = j[name]
+    print(f"| {label} | {r['energy']['work_on_hand_j']:.5f} | {r['force']['max_n']:.2f} |")
+PY
