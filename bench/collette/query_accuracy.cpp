@@ -77,8 +77,8 @@ int main(int argc, char** argv) {
   std::printf("mesh %s: %zu triangles, volume %.4f, sampled %.4f (%d^3 cells); deep pose x %.4f, true overlap %.4f\n\n",
               path.filename().c_str(), mesh->triangles.size(), mesh_volume(*mesh),
               static_cast<double>(in_a.size()) * cell_volume, cells, hi - 0.25 * size.x, v_true);
-  std::printf("| spheres | coverage | max gap | packing overlap / true overlap | direction error [deg] | query median [us] | pack + build [s] |\n");
-  std::printf("|---|---|---|---|---|---|---|\n");
+  std::printf("| spheres | coverage | max gap | packing overlap / true overlap | restoring_direction error [deg] | -volume_gradient error [deg] | query median [us] | pack + build [s] |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
   for (int count : {1000, 2500, 5000, 10000, 20000}) {
     const auto t0 = std::chrono::steady_clock::now();
     PackingOptions options;
@@ -101,8 +101,9 @@ int main(int argc, char** argv) {
     }
     std::sort(times.begin(), times.end());
     const double angle = std::acos(std::clamp(dot(r.restoring_direction, true_dir), -1.0, 1.0)) * 180.0 / kPi;
-    std::printf("| %d | %.3f | %.4f | %.3f | %.1f | %.0f | %.1f |\n", tree->leaf_count(), packing->report.coverage,
-                packing->report.max_gap, r.total_volume / v_true, angle, times[times.size() / 2] * 1e6, build);
+    const double area_angle = std::acos(std::clamp(dot(normalized(-r.volume_gradient), true_dir), -1.0, 1.0)) * 180.0 / kPi;
+    std::printf("| %d | %.3f | %.4f | %.3f | %.1f | %.1f | %.0f | %.1f |\n", tree->leaf_count(), packing->report.coverage,
+                packing->report.max_gap, r.total_volume / v_true, angle, area_angle, times[times.size() / 2] * 1e6, build);
     std::fflush(stdout);
   }
   return 0;

@@ -56,6 +56,7 @@ void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector
     const Vec3 dn = r.weighted_normal_sum - ref.normal_sum;
     EXPECT_LT(norm(dn), 1e-4 * scale + 1e-4 * norm(ref.normal_sum)) << "pose " << k;
     EXPECT_LT(norm(r.volume_centroid - ref.centroid_sum / ref.volume), 1e-4) << "pose " << k;
+    EXPECT_LT(norm(r.volume_gradient - ref.gradient), 1e-3 * norm(ref.gradient) + 1e-6) << "pose " << k;
     // per-pair entries agree with the totals
     double sum = 0.0;
     Vec3 nsum{};

@@ -56,6 +56,7 @@ struct BruteVolume {
   double volume = 0.0;
   Vec3 normal_sum{};
   Vec3 centroid_sum{};  // sum of volume * centroid
+  Vec3 gradient{};      // sum of dV/dd * normal
   std::vector<std::pair<int, int>> pairs;
   std::vector<double> pair_volumes;
 };
@@ -75,6 +76,7 @@ inline BruteVolume brute_volume(const std::vector<Sphere>& a, const std::vector<
       r.volume += v;
       r.normal_sum += v * n;
       r.centroid_sum += v * (ca + n * lens_centroid_offset(d, ra, rb));
+      r.gradient += lens_volume_derivative(d, ra, rb) * n;
       r.pairs.emplace_back(i, j);
       r.pair_volumes.push_back(v);
     }

@@ -52,6 +52,12 @@ struct VolumeQueryResult {
   Vec3 restoring_direction{};       ///< unit direction of sum(volume * normal), A frame; zero if none
   Vec3 weighted_normal_sum{};       ///< sum(volume * normal), A frame [length^3]
   Vec3 volume_centroid{};           ///< volume-weighted mean of the lens centroids, A frame [length]; zero if none
+  /// dV/d(translation of B), A frame [length^2]: -sum(pi a^2 normal), a = radius of each pair's
+  /// intersection circle. The exact gradient of total_volume; -volume_gradient is the direction
+  /// that reduces the overlap fastest (measured closer to the true mesh gradient than
+  /// restoring_direction: 2-4 deg against 6-7 deg on the bunny) and |volume_gradient| is the
+  /// local stiffness of a volume penalty along it.
+  Vec3 volume_gradient{};
   std::int32_t pair_count = 0;      ///< pairs stored in pairs() (<= pair_capacity)
   bool truncated = false;           ///< more pairs overlapped than pair_capacity (totals still cover all)
   QueryStats stats{};
