@@ -2,10 +2,14 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "tree_test_support.hpp"
 #include "uh/collette/distance_query.hpp"
+#include "uh/collette/mesh_import.hpp"
+#include "uh/collette/mesh_inside.hpp"
+#include "uh/collette/sphere_packing.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 
 namespace uh::collette {
@@ -93,6 +97,54 @@ TEST(DistanceQuery, UpperBoundOfTheShapeDistance) {
     EXPECT_GE(r.distance, sep - 2.0 * outer - 1e-6);
     EXPECT_LE(r.distance, sep + 2.0 * gap + 1e-6);
   }
+}
+
+}  // namespace
+}  // namespace uh::collette
+
+namespace uh::collette {
+namespace {
+
+TEST(DistanceQuery, BoundsTheBunnyMeshDistance) {
+  auto mesh = load_mesh(std::string(UH_TEST_DATA_DIR) + "/meshes/bunny_npm_3674.obj");
+  ASSERT_TRUE(mesh) << mesh.error().message;
+  PackingOptions options;
+  options.target_sphere_count = 1000;
+  const auto packing = pack_spheres(*mesh, options);
+  ASSERT_TRUE(packing) << packing.error().message;
+  const auto tree = build_sphere_tree(packing->spheres);
+  ASSERT_TRUE(tree);
+  const MeshInside surface(*mesh);
+  double max_edge = 0.0;
+  for (const auto& t : mesh->triangles)
+    for (int e = 0; e < 3; ++e)
+      max_edge = std::max(max_edge, norm(mesh->vertices[static_cast<std::size_t>(t[static_cast<std::size_t>(e)])] -
+                                         mesh->vertices[static_cast<std::size_t>(t[static_cast<std::size_t>((e + 1) % 3)])]));
+  const Aabb box = mesh_bounds(*mesh);
+  const Vec3 size = box.max - box.min;
+  const Quat rot = quat_from_axis_angle({0, 1, 0}, 0.5);
+  DistanceQuery q;
+  int apart = 0;
+  for (double shift : {1.0, 1.1, 1.3, 2.0}) {
+    const Pose b_in_a{rot, {shift * size.x, 0.05 * size.y, 0.0}};
+    // brute force over A's vertices against B's triangles (exact point-to-mesh distance); the
+    // mesh distance is at most this and, the distance to a mesh being 1-Lipschitz, at least this
+    // minus the longest edge
+    const Pose a_in_b = inverse(b_in_a);
+    double vertex_distance = 1e300;
+    for (const Vec3& v : mesh->vertices) vertex_distance = std::min(vertex_distance, surface.distance(transform_point(a_in_b, v)));
+    for (const Vec3& v : mesh->vertices) vertex_distance = std::min(vertex_distance, surface.distance(transform_point(b_in_a, v)));
+    const DistanceResult& r = q.run(*tree, *tree, b_in_a);
+    if (vertex_distance > max_edge) {
+      EXPECT_FALSE(r.overlapping) << "shift " << shift;
+      ++apart;
+    }
+    // never below the mesh distance (the spheres are inside the meshes) ...
+    EXPECT_GE(r.distance, vertex_distance - max_edge - 1e-9) << "shift " << shift;
+    // ... and above it by at most the two packing gaps
+    EXPECT_LE(r.distance, vertex_distance + 2.0 * packing->report.max_gap + 1e-9) << "shift " << shift;
+  }
+  EXPECT_GE(apart, 2) << "the poses must separate the meshes: the test would prove little";
 }
 
 }  // namespace
