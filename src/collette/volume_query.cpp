@@ -153,68 +153,68 @@ struct Traversal {
 
   void push(std::int32_t ia, std::int32_t ib, float x, float y, float z, float r) { stack->push_back({ia, ib, x, y, z, r}); }
 
-  template <int W>
+  template <int WA, int WB>
   void run() {
     std::vector<VolumeQuery::StackEntry>& st = *stack;
-    alignas(16) float tb[4 * W];
+    alignas(16) float tb[4 * WB];
     while (!st.empty()) {
       const VolumeQuery::StackEntry e = st.back();
       st.pop_back();
       ++visited;
-      // grow (rarely, outside steady state) before a batch of up to W * W pushes
-      if (st.capacity() - st.size() < static_cast<std::size_t>(W * W)) st.reserve(2 * st.capacity() + W * W);
+      // grow (rarely, outside steady state) before a batch of up to WA * WB pushes
+      if (st.capacity() - st.size() < static_cast<std::size_t>(WA * WB)) st.reserve(2 * st.capacity() + WA * WB);
       if (e.a < 0) {
         // A is a leaf: B's children against it
         const Sphere& s = leaves_a[~e.a];
-        transform_block<W>(e.b, tb);
+        transform_block<WB>(e.b, tb);
         const std::uint32_t count_b = b.count[e.b];
         const std::uint32_t leaf_b = b.leaf_mask[e.b];
-        std::uint32_t hits = overlap_mask<W>(tb, tb + W, tb + 2 * W, tb + 3 * W, s.x, s.y, s.z, s.radius) & ((1u << count_b) - 1u);
+        std::uint32_t hits = overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius) & ((1u << count_b) - 1u);
         leaf_tests += popcount8(leaf_b);
-        const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * W;
+        const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
         while (hits) {
           const int j = std::countr_zero(hits);
           hits &= hits - 1u;
           if ((leaf_b >> j) & 1u)
-            add_pair(s.x, s.y, s.z, s.radius, tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j], ~e.a, ~cb[j]);
+            add_pair(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
           else
-            push(e.a, cb[j], tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j]);
+            push(e.a, cb[j], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
         }
         continue;
       }
-      const float* ab = a.bounds + static_cast<std::size_t>(e.a) * 4 * W;
-      const std::int32_t* ca = a.child + static_cast<std::size_t>(e.a) * W;
+      const float* ab = a.bounds + static_cast<std::size_t>(e.a) * 4 * WA;
+      const std::int32_t* ca = a.child + static_cast<std::size_t>(e.a) * WA;
       const std::uint32_t leaf_a = a.leaf_mask[e.a];
       if (e.b < 0) {
         // B is a leaf: A's children against it (padding lanes of A never overlap)
-        std::uint32_t hits = overlap_mask<W>(ab, ab + W, ab + 2 * W, ab + 3 * W, e.bx, e.by, e.bz, e.br);
+        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br);
         leaf_tests += popcount8(leaf_a);
         while (hits) {
           const int k = std::countr_zero(hits);
           hits &= hits - 1u;
           if ((leaf_a >> k) & 1u)
-            add_pair(ab[k], ab[W + k], ab[2 * W + k], ab[3 * W + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
+            add_pair(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
           else
             push(ca[k], e.b, e.bx, e.by, e.bz, e.br);
         }
         continue;
       }
       // both inner: every child of B (moved once) against all children of A in one batch
-      transform_block<W>(e.b, tb);
+      transform_block<WB>(e.b, tb);
       const int count_b = b.count[e.b];
       const std::uint32_t leaf_b = b.leaf_mask[e.b];
-      const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * W;
+      const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
       leaf_tests += popcount8(leaf_a) * popcount8(leaf_b);
       for (int j = 0; j < count_b; ++j) {
-        std::uint32_t hits = overlap_mask<W>(ab, ab + W, ab + 2 * W, ab + 3 * W, tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j]);
+        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
         const bool b_leaf = (leaf_b >> j) & 1u;
         while (hits) {
           const int k = std::countr_zero(hits);
           hits &= hits - 1u;
           if (b_leaf && ((leaf_a >> k) & 1u))
-            add_pair(ab[k], ab[W + k], ab[2 * W + k], ab[3 * W + k], tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j], ~ca[k], ~cb[j]);
+            add_pair(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~ca[k], ~cb[j]);
           else
-            push(ca[k], cb[j], tb[j], tb[W + j], tb[2 * W + j], tb[3 * W + j]);
+            push(ca[k], cb[j], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
         }
       }
     }
@@ -244,12 +244,11 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
     else
       t.push(t.a.root, t.b.root, x, y, z, rb.radius);
   }
-  // trees of different widths cannot share the specialised loop; both use the wider one
-  assert(t.a.width == t.b.width && "uh::collette::VolumeQuery::run(): trees built with block widths 4 and 8");
+  // one loop per pair of block widths (trees built with arity <= 4 and > 4 can meet)
   if (t.a.width == 4)
-    t.run<4>();
+    t.b.width == 4 ? t.run<4, 4>() : t.run<4, 8>();
   else
-    t.run<8>();
+    t.b.width == 4 ? t.run<8, 4>() : t.run<8, 8>();
 
   result_.total_volume = t.sum.volume;
   result_.weighted_normal_sum = {t.sum.nx, t.sum.ny, t.sum.nz};

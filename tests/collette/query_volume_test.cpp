@@ -21,10 +21,10 @@ using testing::Shape;
 
 Vec3 v3(const float f[3]) { return {static_cast<double>(f[0]), static_cast<double>(f[1]), static_cast<double>(f[2])}; }
 
-void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector<Sphere>& lb, int arity, int poses,
-                                std::uint32_t seed) {
-  const auto ta = build_sphere_tree(la, {.arity = arity});
-  const auto tb = build_sphere_tree(lb, {.arity = arity});
+void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector<Sphere>& lb, int arity_a, int arity_b,
+                                int poses, std::uint32_t seed) {
+  const auto ta = build_sphere_tree(la, {.arity = arity_a});
+  const auto tb = build_sphere_tree(lb, {.arity = arity_b});
   ASSERT_TRUE(ta && tb);
   VolumeQuery query;
   std::mt19937 rng(seed);
@@ -74,13 +74,16 @@ void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector
 TEST(VolumeQuery, MatchesBruteForceOnRandomPoses) {
   const auto ball = make_packing(0.16, Shape::kBall, 21);
   const auto box = make_packing(0.14, Shape::kBox, 22);
-  for (int arity : {2, 4, 8}) expect_matches_brute_force(ball, box, arity, 40, 100u + static_cast<std::uint32_t>(arity));
+  for (int arity : {2, 4, 8}) expect_matches_brute_force(ball, box, arity, arity, 40, 100u + static_cast<std::uint32_t>(arity));
+  // trees of different block widths (4 and 8 lanes) against each other
+  expect_matches_brute_force(ball, box, 3, 8, 30, 200u);
+  expect_matches_brute_force(ball, box, 6, 4, 30, 201u);
 }
 
 TEST(VolumeQuery, MatchesBruteForceForSameObject) {
   // an object against a copy of itself: nearly coincident leaves and containment cases
   const auto rod = make_packing(0.07, Shape::kRod, 23);
-  expect_matches_brute_force(rod, rod, 4, 30, 7);
+  expect_matches_brute_force(rod, rod, 4, 4, 30, 7);
   const auto ta = build_sphere_tree(rod);
   ASSERT_TRUE(ta);
   VolumeQuery q;
