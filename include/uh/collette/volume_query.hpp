@@ -4,8 +4,9 @@
 /// direction and the volume centroid (the Inner Sphere Tree penetration-volume query).
 ///
 /// Simultaneous traversal of two SphereTrees A and B that descends only into overlapping node
-/// pairs (the larger sphere of a pair is split, its children tested in one batch against the other
-/// node); at every overlapping leaf pair it adds the exact lens volume (uh::lens_volume), the unit
+/// pairs (both inner nodes of a pair are split: each child of B, moved into A's frame once, is
+/// tested against all children of A in one SIMD batch, on SphereTree::blocks()); at every
+/// overlapping leaf pair it adds the exact lens volume (uh::lens_volume), the unit
 /// normal along the centre line from A's sphere to B's (pushes B out of A) and the lens centroid.
 /// Since the leaves of one object never overlap, the total is exactly the intersection volume of
 /// the two packings.
