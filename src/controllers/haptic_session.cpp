@@ -95,6 +95,10 @@ void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::o
   buffer.clear();
   manager_->drain_trace(buffer);
   for (const auto& s : buffer) {
+    if (have_last_sent_)
+      report_.force_max_step_n = std::max(report_.force_max_step_n, norm(s.sent.force - last_sent_.force));
+    last_sent_ = s.sent;
+    have_last_sent_ = true;
     report_.timeline.push_back({.time_s = s.tick_time_s - t0, .force_n = norm(s.sent.force), .torque_nm = norm(s.sent.torque)});
     if (trace != nullptr) haptico::write_trace_row(*trace, s);
   }
@@ -104,6 +108,8 @@ Status HapticSession::run(double seconds, const std::function<void(const LiveSta
   if (!(seconds > 0.0)) return Error{"HapticSession::run: the duration must be positive"};
   report_.timeline.clear();
   report_.collision_rates.clear();
+  report_.force_max_step_n = 0.0;
+  have_last_sent_ = false;
   report_.timeline.reserve(static_cast<std::size_t>(seconds * haptic_hz_ * 1.05) + 16);
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
@@ -152,6 +158,8 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   if (ticks_per_collision_step < 1) return Error{"HapticSession::run_stepped: ticks per collision step must be >= 1"};
   report_.timeline.clear();
   report_.collision_rates.clear();
+  report_.force_max_step_n = 0.0;
+  have_last_sent_ = false;
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
@@ -211,7 +219,7 @@ void HapticSession::collect_report(double seconds, bool stepped) {
   const ForceControllerStats fc = force_controller_->stats();
   r.force_max_n = fc.max_force_n;
   r.torque_max_nm = fc.max_torque_nm;
-  r.force_max_step_n = fc.max_force_step_n;
+  r.force_max_raw_step_n = fc.max_force_step_n;
   r.force_nonfinite = fc.safety.nonfinite + hs.nonfinite;
   r.force_clamped = fc.safety.force_clamped + hs.force_clamped;
   r.torque_clamped = fc.safety.torque_clamped + hs.torque_clamped;
@@ -246,6 +254,7 @@ std::string session_report_json(const SessionReport& r) {
        {{"max_n", r.force_max_n},
         {"max_torque_nm", r.torque_max_nm},
         {"max_step_n", r.force_max_step_n},
+        {"max_raw_step_n", r.force_max_raw_step_n},
         {"nonfinite", r.force_nonfinite},
         {"clamped", r.force_clamped},
         {"torque_clamped", r.torque_clamped},

@@ -68,7 +68,8 @@ struct SessionReport {
   std::uint64_t truncated_frames = 0;
   // forces
   double force_max_n = 0.0, torque_max_nm = 0.0;
-  double force_max_step_n = 0.0;       ///< largest tick-to-tick change of the contact force [N]
+  double force_max_step_n = 0.0;       ///< largest tick-to-tick change of the force sent to the device [N]
+  double force_max_raw_step_n = 0.0;   ///< same for the contact force before coupling, limits and fades [N]
   std::uint64_t force_nonfinite = 0, force_clamped = 0, torque_clamped = 0, stale_ticks = 0;
   std::uint64_t contact_ticks = 0;
   double work_on_hand_j = 0.0;         ///< energy the device put into the hand [J]
@@ -118,6 +119,8 @@ class HapticSession {
   void take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace, double t0);
 
   Scene scene_;
+  haptico::DeviceCommand last_sent_{};
+  bool have_last_sent_ = false;
   double haptic_hz_ = 1000.0;
   double collision_hz_ = 1000.0;
   std::unique_ptr<collette::CollisionWorld> world_;
