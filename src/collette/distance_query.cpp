@@ -11,7 +11,10 @@ namespace uh::collette {
 namespace {
 
 // min-heap on the lower bound
-bool heap_greater(const DistanceQuery::HeapEntry& l, const DistanceQuery::HeapEntry& r) { return l.bound > r.bound; }
+struct HeapGreater {
+  bool operator()(const DistanceQuery::HeapEntry& l, const DistanceQuery::HeapEntry& r) const { return l.bound > r.bound; }
+};
+constexpr HeapGreater heap_greater{};
 
 }  // namespace
 

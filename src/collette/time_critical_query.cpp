@@ -11,7 +11,11 @@
 namespace uh::collette {
 namespace {
 
-bool heap_less(const TimeCriticalQuery::HeapEntry& l, const TimeCriticalQuery::HeapEntry& r) { return l.key < r.key; }
+// a function object, not a function pointer, so that the heap operations inline the comparison
+struct HeapLess {
+  bool operator()(const TimeCriticalQuery::HeapEntry& l, const TimeCriticalQuery::HeapEntry& r) const { return l.key < r.key; }
+};
+constexpr HeapLess heap_less{};
 
 struct Sums {
   double v = 0.0, nx = 0.0, ny = 0.0, nz = 0.0, cx = 0.0, cy = 0.0, cz = 0.0;
