@@ -29,6 +29,7 @@ Vec3 root_center_world(const SphereTree& tree, const Pose& world_from_object) {
 
 CollisionWorld::CollisionWorld(CollisionWorldOptions options)
     : options_(std::move(options)),
+      volume_query_(VolumeQueryOptions{.contact_margin = static_cast<float>(std::max(0.0, options_.contact_margin))}),
       empty_frame_(std::make_unique<ContactFrame>()),
       loop_(FixedRateLoopOptions{.rate_hz = options_.rate_hz > 0.0 ? options_.rate_hz : 1000.0,
                                  .raise_priority = options_.raise_priority,
@@ -127,7 +128,7 @@ void CollisionWorld::run_step(double time_s) {
 
     const double root_gap = norm(root_center_world(*b.tree, b.pose) - root_center_world(*a.tree, a.pose)) -
                             static_cast<double>(a.tree->root().radius) - static_cast<double>(b.tree->root().radius);
-    if (root_gap < 0.0) {
+    if (root_gap < options_.contact_margin) {
       const auto query_start = std::chrono::steady_clock::now();
       volume_query_.run(*a.tree, *b.tree, a.pose, b.pose, frame);
       query_time_.record(elapsed_ns(query_start));
@@ -142,10 +143,10 @@ void CollisionWorld::run_step(double time_s) {
       frame.world_from_a = a.pose;
       frame.world_from_b = b.pose;
     }
-    if (frame.pair_count == 0 && options_.compute_distance) {
+    if (!(frame.total_volume > 0.0) && options_.compute_distance) {
       // the root gap is only a lower bound; the distance query gives the packing's separation
       frame.distance = distance_query_.run(*a.tree, *b.tree, inverse(a.pose) * b.pose).distance;
-    } else if (frame.pair_count > 0) {
+    } else if (frame.total_volume > 0.0) {
       frame.distance = 0.0;
     }
     frame.sequence = ++watcher->sequence;
@@ -155,7 +156,7 @@ void CollisionWorld::run_step(double time_s) {
 
     const bool touching = frame.pair_count > 0;
     pairs_this_step += frame.pair_count;
-    if (touching) contact_frames_.increment();
+    if (frame.total_volume > 0.0) contact_frames_.increment();
     if (frame.truncated) truncated_frames_.increment();
     if (touching || watcher->touching) on_collision_.broadcast(watcher->a, watcher->b, frame);
     watcher->touching = touching;

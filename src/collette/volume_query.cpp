@@ -48,8 +48,10 @@ struct Traversal {
   std::vector<VolumeQuery::StackEntry>* stack;
   PairOverlap* out;
   std::int32_t capacity;
+  float margin;                // pairs closer than this but not overlapping are stored with volume 0
   std::int32_t stored = 0;
   std::int64_t overlapping = 0;
+  std::int64_t near = 0;       // stored-or-counted pairs within the margin that do not overlap
   std::int64_t leaf_tests = 0;
   std::int64_t visited = 0;
   Totals sum;
@@ -60,7 +62,10 @@ struct Traversal {
     const float dx = bx - ax, dy = by - ay, dz = bz - az;
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float v = lens_volume(d, ar, br);
-    if (!(v > 0.f)) return;
+    if (!(v > 0.f)) {
+      if (margin > 0.f && d < ar + br + margin) add_near_pair(dx, dy, dz, d, ax, ay, az, ar, la, lb);
+      return;
+    }
     const float inv = d > 0.f ? 1.f / d : 0.f;
     // lens_centroid_offset with its cap terms simplified: v_i z_i = 3/4 h_i^2 (2 r_i - h_i)^2,
     // so one division instead of three (same formula, checked against it by the tests)
@@ -103,6 +108,26 @@ struct Traversal {
       p.centroid[1] = cy;
       p.centroid[2] = cz;
     }
+  }
+
+  // a pair apart by less than the margin: stored with volume 0 so that a holder of the pair set
+  // (ForceComp's multi-rate re-evaluation) sees it start to overlap before the next query
+  void add_near_pair(float dx, float dy, float dz, float d, float ax, float ay, float az, float ar, std::int32_t la,
+                     std::int32_t lb) {
+    ++near;
+    if (stored >= capacity) return;
+    const float inv = d > 0.f ? 1.f / d : 0.f;
+    PairOverlap& p = out[stored++];
+    p.leaf_a = la;
+    p.leaf_b = lb;
+    p.volume = 0.f;
+    p.normal[0] = dx * inv;
+    p.normal[1] = dy * inv;
+    p.normal[2] = dz * inv;
+    // where the lens will appear: the point of A's sphere towards B
+    p.centroid[0] = ax + p.normal[0] * ar;
+    p.centroid[1] = ay + p.normal[1] * ar;
+    p.centroid[2] = az + p.normal[2] * ar;
   }
 
   // bit j set when lane j of the (x, y, z, r) lanes overlaps the sphere (px, py, pz, pr)
@@ -169,7 +194,7 @@ struct Traversal {
         transform_block<WB>(e.b, tb);
         const std::uint32_t count_b = b.count[e.b];
         const std::uint32_t leaf_b = b.leaf_mask[e.b];
-        std::uint32_t hits = overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius) & ((1u << count_b) - 1u);
+        std::uint32_t hits = overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius + margin) & ((1u << count_b) - 1u);
         leaf_tests += popcount8(leaf_b);
         const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
         while (hits) {
@@ -187,7 +212,7 @@ struct Traversal {
       const std::uint32_t leaf_a = a.leaf_mask[e.a];
       if (e.b < 0) {
         // B is a leaf: A's children against it (padding lanes of A never overlap)
-        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br);
+        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br + margin);
         leaf_tests += popcount8(leaf_a);
         while (hits) {
           const int k = std::countr_zero(hits);
@@ -206,7 +231,7 @@ struct Traversal {
       const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
       leaf_tests += popcount8(leaf_a) * popcount8(leaf_b);
       for (int j = 0; j < count_b; ++j) {
-        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
+        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j] + margin);
         const bool b_leaf = (leaf_b >> j) & 1u;
         while (hits) {
           const int k = std::countr_zero(hits);
@@ -227,7 +252,8 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
   assert(!a.empty() && !b.empty() && "uh::collette::VolumeQuery::run(): empty tree");
   result_ = VolumeQueryResult{};
   Traversal t{a.blocks(), b.blocks(), a.leaves().data(), detail::FloatTransform::from(b_in_a), &stack_, pairs_.data(),
-              options_.collect_pairs ? options_.pair_capacity : 0, 0, 0, 0, 0, Totals{}};
+              options_.collect_pairs ? options_.pair_capacity : 0, std::max(0.f, options_.contact_margin), 0, 0, 0, 0, 0,
+              Totals{}};
   stack_.clear();
 
   // the roots: A's and B's root spheres, B's moved into A's frame
@@ -236,7 +262,7 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
   float x, y, z;
   t.xf.apply(rb.x, rb.y, rb.z, x, y, z);
   const float dx = x - ra.x, dy = y - ra.y, dz = z - ra.z;
-  const float rs = ra.radius + rb.radius;
+  const float rs = ra.radius + rb.radius + t.margin;
   if (ra.is_leaf() && rb.is_leaf()) ++t.leaf_tests;
   if (dx * dx + dy * dy + dz * dz < rs * rs) {
     if (ra.is_leaf() && rb.is_leaf())
@@ -256,7 +282,8 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
   if (t.sum.volume > 0.0) result_.volume_centroid = Vec3{t.sum.cx, t.sum.cy, t.sum.cz} / t.sum.volume;
   result_.volume_gradient = Vec3{t.sum.gx, t.sum.gy, t.sum.gz} * -kPi;
   result_.pair_count = t.stored;
-  result_.truncated = t.overlapping > t.stored && options_.collect_pairs;
+  result_.truncated = t.overlapping + t.near > t.stored && options_.collect_pairs;
+  result_.near_pairs = t.near;
   result_.stats.node_pairs_visited = t.visited;
   result_.stats.leaf_pairs_tested = t.leaf_tests;
   result_.stats.overlapping_pairs = t.overlapping;
@@ -298,7 +325,7 @@ void VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& worl
     c.sphere_b_local = leaves_b[static_cast<std::size_t>(p.leaf_b)];
   }
   out.pair_count = n;
-  out.truncated = r.stats.overlapping_pairs > n;
+  out.truncated = r.stats.overlapping_pairs + r.near_pairs > n;
   out.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

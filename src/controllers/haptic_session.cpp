@@ -45,7 +45,9 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
 
   session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
-      .rate_hz = session->collision_hz_, .raise_priority = options.raise_priority});
+      .rate_hz = session->collision_hz_,
+      .raise_priority = options.raise_priority,
+      .contact_margin = options.contact_margin.value_or(scene.contact_margin)});
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;
   for (const SceneObject& object : scene.objects) {

@@ -279,7 +279,8 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
   }
   const FieldReader r(source);
   if (!root.is_object()) return Error{fmt::format("{}: expected a JSON object at the top level", source)};
-  UH_CHECK(r.check_keys(root, "", {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force"}));
+  UH_CHECK(r.check_keys(root, "", {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force",
+                                   "collision"}));
 
   Scene scene;
   scene.source = source;
@@ -291,6 +292,12 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
     UH_CHECK(r.check_keys(*it, "rates", {"haptic_hz", "collision_hz"}));
     UH_CHECK(r.number(*it, "rates", "haptic_hz", scene.haptic_hz, 1.0, 10000.0));
     UH_CHECK(r.number(*it, "rates", "collision_hz", scene.collision_hz, 0.0, 10000.0));
+  }
+
+  if (const auto it = root.find("collision"); it != root.end()) {
+    UH_CHECK(r.require_object(*it, "collision"));
+    UH_CHECK(r.check_keys(*it, "collision", {"contact_margin"}));
+    UH_CHECK(r.number(*it, "collision", "contact_margin", scene.contact_margin, 0.0, 1.0));
   }
 
   const auto objects = root.find("objects");

@@ -53,6 +53,9 @@ struct CollisionWorldOptions {
   bool raise_priority = false;    ///< ask for SCHED_FIFO for the collision thread (reported, not fatal)
   int fifo_priority = 70;         ///< SCHED_FIFO priority when raised: below the haptic thread's 80
   bool compute_distance = true;   ///< fill ContactFrame::distance when a watched pair is apart
+  /// Leaf pairs closer than this [length] are delivered with volume 0 before they overlap (see
+  /// VolumeQueryOptions::contact_margin), so multi-rate force rendering starts contacts smoothly.
+  double contact_margin = 0.0;
   std::string thread_name = "uh-collision";
 };
 
@@ -100,7 +103,8 @@ class CollisionWorld {
   Result<WatcherId> add_collision_watcher(ObjectId a, ObjectId b);
 
   /// Binds OnCollision: called on the collision thread for every step in which the watched pair
-  /// overlaps, and once more with an empty frame (pair_count 0) when the contact ends.
+  /// has pairs (overlapping, or within the contact margin), and once more with an empty frame
+  /// (pair_count 0) when that ends.
   DelegateSink<ObjectId, ObjectId, const ContactFrame&> on_collision() { return DelegateSink(on_collision_); }
 
   /// Sets the world pose of an object. One writer thread per object; real-time safe (lock-free).

@@ -44,6 +44,12 @@ static_assert(std::is_trivially_copyable_v<PairOverlap>);
 struct VolumeQueryOptions {
   bool collect_pairs = true;      ///< store each overlapping pair in pairs(); totals are always computed
   int pair_capacity = ContactFrame::kMaxPairs;  ///< most pairs stored; further pairs set `truncated`
+  /// Also store leaf pairs that are apart by less than this [length], with volume 0, normal along
+  /// their centre line and centroid on A's sphere towards B. For multi-rate force rendering: a
+  /// holder of the pair set re-evaluates them every haptic tick and sees them start to overlap
+  /// before the next query, so contacts begin without a step. 0 (default): overlapping pairs only.
+  /// Totals never include them.
+  float contact_margin = 0.f;
   int stack_reserve = 1024;       ///< initial traversal stack entries (grows once if a query needs more)
 };
 
@@ -59,7 +65,8 @@ struct VolumeQueryResult {
   /// restoring_direction: 2-4 deg against 6-7 deg on the bunny) and |volume_gradient| is the
   /// local stiffness of a volume penalty along it.
   Vec3 volume_gradient{};
-  std::int32_t pair_count = 0;      ///< pairs stored in pairs() (<= pair_capacity)
+  std::int32_t pair_count = 0;      ///< pairs stored in pairs() (<= pair_capacity), near pairs included
+  std::int64_t near_pairs = 0;      ///< pairs within contact_margin that do not overlap (stored with volume 0)
   bool truncated = false;           ///< more pairs overlapped than pair_capacity (totals still cover all)
   QueryStats stats{};
 };

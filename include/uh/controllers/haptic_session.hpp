@@ -27,6 +27,7 @@ struct SessionOptions {
   std::optional<double> haptic_hz;       ///< haptic rate [Hz]
   std::optional<double> collision_hz;    ///< collision rate [Hz]; 0 = free-running
   std::optional<bool> multi_rate;        ///< re-evaluate held pairs every tick (else hold forces)
+  std::optional<double> contact_margin;  ///< pairs delivered this far [m] before they touch
   bool raise_priority = false;           ///< ask for SCHED_FIFO for the haptic (80) and collision (70) threads
   std::filesystem::path cache_dir;       ///< where .ist builds are cached; empty = default_cache_dir()
   /// Build progress (what, fraction) while a mesh is packed on first use; calling thread.

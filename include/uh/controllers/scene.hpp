@@ -63,6 +63,7 @@ struct Scene {
   double haptic_hz = 1000.0;           ///< haptic thread rate [Hz]
   double collision_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running
   double seconds = 10.0;               ///< default session length [s]
+  double contact_margin = 0.001;       ///< collision pairs delivered this far [m] before they touch (multi-rate)
   ForceControllerOptions force{};      ///< multi-rate, safety limits, watchdog, coupling
 };
 
