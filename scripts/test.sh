@@ -2,7 +2,8 @@
 # The whole test suite, three builds in separate directories:
 #   1. Release: every test (unit, integration, the installed-package consumer);
 #   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test;
-#   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions).
+#   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions);
+#   4. libFuzzer (clang): a short fuzz run of the .ist loader on generated seeds.
 # Ends with one summary line: "tests: N passed, N failed".
 set -uo pipefail
 source "$(dirname "$0")/common.sh"
@@ -50,6 +51,18 @@ if uh_build build/tsan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=thread
   run_ctest tsan build/tsan -L threads
 else
   echo "test: ThreadSanitizer build failed"; status=1; failed=$((failed + 1))
+fi
+
+echo "== build (libFuzzer, clang) =="
+if command -v clang++ >/dev/null 2>&1; then
+  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+       -DUH_BUILD_FUZZERS=ON -DUH_BUILD_APPS=OFF -DUH_BUILD_BENCHMARKS=OFF; then
+    run_ctest fuzz build/fuzz -R '^ist_'
+  else
+    echo "test: fuzzer build failed"; status=1; failed=$((failed + 1))
+  fi
+else
+  echo "test: clang++ not found (scripts/install-deps.sh installs it)"; status=1; failed=$((failed + 1))
 fi
 
 echo "tests: $passed passed, $failed failed"
