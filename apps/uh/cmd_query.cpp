@@ -32,7 +32,9 @@ struct QueryArgs {
 struct QueryRow {
   std::string id;
   double volume = 0.0;
+  double volume_estimate = 0.0;  // volume / (coverage_a * coverage_b): estimate of the meshes' overlap
   Vec3 normal{};
+  Vec3 gradient_direction{};      // -grad of the packing overlap volume w.r.t. B's position (exact query only)
   std::int64_t pairs = 0;
   double distance = 0.0;
   double time_us = 0.0;
@@ -76,6 +78,9 @@ int run_query(const QueryArgs& args) {
   auto poses = read_poses_csv(args.poses);
   if (!poses) return fail(poses.error().message);
 
+  // each packing fills a share (its coverage) of its mesh, so it meets about coverage_a * coverage_b
+  // of the meshes' true overlap (docs/collette-queries.md, "Accuracy")
+  const double calibration = a->meta.coverage * b->meta.coverage;
   collette::VolumeQuery volume_query;
   collette::TimeCriticalQuery time_critical_query;
   collette::DistanceQuery distance_query;
@@ -94,10 +99,12 @@ int run_query(const QueryArgs& args) {
       const auto& r = volume_query.run(a->tree, b->tree, pose.b_in_a);
       row.volume = r.total_volume;
       row.normal = r.restoring_direction;
+      row.gradient_direction = normalized(-r.volume_gradient);
       row.pairs = r.stats.overlapping_pairs;
     }
     if (row.volume <= 0.0) row.distance = distance_query.run(a->tree, b->tree, pose.b_in_a).distance;
     row.time_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    if (calibration > 0.0) row.volume_estimate = row.volume / calibration;
     rows.push_back(std::move(row));
   }
 
@@ -110,11 +117,14 @@ int run_query(const QueryArgs& args) {
     nlohmann::json results = nlohmann::json::array();
     for (const QueryRow& r : rows)
       results.push_back({{"id", r.id}, {"volume", r.volume}, {"nx", r.normal.x}, {"ny", r.normal.y}, {"nz", r.normal.z},
-                         {"pairs", r.pairs}, {"distance", r.distance}, {"time_us", r.time_us}});
+                         {"pairs", r.pairs}, {"distance", r.distance}, {"time_us", r.time_us},
+                         {"volume_estimate", r.volume_estimate},
+                         {"gradient_direction", {r.gradient_direction.x, r.gradient_direction.y, r.gradient_direction.z}}});
     nlohmann::json j = {{"a", args.a},
                         {"b", args.b},
                         {"poses", rows.size()},
                         {"mode", args.budget_us > 0.0 ? "time-critical" : "exact"},
+                        {"coverage", {a->meta.coverage, b->meta.coverage}},
                         {"time_us", {{"median", percentile(times, 0.5)}, {"p99", percentile(times, 0.99)},
                                      {"max", percentile(times, 1.0)}}},
                         {"results", results}};
