@@ -1,3 +1,4 @@
+// Shared by the ForceComp and Haptico test programs (each links its own copy of the replacement).
 #include "allocation_counter.hpp"
 
 #include <cstdlib>
