@@ -61,7 +61,10 @@ int run_build(const IstBuildArgs& args) {
   options.mesh.allow_open = args.allow_open;
   auto built = collette::build_ist_asset(args.mesh, options);
   bar.finish();
-  if (!built) return fail(built.error().message);
+  if (!built) {
+    const bool open_mesh = built.error().message.find("allow_open") != std::string::npos;
+    return fail(built.error().message + (open_mesh ? "; on the command line: --allow-open" : ""));
+  }
   if (auto saved = collette::save_ist(args.out, built->asset); !saved) return fail(saved.error().message);
   if (!args.preview.empty()) {
     std::vector<Sphere> leaves(built->asset.tree.leaves().begin(), built->asset.tree.leaves().end());
