@@ -76,9 +76,12 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
       if (frame.pair_count > 0) {
         w->held.hold(frame);
         w->world_from_object = frame.world_from_a;
-        const auto r = component_.evaluate(frame, tool_motion);
-        w->held_wrench = r.wrench;
-        w->held_pairs = r.pair_count;
+        if (!options_.multi_rate) {
+          // held-force mode: the frame's own force, kept until the next frame
+          const auto r = component_.evaluate(frame, tool_motion);
+          w->held_wrench = r.wrench;
+          w->held_pairs = r.pair_count;
+        }
       } else {
         w->held.clear();
         w->held_wrench = {};

@@ -27,6 +27,7 @@ HeldContactSet::HeldContactSet(std::int32_t capacity)
       held_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
       normal_a_local_(new Vec3[static_cast<std::size_t>(std::max(capacity, 1))]),
       scratch_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
+      packed_(new PackedPair[static_cast<std::size_t>(std::max(capacity, 1))]),
       local_(new LocalPair[static_cast<std::size_t>(std::max(capacity, 1))]) {
   assert(capacity > 0 && "uh::forcecomp::HeldContactSet::HeldContactSet(): capacity must be positive");
 }
@@ -47,6 +48,11 @@ void HeldContactSet::hold(std::span<const SpherePairContact> pairs, std::uint64_
   const std::size_t n = std::min(pairs.size(), static_cast<std::size_t>(capacity_));
   dropped_pairs_ += pairs.size() - n;
   std::copy_n(pairs.begin(), n, held_.get());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Sphere& a = pairs[i].sphere_a_local;
+    const Sphere& b = pairs[i].sphere_b_local;
+    packed_[i] = {a.x, a.y, a.z, a.radius, b.x, b.y, b.z, b.radius};
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const float* nw = held_[i].normal_world;
     // without poses the world normal is the best guess for A's frame (exact when A is unrotated)
@@ -91,23 +97,66 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   // everything in A's frame: A's spheres need no transform, B's one; the sums turn back at the end
   const Pose a_from_world = inverse(world_from_a);
   const Pose a_from_b = a_from_world * world_from_b;
+  // Per pair in float, as the collision query does (the lens formulas agree with the double ones to
+  // ~1e-6 relative), sums in double; one division per overlapping pair: this loop runs every
+  // haptic tick over up to tens of thousands of pairs.
+  const Mat3 rot = rotation_matrix(a_from_b.rotation);
+  float r[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r[i][j] = static_cast<float>(rot.m[i][j]);
+  const float tx = static_cast<float>(a_from_b.position.x), ty = static_cast<float>(a_from_b.position.y),
+              tz = static_cast<float>(a_from_b.position.z);
+  constexpr float kPiF = static_cast<float>(kPi);
   double total = 0.0;
+  std::int32_t count = 0;
   for (std::int32_t k = 0; k < size_; ++k) {
-    const auto i = static_cast<std::size_t>(k);
-    const SpherePairContact& in = held_[i];
-    const Vec3 ca = centre(in.sphere_a_local);
-    const Vec3 cb = transform_point(a_from_b, centre(in.sphere_b_local));
-    const double ra = static_cast<double>(in.sphere_a_local.radius);
-    const double rb = static_cast<double>(in.sphere_b_local.radius);
-    const Vec3 delta = cb - ca;
-    const double d = norm(delta);
-    LocalPair& out = local_[i];
-    out.volume = lens_volume(d, ra, rb);
-    if (!(out.volume > 0.0)) continue;
-    out.normal_a = d > 1e-6 * (ra + rb) ? delta / d : normal_a_local_[i];
-    out.centroid_a = ca + lens_centroid_offset(d, ra, rb) * out.normal_a;
-    total += out.volume;
+    const PackedPair& p = packed_[static_cast<std::size_t>(k)];
+    const float bx = r[0][0] * p.bx + r[0][1] * p.by + r[0][2] * p.bz + tx;
+    const float by = r[1][0] * p.bx + r[1][1] * p.by + r[1][2] * p.bz + ty;
+    const float bz = r[2][0] * p.bx + r[2][1] * p.by + r[2][2] * p.bz + tz;
+    const float dx = bx - p.ax, dy = by - p.ay, dz = bz - p.az;
+    const float d2 = dx * dx + dy * dy + dz * dz;
+    const float rs = p.ar + p.br;
+    if (!(d2 < rs * rs)) continue;  // apart: most near pairs of the contact margin end here
+    const float d = std::sqrt(d2);
+    const float inv = d > 0.f ? 1.f / d : 0.f;
+    LocalPair& out = local_[static_cast<std::size_t>(count)];
+    float off;
+    if (d <= std::abs(p.ar - p.br)) {
+      // containment: the smaller sphere's volume, its centre as centroid
+      const float rmin = std::min(p.ar, p.br);
+      out.volume = 4.f / 3.f * kPiF * rmin * rmin * rmin;
+      off = p.ar <= p.br ? 0.f : d;
+    } else {
+      const float s_ = rs - d;
+      out.volume = kPiF * s_ * s_ *
+                   (d2 + 2.f * d * p.ar - 3.f * p.ar * p.ar + 2.f * d * p.br + 6.f * p.ar * p.br - 3.f * p.br * p.br) *
+                   (inv / 12.f);
+      // lens_centroid_offset with its cap terms simplified: v_i z_i = 3/4 h_i^2 (2 r_i - h_i)^2
+      const float x = (d2 + p.ar * p.ar - p.br * p.br) * 0.5f * inv;
+      const float h1 = p.ar - x, h2 = p.br - (d - x);
+      const float v1 = h1 * h1 * (3.f * p.ar - h1), v2 = h2 * h2 * (3.f * p.br - h2);
+      const float q1 = h1 * (2.f * p.ar - h1), q2 = h2 * (2.f * p.br - h2);
+      off = (0.75f * (q1 * q1 - q2 * q2) + v2 * d) / (v1 + v2);
+    }
+    if (!(out.volume > 0.f)) continue;
+    if (d > 1e-6f * rs) {
+      out.nx = dx * inv;
+      out.ny = dy * inv;
+      out.nz = dz * inv;
+    } else {
+      const Vec3& n = normal_a_local_[static_cast<std::size_t>(k)];
+      out.nx = static_cast<float>(n.x);
+      out.ny = static_cast<float>(n.y);
+      out.nz = static_cast<float>(n.z);
+    }
+    out.cx = p.ax + out.nx * off;
+    out.cy = p.ay + out.ny * off;
+    out.cz = p.az + out.nz * off;
+    total += static_cast<double>(out.volume);
+    ++count;
   }
+  local_count_ = count;
 
   PenaltyResult result;
   result.total_volume = total;
@@ -125,17 +174,18 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   const bool six_dof = input.mode == ForceMode::k6Dof;
   Vec3 force{};
   Vec3 torque{};
-  for (std::int32_t k = 0; k < size_; ++k) {
+  for (std::int32_t k = 0; k < local_count_; ++k) {
     const LocalPair& p = local_[static_cast<std::size_t>(k)];
-    if (!(p.volume > 0.0)) continue;
     ++result.pair_count;
-    const Vec3 n = sign * p.normal_a;
-    const double vel = dot(tool.point_velocity(p.centroid_a) - other.point_velocity(p.centroid_a), n);
-    const double f = input.force_scale * p.volume - damping_per_volume * vel * p.volume;
+    const Vec3 n = sign * Vec3{static_cast<double>(p.nx), static_cast<double>(p.ny), static_cast<double>(p.nz)};
+    const Vec3 c{static_cast<double>(p.cx), static_cast<double>(p.cy), static_cast<double>(p.cz)};
+    const double volume = static_cast<double>(p.volume);
+    const double vel = dot(tool.point_velocity(c) - other.point_velocity(c), n);
+    const double f = input.force_scale * volume - damping_per_volume * vel * volume;
     if (!(f > 0.0)) continue;  // never pull the objects together
     ++result.pushing_pairs;
     force += f * n;
-    if (six_dof) torque += cross(p.centroid_a - tool.center_of_mass_world, f * n);
+    if (six_dof) torque += cross(c - tool.center_of_mass_world, f * n);
   }
   result.wrench.force = rotate(world_from_a.rotation, force);
   result.wrench.torque = rotate(world_from_a.rotation, torque);
