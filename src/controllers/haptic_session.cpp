@@ -69,9 +69,10 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   if (!device) return Error{fmt::format("{}: tool.device: {}", scene.source, device.error().message)};
   const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, session->haptic_hz_ * 0.5));
   session->manager_ = std::make_unique<haptico::HapticManager>(
-      std::move(device).value(), haptico::HapticManagerOptions{.rate_hz = session->haptic_hz_,
-                                                               .raise_priority = options.raise_priority,
-                                                               .trace_capacity = trace_capacity});
+      std::move(device).value(),
+      haptico::HapticManagerOptions{.rate_hz = session->haptic_hz_,
+                                    .raise_priority = options.raise_priority,
+                                    .trace_capacity = trace_capacity});
   if (auto opened = session->manager_->open(); !opened)
     return Error{fmt::format("{}: tool.device: {}", scene.source, opened.error().message)};
 

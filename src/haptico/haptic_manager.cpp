@@ -25,6 +25,7 @@ FixedRateLoopOptions loop_options(const HapticManagerOptions& o) {
   FixedRateLoopOptions l;
   l.rate_hz = o.rate_hz;
   l.raise_priority = o.raise_priority;
+  l.spin_us = o.spin_us;
   l.name = "uh-haptic";
   return l;
 }

@@ -24,6 +24,9 @@ namespace uh::haptico {
 struct HapticManagerOptions {
   double rate_hz = 1000.0;          ///< haptic tick rate [Hz], in (0, 10000]; devices run 1-4 kHz
   bool raise_priority = false;      ///< ask for SCHED_FIFO for the haptic thread (see FixedRateLoop)
+  /// Busy-wait this long before each tick's deadline [us] (FixedRateLoopOptions::spin_us): a longer
+  /// spin absorbs longer wake-up latencies of the OS at the cost of that much CPU per tick.
+  double spin_us = 80.0;
   std::size_t trace_capacity = 0;   ///< ticks the trace queue holds between drains; 0 = no trace
   /// Time [s] over which forces fade in after open(), start(), resume() and clear_fault(), so that a tool
   /// that starts inside an object does not jolt the hand; counted in ticks at rate_hz (also in
