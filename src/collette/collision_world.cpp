@@ -46,7 +46,8 @@ Result<ObjectId> CollisionWorld::add_object(CollisionObjectDef def) {
   object->tree = std::move(def.tree);
   object->name = std::move(def.name);
   object->pose = def.world_from_object;
-  object->pose_in.write(def.world_from_object);
+  object->has_pose = def.has_initial_pose;
+  if (def.has_initial_pose) object->pose_in.write(def.world_from_object);
   objects_.push_back(std::move(object));
   return static_cast<ObjectId>(objects_.size() - 1);
 }
@@ -117,13 +118,18 @@ void CollisionWorld::step(double time_s) { run_step(time_s); }
 
 void CollisionWorld::run_step(double time_s) {
   const auto step_start = std::chrono::steady_clock::now();
-  for (auto& object : objects_)
-    if (object->pose_in.update()) object->pose = object->pose_in.read_buffer();
+  for (auto& object : objects_) {
+    if (object->pose_in.update()) {
+      object->pose = object->pose_in.read_buffer();
+      object->has_pose = true;
+    }
+  }
 
   std::int64_t pairs_this_step = 0;
   for (auto& watcher : watchers_) {
     const Object& a = *objects_[static_cast<std::size_t>(watcher->a)];
     const Object& b = *objects_[static_cast<std::size_t>(watcher->b)];
+    if (!a.has_pose || !b.has_pose) continue;  // nothing to report before the mover's first pose
     ContactFrame& frame = watcher->frames.write_buffer();
 
     const double root_gap = norm(root_center_world(*b.tree, b.pose) - root_center_world(*a.tree, a.pose)) -

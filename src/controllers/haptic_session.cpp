@@ -59,9 +59,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   }
   auto tool_tree = load_shape_tree(scene.tool.shape, cache, options.build_progress);
   if (!tool_tree) return Error{fmt::format("{}: tool '{}': {}", scene.source, scene.tool.name, tool_tree.error().message)};
-  auto tool_id = world.add_object({.tree = *tool_tree,
-                                   .world_from_object = scene.tool.workspace.world_from_device_base,
-                                   .name = scene.tool.name});
+  // the tool's pose comes from the device on the first haptic tick (BridgingController)
+  auto tool_id = world.add_object({.tree = *tool_tree, .has_initial_pose = false, .name = scene.tool.name});
   if (!tool_id) return tool_id.error();
   session->tool_id_ = *tool_id;
 

@@ -178,3 +178,25 @@ TEST_F(WorldFixture, FreeRunningModeStartsAndStops) {
 
 }  // namespace
 }  // namespace uh::collette
+
+namespace uh::collette {
+namespace {
+
+TEST_F(WorldFixture, AnObjectWithoutAPoseIsNotQueriedUntilItsMoverSetsOne) {
+  CollisionWorld world;
+  const ObjectId a = *world.add_object({.tree = tree, .name = "a"});
+  // at the identity pose B would overlap A completely: it must not be reported before set_pose
+  const ObjectId b = *world.add_object({.tree = tree, .has_initial_pose = false, .name = "tool"});
+  const WatcherId w = *world.add_collision_watcher(a, b);
+  auto frame = std::make_unique<ContactFrame>();
+  world.step(0.0);
+  EXPECT_FALSE(world.read_contact(w, *frame)) << "no frame before the tool has a pose";
+  EXPECT_EQ(world.stats().queries, 0u);
+  world.set_pose(b, Pose{{}, {0.5, 0.0, 0.0}});
+  world.step(0.001);
+  ASSERT_TRUE(world.read_contact(w, *frame));
+  EXPECT_GT(frame->total_volume, 0.0);
+}
+
+}  // namespace
+}  // namespace uh::collette

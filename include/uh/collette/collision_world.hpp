@@ -63,6 +63,9 @@ struct CollisionWorldOptions {
 struct CollisionObjectDef {
   std::shared_ptr<const SphereTree> tree;  ///< non-empty, validated tree
   Pose world_from_object{};                ///< initial pose of the object's mesh frame in the world
+  /// False for an object whose pose only its mover knows (e.g. a tool bound to a device): its
+  /// watched pairs are skipped until the first set_pose(), instead of colliding at a made-up pose.
+  bool has_initial_pose = true;
   std::string name;                        ///< for messages
 };
 
@@ -138,6 +141,7 @@ class CollisionWorld {
     std::string name;
     LatestValue<Pose> pose_in;   // written by the object's mover, read by the collision step
     Pose pose{};                 // collision thread's copy
+    bool has_pose = false;       // collision thread: a pose was given (initially or by set_pose)
   };
   struct Watcher {
     ObjectId a = -1;
