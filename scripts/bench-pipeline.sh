@@ -23,6 +23,10 @@ run descent_multi "$uh_root/scenes/bunny_descent.json" --collision-hz 250
 run descent_held "$uh_root/scenes/bunny_descent.json" --collision-hz 250 --held-forces
 run descent4k_multi "$uh_root/scenes/bunny_descent.json" --collision-hz 250 --haptic-hz 4000
 run descent4k_held "$uh_root/scenes/bunny_descent.json" --collision-hz 250 --haptic-hz 4000 --held-forces
+run sdescent_multi "$uh_root/scenes/bunny_descent.json" --stepped --ticks-per-collision 4
+run sdescent_held "$uh_root/scenes/bunny_descent.json" --stepped --ticks-per-collision 4 --held-forces
+run sdescent4k_multi "$uh_root/scenes/bunny_descent.json" --stepped --haptic-hz 4000 --ticks-per-collision 16
+run sdescent4k_held "$uh_root/scenes/bunny_descent.json" --stepped --haptic-hz 4000 --ticks-per-collision 16 --held-forces
 run circle_stepped "$uh_root/scenes/bunny_coupling_circle.json" --stepped --ticks-per-collision 1
 run circle_threaded "$uh_root/scenes/bunny_coupling_circle.json"
 
@@ -39,13 +43,15 @@ for name, label in [("deep1k", "default scene, 1 kHz"), ("deep4k", "default scen
           f"{c['rate_hz']['median']:.0f} / {c['rate_hz']['min']:.0f} | {c['query_us']['median']:.0f} / {c['query_us']['p99']:.0f} / {c['query_us']['max']:.0f} | "
           f"{c['max_pairs']} | {f['max_n']:.2f} | {f['clamped']} |")
 print()
-print("| force continuity, collision throttled to 250 Hz (bunny_descent) | haptic 1 kHz | haptic 4 kHz |")
-print("|---|---|---|")
-m1, h1 = j["descent_multi"]["force"]["max_step_n"], j["descent_held"]["force"]["max_step_n"]
-m4, h4 = j["descent4k_multi"]["force"]["max_step_n"], j["descent4k_held"]["force"]["max_step_n"]
-print(f"| largest tick-to-tick step, held forces [N] | {h1:.5f} | {h4:.5f} |")
-print(f"| largest tick-to-tick step, multi-rate re-evaluation [N] | {m1:.5f} | {m4:.5f} |")
-print(f"| ratio held / multi-rate | {h1 / m1 if m1 > 0 else float('inf'):.1f}x | {h4 / m4 if m4 > 0 else float('inf'):.1f}x |")
+print("| force continuity, collision at 250 Hz (bunny_descent) | threaded, haptic 1 kHz | threaded, haptic 4 kHz | stepped, 1 kHz | stepped, 4 kHz |")
+print("|---|---|---|---|---|")
+cols = [("descent_multi", "descent_held"), ("descent4k_multi", "descent4k_held"), ("sdescent_multi", "sdescent_held"),
+        ("sdescent4k_multi", "sdescent4k_held")]
+ms = [j[m]["force"]["max_step_n"] for m, _ in cols]
+hs = [j[h]["force"]["max_step_n"] for _, h in cols]
+print("| largest tick-to-tick step, held forces [N] | " + " | ".join(f"{h:.5f}" for h in hs) + " |")
+print("| largest tick-to-tick step, multi-rate re-evaluation [N] | " + " | ".join(f"{m:.5f}" for m in ms) + " |")
+print("| ratio held / multi-rate | " + " | ".join(f"{h / m:.1f}x" if m > 0 else "inf" for m, h in zip(ms, hs)) + " |")
 print()
 print("| passivity, closed circle through the surface with the virtual coupling | energy into the hand [J] | max force [N] |")
 print("|---|---|---|")

@@ -64,7 +64,12 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   if (!tool_id) return tool_id.error();
   session->tool_id_ = *tool_id;
 
-  auto device = registry.create(scene.tool.device.driver, scene.tool.device.config);
+  // a simulated device advances its own time by one period per tick: it runs at the haptic rate
+  // unless the scene says otherwise (else a 4 kHz session would play its script four times too fast)
+  haptico::DeviceConfig device_config = scene.tool.device.config;
+  if (scene.tool.device.driver.rfind("sim-", 0) == 0 && !device_config.has("rate_hz"))
+    device_config.set("rate_hz", session->haptic_hz_);
+  auto device = registry.create(scene.tool.device.driver, device_config);
   if (!device) return Error{fmt::format("{}: tool.device: {}", scene.source, device.error().message)};
   const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, session->haptic_hz_ * 0.5));
   session->manager_ = std::make_unique<haptico::HapticManager>(
