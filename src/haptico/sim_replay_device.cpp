@@ -47,6 +47,10 @@ Result<std::vector<TrajectorySample>> SimReplayDevice::parse_csv(std::istream& i
   std::string line;
   int line_number = 0;
   bool seen_content = false;
+  // where each of time_s,x,y,z,qw,qx,qy,qz stands in a row; a header may name them in any order
+  // among other columns (a `uh run --trace` CSV: its device_time_s is the time column)
+  std::size_t column[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  std::size_t row_fields = 8;
   while (std::getline(in, line)) {
     ++line_number;
     const std::string_view text = trim(line);
@@ -56,24 +60,37 @@ Result<std::vector<TrajectorySample>> SimReplayDevice::parse_csv(std::istream& i
     if (!seen_content && !to_number(fields.front(), first)) {
       // a header line: accept it only if it names the expected columns
       seen_content = true;
-      std::string normalized;
-      for (std::size_t i = 0; i < fields.size(); ++i) normalized += fmt::format("{}{}", i ? "," : "", trim(fields[i]));
-      if (normalized != kColumns) {
+      static constexpr std::string_view kNames[8] = {"time_s", "x", "y", "z", "qw", "qx", "qy", "qz"};
+      bool found[8] = {};
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        const std::string_view name = trim(fields[i]);
+        for (std::size_t k = 0; k < 8; ++k) {
+          const bool match = name == kNames[k] || (k == 0 && name == "device_time_s" && !found[0]);
+          if (match && !found[k]) {
+            column[k] = i;
+            found[k] = true;
+            break;
+          }
+        }
+      }
+      if (!std::all_of(std::begin(found), std::end(found), [](bool f) { return f; })) {
         return Error{fmt::format("{}:{}: header '{}' does not match the expected columns '{}'", source_name,
                                  line_number, text, kColumns)};
       }
+      row_fields = fields.size();
       continue;
     }
     seen_content = true;
-    if (fields.size() != 8) {
-      return Error{fmt::format("{}:{}: expected 8 comma-separated numbers ({}), found {} fields", source_name,
-                               line_number, kColumns, fields.size())};
+    if (fields.size() != row_fields) {
+      return Error{fmt::format("{}:{}: expected {} comma-separated numbers ({}), found {} fields", source_name,
+                               line_number, row_fields, row_fields == 8 ? kColumns : "as named by the header",
+                               fields.size())};
     }
     double v[8] = {};
     for (std::size_t i = 0; i < 8; ++i) {
-      if (!to_number(fields[i], v[i]) || !std::isfinite(v[i])) {
-        return Error{fmt::format("{}:{}: field {} ('{}') is not a finite number", source_name, line_number, i + 1,
-                                 trim(fields[i]))};
+      if (!to_number(fields[column[i]], v[i]) || !std::isfinite(v[i])) {
+        return Error{fmt::format("{}:{}: field {} ('{}') is not a finite number", source_name, line_number,
+                                 column[i] + 1, trim(fields[column[i]]))};
       }
     }
     const double qn = std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);

@@ -1,4 +1,5 @@
 #include "uh/haptico/sim_replay_device.hpp"
+#include "uh/haptico/trace_sample.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,6 +21,34 @@ std::string error_of(const std::string& text) {
   auto r = parse(text);
   EXPECT_FALSE(r.has_value()) << "parsed although invalid: " << text;
   return r ? std::string() : r.error().message;
+}
+
+TEST(SimReplayDevice, ReadsASessionTraceByColumnName) {
+  // a `uh run --trace` file: many columns, device_time_s is the time, x..qz the pose
+  std::ostringstream trace;
+  write_trace_header(trace);
+  for (int k = 0; k < 3; ++k) {
+    TraceSample s;
+    s.tick_time_s = 100.0 + 0.001 * k;
+    s.state.time_s = 0.001 * k;
+    s.state.position = {0.01 * k, -0.02, 0.03};
+    s.state.orientation = normalized(Quat{1.0, 0.1 * k, 0.0, 0.0});
+    s.sent.force = {1.0, 2.0, 3.0};
+    write_trace_row(trace, s);
+  }
+  const auto r = parse(trace.str());
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_EQ(r->size(), 3u);
+  EXPECT_DOUBLE_EQ((*r)[2].time_s, 0.002);
+  EXPECT_NEAR((*r)[2].pose.position.x, 0.02, 1e-12);
+  EXPECT_NEAR((*r)[2].pose.position.y, -0.02, 1e-12);
+  EXPECT_NEAR((*r)[2].pose.rotation.x, normalized(Quat{1.0, 0.2, 0.0, 0.0}).x, 1e-9);
+  // a header that lacks a pose column is still refused, with the expected columns named
+  EXPECT_NE(error_of("time_s,x,y,z,qw,qx,qy,extra\n0,0,0,0,1,0,0,0\n").find("does not match the expected columns"),
+            std::string::npos);
+  // rows must have as many fields as the header
+  EXPECT_NE(error_of("extra,time_s,x,y,z,qw,qx,qy,qz\n7,0,0,0,0,1,0,0,0\n0.1,0,0,0,1,0,0,0\n").find("found 8 fields"),
+            std::string::npos);
 }
 
 TEST(SimReplayDevice, ParsesHeaderCommentsAndRows) {
