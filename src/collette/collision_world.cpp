@@ -145,6 +145,7 @@ void CollisionWorld::run_step(double time_s) {
       frame.truncated = false;
       frame.restoring_direction_world = Vec3{};
       frame.volume_centroid_world = Vec3{};
+      frame.volume_gradient_world = Vec3{};
       frame.query_seconds = 0.0;
       frame.world_from_a = a.pose;
       frame.world_from_b = b.pose;

@@ -300,6 +300,7 @@ void VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& worl
   out.total_volume = r.total_volume;
   out.restoring_direction_world = transform_vector(world_from_a, r.restoring_direction);
   out.volume_centroid_world = r.total_volume > 0.0 ? transform_point(world_from_a, r.volume_centroid) : Vec3{};
+  out.volume_gradient_world = transform_vector(world_from_a, r.volume_gradient);
   out.distance = 0.0;
   const std::int32_t n = std::min<std::int32_t>(r.pair_count, ContactFrame::kMaxPairs);
   const Mat3 m = rotation_matrix(normalized(world_from_a.rotation));

@@ -96,6 +96,8 @@ TEST_F(WorldFixture, StepMatchesBruteForceAndBroadcastsContactAndItsEnd) {
   // lattice-on-lattice pair normals are noisy, but their volume-weighted sum must point out of A (+x)
   EXPECT_GT(frame->restoring_direction_world.x, 0.0) << "B sits at +x of A, so it is pushed towards +x";
   EXPECT_NEAR(norm(frame->restoring_direction_world), 1.0, 1e-9);
+  // the volume shrinks when B moves out along +x
+  EXPECT_LT(frame->volume_gradient_world.x, 0.0);
   EXPECT_FALSE(world.read_contact(w, *frame)) << "no newer frame yet";
 
   world.set_pose(b, apart);

@@ -51,6 +51,10 @@ struct ContactFrame {
   double total_volume = 0.0;        ///< sum of all pair volumes [length^3], >= 0
   Vec3 restoring_direction_world{}; ///< unit direction of sum(volume * normal): pushes B out of A; zero if none
   Vec3 volume_centroid_world{};     ///< volume-weighted mean of the lens centroids [length]
+  /// d(total_volume)/d(position of B), world frame [length^2]: -sum(pi a^2 normal) over the pairs
+  /// (a = radius of a pair's intersection circle). Its negation is the exact restoring direction
+  /// of the packings, closer to the meshes' true one than restoring_direction_world.
+  Vec3 volume_gradient_world{};
   double distance = 0.0;            ///< separation when apart (upper bound), 0 when touching [length]
   double query_seconds = 0.0;       ///< time the query took [s]
   std::int32_t pair_count = 0;      ///< number of valid entries in pairs
@@ -72,6 +76,7 @@ inline void copy_contact_frame(const ContactFrame& src, ContactFrame& dst) {
   dst.total_volume = src.total_volume;
   dst.restoring_direction_world = src.restoring_direction_world;
   dst.volume_centroid_world = src.volume_centroid_world;
+  dst.volume_gradient_world = src.volume_gradient_world;
   dst.distance = src.distance;
   dst.query_seconds = src.query_seconds;
   dst.pair_count = src.pair_count;
