@@ -33,7 +33,6 @@ void ProgressBar::draw(double fraction) {
   bar.resize(kWidth, '.');
   std::fprintf(stderr, "\r%s [%s] %3.0f%%  %.1f s", label_.c_str(), bar.c_str(), fraction * 100.0, seconds);
   std::fflush(stderr);
-  last_fraction_ = fraction;
 }
 
 void ProgressBar::finish() {

@@ -27,7 +27,6 @@ class ProgressBar {
   std::string label_;
   bool interactive_ = false;
   bool finished_ = false;
-  double last_fraction_ = -1.0;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };

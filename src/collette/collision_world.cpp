@@ -30,7 +30,6 @@ Vec3 root_center_world(const SphereTree& tree, const Pose& world_from_object) {
 CollisionWorld::CollisionWorld(CollisionWorldOptions options)
     : options_(std::move(options)),
       volume_query_(VolumeQueryOptions{.contact_margin = static_cast<float>(std::max(0.0, options_.contact_margin))}),
-      empty_frame_(std::make_unique<ContactFrame>()),
       loop_(FixedRateLoopOptions{.rate_hz = options_.rate_hz > 0.0 ? options_.rate_hz : 1000.0,
                                  .raise_priority = options_.raise_priority,
                                  .fifo_priority = options_.fifo_priority,

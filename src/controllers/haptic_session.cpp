@@ -98,6 +98,13 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   return session;
 }
 
+void HapticSession::begin_run() {
+  report_.timeline.clear();
+  report_.collision_rates.clear();
+  report_.force_max_step_n = 0.0;
+  have_last_sent_ = false;
+}
+
 void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace, double t0) {
   buffer.clear();
   manager_->drain_trace(buffer);
@@ -113,10 +120,7 @@ void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::o
 
 Status HapticSession::run(double seconds, const std::function<void(const LiveStatus&)>& on_status, std::ostream* trace) {
   if (!(seconds > 0.0)) return Error{"HapticSession::run: the duration must be positive"};
-  report_.timeline.clear();
-  report_.collision_rates.clear();
-  report_.force_max_step_n = 0.0;
-  have_last_sent_ = false;
+  begin_run();
   report_.timeline.reserve(static_cast<std::size_t>(seconds * haptic_hz_ * 1.05) + 16);
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
@@ -163,10 +167,7 @@ Status HapticSession::run(double seconds, const std::function<void(const LiveSta
 Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, std::ostream* trace) {
   if (!(seconds > 0.0)) return Error{"HapticSession::run_stepped: the duration must be positive"};
   if (ticks_per_collision_step < 1) return Error{"HapticSession::run_stepped: ticks per collision step must be >= 1"};
-  report_.timeline.clear();
-  report_.collision_rates.clear();
-  report_.force_max_step_n = 0.0;
-  have_last_sent_ = false;
+  begin_run();
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));

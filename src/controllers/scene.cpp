@@ -135,8 +135,6 @@ class FieldReader {
     return quat(*it, p, "rotation", out.rotation);
   }
 
-  const std::string& source() const { return source_; }
-
  private:
   std::string source_;
 };

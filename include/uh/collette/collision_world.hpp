@@ -159,7 +159,6 @@ class CollisionWorld {
   OnCollision on_collision_;
   VolumeQuery volume_query_;
   DistanceQuery distance_query_;
-  std::unique_ptr<ContactFrame> empty_frame_;  // broadcast when a contact ends, reused
   FixedRateLoop loop_;
   std::thread free_thread_;
   std::atomic<bool> free_running_{false};

@@ -116,6 +116,7 @@ class HapticSession {
 
  private:
   HapticSession() = default;
+  void begin_run();
   void collect_report(double seconds, bool stepped);
   void take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace, double t0);
 
