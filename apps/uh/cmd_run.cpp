@@ -26,6 +26,7 @@ struct RunArgs {
   std::string plot;
   double haptic_hz = 0.0;
   double collision_hz = -1.0;
+  double coherence_skin = -1.0;
   bool held_forces = false;
   bool stepped = false;
   int ticks_per_collision = 4;
@@ -55,6 +56,7 @@ int run_session(const RunArgs& args) {
   controllers::SessionOptions options;
   if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
   if (args.collision_hz >= 0.0) options.collision_hz = args.collision_hz;
+  if (args.coherence_skin >= 0.0) options.coherence_skin = args.coherence_skin;
   if (args.held_forces) options.multi_rate = false;
   options.raise_priority = !args.no_realtime;
   options.cache_dir = cache;
@@ -124,6 +126,9 @@ void add_run_command(CLI::App& app, CommandRunner& runner) {
   r->add_option("--plot", args.plot, "write a PNG of force, torque and collision rate over time");
   r->add_option("--haptic-hz", args.haptic_hz, "override the haptic rate [Hz]")->check(CLI::Range(1.0, 10000.0));
   r->add_option("--collision-hz", args.collision_hz, "override the collision rate [Hz] (0 = free-running)")->check(CLI::Range(0.0, 10000.0));
+  r->add_option("--coherence-skin", args.coherence_skin,
+                "override the volume query's frame-to-frame coherence skin [m] (0 = traverse every step)")
+      ->check(CLI::Range(0.0, 1.0));
   r->add_flag("--held-forces", args.held_forces, "hold each collision frame's force instead of re-evaluating every tick");
   r->add_flag("--stepped", args.stepped, "deterministic run on one thread in simulated time");
   r->add_option("--ticks-per-collision", args.ticks_per_collision, "with --stepped: haptic ticks per collision step")

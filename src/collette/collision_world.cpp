@@ -63,6 +63,10 @@ Result<WatcherId> CollisionWorld::add_collision_watcher(ObjectId a, ObjectId b) 
   auto watcher = std::make_unique<Watcher>();
   watcher->a = a;
   watcher->b = b;
+  if (options_.coherence_skin > 0.0)
+    watcher->coherent_query = std::make_unique<VolumeQuery>(
+        VolumeQueryOptions{.contact_margin = static_cast<float>(std::max(0.0, options_.contact_margin)),
+                           .coherence_skin = static_cast<float>(options_.coherence_skin)});
   watchers_.push_back(std::move(watcher));
   return static_cast<WatcherId>(watchers_.size() - 1);
 }
@@ -89,6 +93,7 @@ Status CollisionWorld::start() {
   queries_.reset();
   contact_frames_.reset();
   truncated_frames_.reset();
+  coherent_queries_.reset();
   max_pairs_.store(0);
   stop_requested_.store(false);
   if (options_.rate_hz > 0.0) {
@@ -135,7 +140,9 @@ void CollisionWorld::run_step(double time_s) {
                             static_cast<double>(a.tree->root().radius) - static_cast<double>(b.tree->root().radius);
     if (root_gap < options_.contact_margin) {
       const auto query_start = std::chrono::steady_clock::now();
-      volume_query_.run(*a.tree, *b.tree, a.pose, b.pose, frame);
+      VolumeQuery& query = watcher->coherent_query ? *watcher->coherent_query : volume_query_;
+      query.run(*a.tree, *b.tree, a.pose, b.pose, frame);
+      if (query.result().reused_candidates) coherent_queries_.increment();
       query_time_.record(elapsed_ns(query_start));
       queries_.increment();
     } else {
@@ -189,6 +196,7 @@ CollisionWorldStats CollisionWorld::stats() const {
   s.queries = queries_.load();
   s.contact_frames = contact_frames_.load();
   s.truncated_frames = truncated_frames_.load();
+  s.coherent_queries = coherent_queries_.load();
   s.last_pairs = last_pairs_.load(std::memory_order_relaxed);
   s.max_pairs = max_pairs_.load(std::memory_order_relaxed);
   if (options_.rate_hz > 0.0) s.missed_deadlines = loop_.stats().missed_deadlines;

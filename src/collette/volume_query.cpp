@@ -30,6 +30,11 @@ VolumeQuery::VolumeQuery(const VolumeQueryOptions& options) : options_(options) 
   options_.pair_capacity = std::max(0, options_.pair_capacity);
   stack_.reserve(static_cast<std::size_t>(std::max(64, options_.stack_reserve)));
   if (options_.collect_pairs) pairs_.resize(static_cast<std::size_t>(options_.pair_capacity));
+  options_.coherence_skin = std::isfinite(options_.coherence_skin) ? std::max(0.f, options_.coherence_skin) : 0.f;
+  if (options_.coherence_skin > 0.f) {
+    const int reserve = options_.candidate_reserve > 0 ? options_.candidate_reserve : std::max(1024, 2 * options_.pair_capacity);
+    candidates_.reserve(static_cast<std::size_t>(reserve));
+  }
 }
 
 namespace {
@@ -49,6 +54,8 @@ struct Traversal {
   PairOverlap* out;
   std::int32_t capacity;
   float margin;                // pairs closer than this but not overlapping are stored with volume 0
+  float search_margin;         // node and leaf pairs closer than this are followed (margin, plus the skin when keeping)
+  std::vector<VolumeQuery::Candidate>* candidates;  // keeping traversals: (A leaf, B leaf index) within search_margin
   std::int32_t stored = 0;
   std::int64_t overlapping = 0;
   std::int64_t near = 0;       // stored-or-counted pairs within the margin that do not overlap
@@ -57,7 +64,7 @@ struct Traversal {
   Totals sum;
 
   // an overlapping leaf pair: A's leaf la at (ax, ay, az, ar), B's leaf lb at (bx, by, bz, br) in A's frame
-  void add_pair(float ax, float ay, float az, float ar, float bx, float by, float bz, float br, std::int32_t la,
+  [[gnu::always_inline]] inline void add_pair(float ax, float ay, float az, float ar, float bx, float by, float bz, float br, std::int32_t la,
                 std::int32_t lb) {
     const float dx = bx - ax, dy = by - ay, dz = bz - az;
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -178,7 +185,23 @@ struct Traversal {
 
   void push(std::int32_t ia, std::int32_t ib, float x, float y, float z, float r) { stack->push_back({ia, ib, x, y, z, r}); }
 
-  template <int WA, int WB>
+  // a leaf pair within search_margin: evaluated now, or kept as a candidate (B's leaf by index;
+  // VolumeQuery::traverse turns it into a slot); grows only past every earlier run's need
+  template <bool Keep>
+  [[gnu::always_inline]] inline void leaf_pair(float ax, float ay, float az, float ar, float bx, float by, float bz, float br, std::int32_t la,
+                 std::int32_t lb) {
+    if constexpr (Keep) {
+      if (candidates->size() == candidates->capacity()) candidates->reserve(2 * candidates->capacity() + 1024);
+      candidates->push_back({la, lb});
+      // the same test as VolumeQuery::test_candidates, so that both give the same pairs
+      const float dx = bx - ax, dy = by - ay, dz = bz - az, rs = br + (ar + margin);
+      if (dx * dx + dy * dy + dz * dz < rs * rs) add_pair(ax, ay, az, ar, bx, by, bz, br, la, lb);
+    } else {
+      add_pair(ax, ay, az, ar, bx, by, bz, br, la, lb);
+    }
+  }
+
+  template <int WA, int WB, bool Keep>
   void run() {
     std::vector<VolumeQuery::StackEntry>& st = *stack;
     alignas(16) float tb[4 * WB];
@@ -194,14 +217,14 @@ struct Traversal {
         transform_block<WB>(e.b, tb);
         const std::uint32_t count_b = b.count[e.b];
         const std::uint32_t leaf_b = b.leaf_mask[e.b];
-        std::uint32_t hits = overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius + margin) & ((1u << count_b) - 1u);
+        std::uint32_t hits = overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius + search_margin) & ((1u << count_b) - 1u);
         leaf_tests += popcount8(leaf_b);
         const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
         while (hits) {
           const int j = std::countr_zero(hits);
           hits &= hits - 1u;
           if ((leaf_b >> j) & 1u)
-            add_pair(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
+            leaf_pair<Keep>(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
           else
             push(e.a, cb[j], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
         }
@@ -212,13 +235,13 @@ struct Traversal {
       const std::uint32_t leaf_a = a.leaf_mask[e.a];
       if (e.b < 0) {
         // B is a leaf: A's children against it (padding lanes of A never overlap)
-        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br + margin);
+        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br + search_margin);
         leaf_tests += popcount8(leaf_a);
         while (hits) {
           const int k = std::countr_zero(hits);
           hits &= hits - 1u;
           if ((leaf_a >> k) & 1u)
-            add_pair(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
+            leaf_pair<Keep>(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
           else
             push(ca[k], e.b, e.bx, e.by, e.bz, e.br);
         }
@@ -231,13 +254,13 @@ struct Traversal {
       const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
       leaf_tests += popcount8(leaf_a) * popcount8(leaf_b);
       for (int j = 0; j < count_b; ++j) {
-        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j] + margin);
+        std::uint32_t hits = overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j] + search_margin);
         const bool b_leaf = (leaf_b >> j) & 1u;
         while (hits) {
           const int k = std::countr_zero(hits);
           hits &= hits - 1u;
           if (b_leaf && ((leaf_a >> k) & 1u))
-            add_pair(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~ca[k], ~cb[j]);
+            leaf_pair<Keep>(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~ca[k], ~cb[j]);
           else
             push(ca[k], cb[j], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
         }
@@ -248,12 +271,39 @@ struct Traversal {
 
 }  // namespace
 
-const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) {
-  assert(!a.empty() && !b.empty() && "uh::collette::VolumeQuery::run(): empty tree");
-  result_ = VolumeQueryResult{};
-  Traversal t{a.blocks(), b.blocks(), a.leaves().data(), detail::FloatTransform::from(b_in_a), &stack_, pairs_.data(),
-              options_.collect_pairs ? options_.pair_capacity : 0, std::max(0.f, options_.contact_margin), 0, 0, 0, 0, 0,
-              Totals{}};
+namespace {
+
+Traversal make_traversal(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, const VolumeQueryOptions& options,
+                         std::vector<VolumeQuery::StackEntry>* stack, PairOverlap* pairs,
+                         std::vector<VolumeQuery::Candidate>* candidates) {
+  const float margin = std::max(0.f, options.contact_margin);
+  return Traversal{a.blocks(), b.blocks(), a.leaves().data(), detail::FloatTransform::from(b_in_a), stack, pairs,
+                   options.collect_pairs ? options.pair_capacity : 0, margin, margin, candidates, 0, 0, 0, 0, 0, Totals{}};
+}
+
+// Fills a result from a finished traversal or candidate test.
+void finish(const Traversal& t, bool collect_pairs, VolumeQueryResult& result) {
+  result.total_volume = t.sum.volume;
+  result.weighted_normal_sum = {t.sum.nx, t.sum.ny, t.sum.nz};
+  result.restoring_direction = normalized(result.weighted_normal_sum);
+  if (t.sum.volume > 0.0) result.volume_centroid = Vec3{t.sum.cx, t.sum.cy, t.sum.cz} / t.sum.volume;
+  result.volume_gradient = Vec3{t.sum.gx, t.sum.gy, t.sum.gz} * -kPi;
+  result.pair_count = t.stored;
+  result.truncated = t.overlapping + t.near > t.stored && collect_pairs;
+  result.near_pairs = t.near;
+  result.stats.node_pairs_visited = t.visited;
+  result.stats.leaf_pairs_tested = t.leaf_tests;
+  result.stats.overlapping_pairs = t.overlapping;
+}
+
+}  // namespace
+
+void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, bool keep_candidates) {
+  Traversal t = make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_);
+  if (keep_candidates) {
+    t.search_margin += options_.coherence_skin;
+    candidates_.clear();
+  }
   stack_.clear();
 
   // the roots: A's and B's root spheres, B's moved into A's frame
@@ -262,31 +312,111 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
   float x, y, z;
   t.xf.apply(rb.x, rb.y, rb.z, x, y, z);
   const float dx = x - ra.x, dy = y - ra.y, dz = z - ra.z;
-  const float rs = ra.radius + rb.radius + t.margin;
+  const float rs = ra.radius + rb.radius + t.search_margin;
   if (ra.is_leaf() && rb.is_leaf()) ++t.leaf_tests;
   if (dx * dx + dy * dy + dz * dz < rs * rs) {
-    if (ra.is_leaf() && rb.is_leaf())
-      t.add_pair(ra.x, ra.y, ra.z, ra.radius, x, y, z, rb.radius, ra.first, rb.first);
-    else
+    if (ra.is_leaf() && rb.is_leaf()) {
+      if (keep_candidates)
+        t.leaf_pair<true>(ra.x, ra.y, ra.z, ra.radius, x, y, z, rb.radius, ra.first, rb.first);
+      else
+        t.add_pair(ra.x, ra.y, ra.z, ra.radius, x, y, z, rb.radius, ra.first, rb.first);
+    } else {
       t.push(t.a.root, t.b.root, x, y, z, rb.radius);
+    }
   }
   // one loop per pair of block widths (trees built with arity <= 4 and > 4 can meet)
-  if (t.a.width == 4)
-    t.b.width == 4 ? t.run<4, 4>() : t.run<4, 8>();
-  else
-    t.b.width == 4 ? t.run<8, 4>() : t.run<8, 8>();
+  const bool wide_a = t.a.width != 4, wide_b = t.b.width != 4;
+  if (keep_candidates) {
+    if (!wide_a) wide_b ? t.run<4, 8, true>() : t.run<4, 4, true>();
+    else wide_b ? t.run<8, 8, true>() : t.run<8, 4, true>();
+  } else {
+    if (!wide_a) wide_b ? t.run<4, 8, false>() : t.run<4, 4, false>();
+    else wide_b ? t.run<8, 8, false>() : t.run<8, 4, false>();
+  }
+  finish(t, options_.collect_pairs, result_);
+  if (!keep_candidates) return;
+  result_.candidate_pairs = static_cast<std::int64_t>(candidates_.size());
 
-  result_.total_volume = t.sum.volume;
-  result_.weighted_normal_sum = {t.sum.nx, t.sum.ny, t.sum.nz};
-  result_.restoring_direction = normalized(result_.weighted_normal_sum);
-  if (t.sum.volume > 0.0) result_.volume_centroid = Vec3{t.sum.cx, t.sum.cy, t.sum.cz} / t.sum.volume;
-  result_.volume_gradient = Vec3{t.sum.gx, t.sum.gy, t.sum.gz} * -kPi;
-  result_.pair_count = t.stored;
-  result_.truncated = t.overlapping + t.near > t.stored && options_.collect_pairs;
-  result_.near_pairs = t.near;
-  result_.stats.node_pairs_visited = t.visited;
-  result_.stats.leaf_pairs_tested = t.leaf_tests;
-  result_.stats.overlapping_pairs = t.overlapping;
+  // B's leaves among the candidates get slots, in first-seen order (the traversal's locality)
+  const auto leaf_count_b = static_cast<std::size_t>(b.leaf_count());
+  if (slot_of_leaf_b_.size() != leaf_count_b) slot_of_leaf_b_.assign(leaf_count_b, -1);
+  if (candidate_leaves_b_.capacity() < leaf_count_b) candidate_leaves_b_.reserve(leaf_count_b);
+  if (moved_leaves_b_.size() < leaf_count_b) moved_leaves_b_.resize(leaf_count_b);
+  candidate_leaves_b_.clear();
+  for (Candidate& c : candidates_) {
+    std::int32_t& slot = slot_of_leaf_b_[static_cast<std::size_t>(c.slot_b)];
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(candidate_leaves_b_.size());
+      candidate_leaves_b_.push_back(c.slot_b);
+    }
+    c.slot_b = slot;
+  }
+  for (const std::int32_t leaf : candidate_leaves_b_) slot_of_leaf_b_[static_cast<std::size_t>(leaf)] = -1;
+  candidate_tree_a_ = &a;
+  candidate_tree_b_ = &b;
+  candidate_pose_ = b_in_a;
+}
+
+bool VolumeQuery::candidates_hold(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) const {
+  if (&a != candidate_tree_a_ || &b != candidate_tree_b_) return false;
+  // How far any point of B can have moved relative to A since the candidates were kept: B's leaf
+  // centres lie within its root sphere (c, R), and x(P1) - x(P0) = (R1 - R0) q + (t1 - t0) with
+  // q = c + u, |u| <= R, so |move| <= |P1 c - P0 c| + |R1 - R0| R, where |R1 - R0| = 2 sin(theta/2)
+  // for the relative rotation angle theta: twice the vector part of conj(q0) q1.
+  const SphereTreeNode& root_b = b.root();
+  const SphereTreeNode& root_a = a.root();
+  const Vec3 c{root_b.x, root_b.y, root_b.z};
+  const Vec3 c_now = transform_point(b_in_a, c);
+  const Quat rel = conjugate(normalized(candidate_pose_.rotation)) * normalized(b_in_a.rotation);
+  const double sin_half = std::sqrt(rel.x * rel.x + rel.y * rel.y + rel.z * rel.z);
+  const double move = norm(c_now - transform_point(candidate_pose_, c)) + 2.0 * sin_half * static_cast<double>(root_b.radius);
+  // float round-off of the traversal that kept them, a few ulps of the coordinates' magnitude
+  const double scale = norm(c_now) + static_cast<double>(root_b.radius) + norm(Vec3{root_a.x, root_a.y, root_a.z}) +
+                       static_cast<double>(root_a.radius);
+  return std::isfinite(move) && move + 1e-5 * scale < static_cast<double>(options_.coherence_skin);
+}
+
+void VolumeQuery::test_candidates(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) {
+  Traversal t = make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_);
+  // B's candidate leaves moved into A's frame once, with the traversal's float arithmetic (same
+  // association as its SIMD transform), so that a pair's distance is bit for bit the traversal's
+  const auto leaves_b = b.leaves();
+  const detail::FloatTransform& f = t.xf;
+  Sphere* moved = moved_leaves_b_.data();
+  for (std::size_t i = 0; i < candidate_leaves_b_.size(); ++i) {
+    const Sphere& s = leaves_b[static_cast<std::size_t>(candidate_leaves_b_[i])];
+    moved[i] = {(f.r[0][0] * s.x + f.r[0][1] * s.y) + (f.r[0][2] * s.z + f.t[0]),
+                (f.r[1][0] * s.x + f.r[1][1] * s.y) + (f.r[1][2] * s.z + f.t[1]),
+                (f.r[2][0] * s.x + f.r[2][1] * s.y) + (f.r[2][2] * s.z + f.t[2]), s.radius};
+  }
+  const Sphere* leaves_a = t.leaves_a;
+  for (const Candidate& c : candidates_) {
+    const Sphere& sa = leaves_a[c.leaf_a];
+    const Sphere& sb = moved[c.slot_b];
+    const float dx = sb.x - sa.x, dy = sb.y - sa.y, dz = sb.z - sa.z, rs = sb.radius + (sa.radius + t.margin);
+    if (dx * dx + dy * dy + dz * dz < rs * rs)
+      t.add_pair(sa.x, sa.y, sa.z, sa.radius, sb.x, sb.y, sb.z, sb.radius, c.leaf_a,
+                 candidate_leaves_b_[static_cast<std::size_t>(c.slot_b)]);
+  }
+  t.leaf_tests = static_cast<std::int64_t>(candidates_.size());
+  finish(t, options_.collect_pairs, result_);
+  result_.candidate_pairs = static_cast<std::int64_t>(candidates_.size());
+}
+
+const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) {
+  assert(!a.empty() && !b.empty() && "uh::collette::VolumeQuery::run(): empty tree");
+  result_ = VolumeQueryResult{};
+  if (options_.coherence_skin <= 0.f) {
+    traverse(a, b, b_in_a, false);
+    return result_;
+  }
+  // a traversal that keeps candidates evaluates the pairs as it goes; later runs test only those
+  if (candidates_hold(a, b, b_in_a)) {
+    test_candidates(a, b, b_in_a);
+    result_.reused_candidates = true;
+  } else {
+    traverse(a, b, b_in_a, true);
+  }
   return result_;
 }
 

@@ -47,7 +47,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
       .rate_hz = session->collision_hz_,
       .raise_priority = options.raise_priority,
-      .contact_margin = options.contact_margin.value_or(scene.contact_margin)});
+      .contact_margin = options.contact_margin.value_or(scene.contact_margin),
+      .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;
   for (const SceneObject& object : scene.objects) {
@@ -212,6 +213,7 @@ void HapticSession::collect_report(double seconds, bool stepped) {
   r.query_max_us = ws.query_time.max_ns * 1e-3;
   r.max_pairs = ws.max_pairs;
   r.truncated_frames = ws.truncated_frames;
+  r.coherent_queries = ws.coherent_queries;
   if (stepped) {
     r.collision_rate_min_hz = r.collision_rate_median_hz = r.collision_rate_mean_hz = collision_hz_;
   } else {
@@ -257,7 +259,8 @@ std::string session_report_json(const SessionReport& r) {
         {"steps", r.collision_steps},
         {"query_us", {{"median", r.query_median_us}, {"p99", r.query_p99_us}, {"max", r.query_max_us}}},
         {"max_pairs", r.max_pairs},
-        {"truncated_frames", r.truncated_frames}}},
+        {"truncated_frames", r.truncated_frames},
+        {"coherent_queries", r.coherent_queries}}},
       {"force",
        {{"max_n", r.force_max_n},
         {"max_torque_nm", r.torque_max_nm},

@@ -294,8 +294,9 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
 
   if (const auto it = root.find("collision"); it != root.end()) {
     UH_CHECK(r.require_object(*it, "collision"));
-    UH_CHECK(r.check_keys(*it, "collision", {"contact_margin"}));
+    UH_CHECK(r.check_keys(*it, "collision", {"contact_margin", "coherence_skin"}));
     UH_CHECK(r.number(*it, "collision", "contact_margin", scene.contact_margin, 0.0, 1.0));
+    UH_CHECK(r.number(*it, "collision", "coherence_skin", scene.coherence_skin, 0.0, 1.0));
   }
 
   const auto objects = root.find("objects");

@@ -120,6 +120,48 @@ TEST_F(WorldFixture, StepMatchesBruteForceAndBroadcastsContactAndItsEnd) {
   EXPECT_EQ(stats.contact_frames, 1u);
 }
 
+TEST_F(WorldFixture, CoherentWatchersDeliverTheSameFramesAsTraversingOnes) {
+  // two watched pairs (B and C against A) in a world with a coherence skin, against the same
+  // scene in a world without: every frame must agree, along small steps and a jump
+  CollisionWorld plain({.contact_margin = 0.01});
+  CollisionWorld coherent({.contact_margin = 0.01, .coherence_skin = 0.02});
+  const auto other = make_tree(lattice_block(4, 0.04f));
+  std::vector<WatcherId> watchers[2];
+  CollisionWorld* worlds[2] = {&plain, &coherent};
+  for (int k = 0; k < 2; ++k) {
+    CollisionWorld& w = *worlds[k];
+    const ObjectId a = *w.add_object({.tree = tree, .name = "a"});
+    const ObjectId b = *w.add_object({.tree = tree, .world_from_object = {{}, {0.5, 0.0, 0.0}}, .name = "b"});
+    const ObjectId c = *w.add_object({.tree = other, .world_from_object = {{}, {0.0, 0.4, 0.0}}, .name = "c"});
+    watchers[k] = {*w.add_collision_watcher(a, b), *w.add_collision_watcher(a, c)};
+  }
+  auto frame_plain = std::make_unique<ContactFrame>();
+  auto frame_coherent = std::make_unique<ContactFrame>();
+  int touching = 0;
+  for (int step = 0; step < 120; ++step) {
+    const double t = 0.001 * step;
+    const double jump = step == 60 ? 0.2 : 0.0;
+    const Pose pb{quat_from_axis_angle({0, 0, 1}, 0.2 * t), {0.5 - 0.3 * t + jump, 0.01 * (step % 3), 0.0}};
+    const Pose pc{quat_from_axis_angle({1, 0, 0}, 0.5 * t), {0.0, 0.4 - 0.5 * t, 0.002 * step}};
+    for (CollisionWorld* w : worlds) {
+      w->set_pose(1, pb);
+      w->set_pose(2, pc);
+      w->step(t);
+    }
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_TRUE(plain.read_contact(watchers[0][static_cast<std::size_t>(i)], *frame_plain));
+      ASSERT_TRUE(coherent.read_contact(watchers[1][static_cast<std::size_t>(i)], *frame_coherent));
+      ASSERT_EQ(frame_coherent->pair_count, frame_plain->pair_count) << "step " << step << " watcher " << i;
+      EXPECT_NEAR(frame_coherent->total_volume, frame_plain->total_volume, 1e-12 + 1e-9 * frame_plain->total_volume);
+      if (frame_plain->total_volume > 0.0) ++touching;
+    }
+  }
+  EXPECT_GT(touching, 150) << "the paths must stay mostly in contact";
+  EXPECT_EQ(plain.stats().coherent_queries, 0u);
+  EXPECT_GT(coherent.stats().coherent_queries, 150u) << "the small steps must reuse the kept candidates";
+  EXPECT_LT(coherent.stats().coherent_queries, coherent.stats().queries) << "the jump must force a traversal";
+}
+
 TEST_F(WorldFixture, ThreadedWorldPublishesFramesForPosesSetFromAnotherThread) {
   CollisionWorld world({.rate_hz = 2000.0});
   const ObjectId a = *world.add_object({.tree = tree, .name = "a"});

@@ -54,6 +54,7 @@ TEST(VolumeQuery, SteadyStateDoesNotAllocate) {
   const auto tb = build_sphere_tree(testing::make_packing(0.08, testing::Shape::kBox, 82));
   ASSERT_TRUE(ta && tb);
   VolumeQuery vq;
+  VolumeQuery coherent({.coherence_skin = 0.05f});  // traverses on each jump, reuses on each repeat
   TimeCriticalQuery tc;
   DistanceQuery dq;
   std::mt19937 rng(1);
@@ -63,19 +64,25 @@ TEST(VolumeQuery, SteadyStateDoesNotAllocate) {
   // warm-up: every scratch buffer reaches its high-water mark
   for (const Pose& p : poses) {
     (void)vq.run(*ta, *tb, p);
+    (void)coherent.run(*ta, *tb, p);
+    (void)coherent.run(*ta, *tb, p);
     (void)tc.run(*ta, *tb, p);
     (void)dq.run(*ta, *tb, p);
   }
   const long before = g_allocations;
   double volume = 0.0;
   std::int64_t pairs = 0;
+  int reused = 0;
   for (const Pose& p : poses) {
     volume += vq.run(*ta, *tb, p).total_volume;
+    volume += coherent.run(*ta, *tb, p).total_volume;
+    reused += coherent.run(*ta, *tb, p).reused_candidates ? 1 : 0;
     pairs += vq.result().stats.overlapping_pairs;
     volume += tc.run(*ta, *tb, p, {.max_expansions = 200}).volume_estimate;
     volume += dq.run(*ta, *tb, p).distance;
   }
   EXPECT_EQ(g_allocations - before, 0);
+  EXPECT_EQ(reused, static_cast<int>(poses.size()));
   EXPECT_GT(pairs, 1000) << "the poses must exercise the traversal";
   EXPECT_GT(volume, 0.0);
   // the counter itself works

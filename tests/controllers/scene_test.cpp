@@ -42,6 +42,20 @@ TEST(Scene, ParsesTheSmallTestScene) {
   EXPECT_DOUBLE_EQ(scene->tool.force.force_scale, 8.0e6);
   EXPECT_EQ(scene->watch, std::vector<std::string>{"bunny"});
   EXPECT_TRUE(scene->force.multi_rate);
+  EXPECT_DOUBLE_EQ(scene->coherence_skin, 0.0) << "coherence is off unless a scene asks for it";
+}
+
+TEST(Scene, ReadsTheCollisionSection) {
+  const std::string with_collision =
+      replaced(small_scene_json(), R"("rates":)", R"("collision": { "contact_margin": 0.002, "coherence_skin": 0.0005 }, "rates":)");
+  const auto scene = parse_scene(with_collision, "small.json", test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  EXPECT_DOUBLE_EQ(scene->contact_margin, 0.002);
+  EXPECT_DOUBLE_EQ(scene->coherence_skin, 0.0005);
+  const auto bad = parse_scene(replaced(with_collision, "0.0005", "-1"), "small.json", test_assets());
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("field 'collision.coherence_skin': expected a number in [0, 1]"), std::string::npos)
+      << bad.error().message;
 }
 
 TEST(Scene, ReportsFileFieldAndExpectation) {

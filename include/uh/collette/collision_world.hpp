@@ -56,6 +56,10 @@ struct CollisionWorldOptions {
   /// Leaf pairs closer than this [length] are delivered with volume 0 before they overlap (see
   /// VolumeQueryOptions::contact_margin), so multi-rate force rendering starts contacts smoothly.
   double contact_margin = 0.0;
+  /// Frame-to-frame coherence of each watched pair's volume query (see
+  /// VolumeQueryOptions::coherence_skin) [length]; 0 = traverse every step. Each watcher then owns
+  /// its query (about 1.2 MB of pair buffer), since the kept candidates belong to one pair.
+  double coherence_skin = 0.0;
   std::string thread_name = "uh-collision";
 };
 
@@ -78,6 +82,7 @@ struct CollisionWorldStats {
   std::uint64_t queries = 0;            ///< tree queries run (broad phase passed)
   std::uint64_t contact_frames = 0;     ///< frames with at least one overlapping pair
   std::uint64_t truncated_frames = 0;   ///< frames with more pairs than ContactFrame::kMaxPairs
+  std::uint64_t coherent_queries = 0;   ///< queries that reused their kept candidates (coherence_skin > 0)
   std::int64_t last_pairs = 0;          ///< pairs of the last frame, summed over watchers
   std::int64_t max_pairs = 0;           ///< largest pair count of one frame
   std::uint64_t missed_deadlines = 0;   ///< fixed-rate mode: steps that started a period late
@@ -149,6 +154,7 @@ class CollisionWorld {
     bool touching = false;
     std::uint64_t sequence = 0;
     LatestValue<ContactFrame> frames;  // written by the collision step, read by read_contact()
+    std::unique_ptr<VolumeQuery> coherent_query;  // with coherence_skin > 0: this pair's own query
   };
 
   void run_step(double time_s);
@@ -171,6 +177,7 @@ class CollisionWorld {
   EventCounter queries_;
   EventCounter contact_frames_;
   EventCounter truncated_frames_;
+  EventCounter coherent_queries_;
   std::atomic<std::int64_t> last_pairs_{0};
   std::atomic<std::int64_t> max_pairs_{0};
 };

@@ -51,6 +51,16 @@ struct VolumeQueryOptions {
   /// Totals never include them.
   float contact_margin = 0.f;
   int stack_reserve = 1024;       ///< initial traversal stack entries (grows once if a query needs more)
+  /// Frame-to-frame coherence (a Verlet list): 0 (default) traverses the trees on every run. A
+  /// positive skin [length] makes a traversal also keep every leaf pair apart by less than
+  /// `contact_margin + coherence_skin` as a candidate; the following runs skip the traversal and
+  /// test only those candidates for as long as no point of B has moved (relative to A) by more than
+  /// the skin since then: a pair outside the candidates was farther apart than margin + skin, so it
+  /// cannot overlap yet. Results are exactly those of a traversal (same pairs, totals equal up to
+  /// summation order). Pays when B moves little between runs (a haptic tool at kilohertz rates) and
+  /// the skin holds few more pairs than overlap: docs/collette-queries.md, "Coherence".
+  float coherence_skin = 0.f;
+  int candidate_reserve = 0;      ///< initial candidate entries (0: twice pair_capacity, at least 1024)
 };
 
 /// Totals of one VolumeQuery::run, in A's mesh frame. Trivially copyable.
@@ -65,6 +75,10 @@ struct VolumeQueryResult {
   /// restoring_direction: 2-4 deg against 6-7 deg on the bunny) and |volume_gradient| is the
   /// local stiffness of a volume penalty along it.
   Vec3 volume_gradient{};
+  /// This run tested the candidates kept by an earlier traversal instead of traversing
+  /// (coherence_skin > 0 only); stats.node_pairs_visited is then 0.
+  bool reused_candidates = false;
+  std::int64_t candidate_pairs = 0; ///< candidates kept (coherence_skin > 0 only), tested this run
   std::int32_t pair_count = 0;      ///< pairs stored in pairs() (<= pair_capacity), near pairs included
   std::int64_t near_pairs = 0;      ///< pairs within contact_margin that do not overlap (stored with volume 0)
   bool truncated = false;           ///< more pairs overlapped than pair_capacity (totals still cover all)
@@ -94,6 +108,10 @@ class VolumeQuery {
   void run(const SphereTree& a, const SphereTree& b, const Pose& world_from_a, const Pose& world_from_b,
            ContactFrame& out);
 
+  /// Forgets the coherence candidates: the next run traverses. Call it when a tree changes (runs
+  /// with other trees than the last traversal's do this themselves, by address).
+  void reset_coherence() { candidate_tree_a_ = candidate_tree_b_ = nullptr; }
+
   /// The totals of the last run.
   const VolumeQueryResult& result() const { return result_; }
   /// The overlapping pairs stored by the last run (empty unless collect_pairs), A frame.
@@ -109,11 +127,30 @@ class VolumeQuery {
     float bx, by, bz, br;
   };
 
+  /// A kept leaf pair: A's leaf index and the slot of B's leaf in the run's moved-B-leaves buffer.
+  struct Candidate {
+    std::int32_t leaf_a;
+    std::int32_t slot_b;
+  };
+
  private:
+  void traverse(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, bool keep_candidates);
+  void test_candidates(const SphereTree& a, const SphereTree& b, const Pose& b_in_a);
+  bool candidates_hold(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) const;
+
   VolumeQueryOptions options_;
   std::vector<StackEntry> stack_;
   std::vector<PairOverlap> pairs_;
   VolumeQueryResult result_;
+  // coherence: the kept pairs, B's leaves among them (by index) and where they are this run, and
+  // the trees and pose of the traversal that kept them
+  std::vector<Candidate> candidates_;
+  std::vector<std::int32_t> candidate_leaves_b_;
+  std::vector<std::int32_t> slot_of_leaf_b_;
+  std::vector<Sphere> moved_leaves_b_;
+  const SphereTree* candidate_tree_a_ = nullptr;
+  const SphereTree* candidate_tree_b_ = nullptr;
+  Pose candidate_pose_{};
 };
 
 }  // namespace uh::collette

@@ -28,6 +28,7 @@ struct SessionOptions {
   std::optional<double> collision_hz;    ///< collision rate [Hz]; 0 = free-running
   std::optional<bool> multi_rate;        ///< re-evaluate held pairs every tick (else hold forces)
   std::optional<double> contact_margin;  ///< pairs delivered this far [m] before they touch
+  std::optional<double> coherence_skin;  ///< volume-query coherence skin [m] (0 = off); default: the scene's
   bool raise_priority = false;           ///< ask for SCHED_FIFO for the haptic (80) and collision (70) threads
   std::filesystem::path cache_dir;       ///< where .ist builds are cached; empty = default_cache_dir()
   /// Build progress (what, fraction) while a mesh is packed on first use; calling thread.
@@ -67,6 +68,7 @@ struct SessionReport {
   double query_median_us = 0.0, query_p99_us = 0.0, query_max_us = 0.0;
   std::int64_t max_pairs = 0;
   std::uint64_t truncated_frames = 0;
+  std::uint64_t coherent_queries = 0;   ///< collision queries that reused their kept candidates
   // forces
   double force_max_n = 0.0, torque_max_nm = 0.0;
   double force_max_step_n = 0.0;       ///< largest tick-to-tick change of the force sent to the device [N]

@@ -64,6 +64,7 @@ struct Scene {
   double collision_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running
   double seconds = 10.0;               ///< default session length [s]
   double contact_margin = 0.001;       ///< collision pairs delivered this far [m] before they touch (multi-rate)
+  double coherence_skin = 0.0;         ///< frame-to-frame coherence skin of the volume query [m]; 0 = off
   ForceControllerOptions force{};      ///< multi-rate, safety limits, watchdog, coupling
 };
 
