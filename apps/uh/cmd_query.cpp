@@ -27,6 +27,7 @@ struct QueryArgs {
   std::string out;
   bool json = false;
   double budget_us = 0.0;
+  double coherence_skin = 0.0;  // mesh units; 0 = traverse for every pose
 };
 
 struct QueryRow {
@@ -81,7 +82,8 @@ int run_query(const QueryArgs& args) {
   // each packing fills a share (its coverage) of its mesh, so it meets about coverage_a * coverage_b
   // of the meshes' true overlap (docs/collette-queries.md, "Accuracy")
   const double calibration = a->meta.coverage * b->meta.coverage;
-  collette::VolumeQuery volume_query;
+  collette::VolumeQuery volume_query({.coherence_skin = static_cast<float>(args.coherence_skin)});
+  std::int64_t coherent_poses = 0;
   collette::TimeCriticalQuery time_critical_query;
   collette::DistanceQuery distance_query;
   const collette::TimeCriticalBudget budget{.max_seconds = args.budget_us * 1e-6};
@@ -101,6 +103,7 @@ int run_query(const QueryArgs& args) {
       row.normal = r.restoring_direction;
       row.gradient_direction = normalized(-r.volume_gradient);
       row.pairs = r.stats.overlapping_pairs;
+      coherent_poses += r.reused_candidates ? 1 : 0;
     }
     if (row.volume <= 0.0) row.distance = distance_query.run(a->tree, b->tree, pose.b_in_a).distance;
     row.time_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
@@ -129,6 +132,7 @@ int run_query(const QueryArgs& args) {
                                      {"max", percentile(times, 1.0)}}},
                         {"results", results}};
     if (args.budget_us > 0.0) j["budget_us"] = args.budget_us;
+    if (args.coherence_skin > 0.0) j["coherence"] = {{"skin", args.coherence_skin}, {"reused_poses", coherent_poses}};
     if (!args.out.empty()) j["out"] = args.out;
     std::printf("%s\n", j.dump(2).c_str());
   } else if (args.out.empty()) {
@@ -154,6 +158,9 @@ void add_query_command(CLI::App& app, CommandRunner& runner) {
   q->add_option("--out", args.out, "write id,volume,nx,ny,nz,pairs,distance,time_us to this CSV");
   q->add_flag("--json", args.json, "print a JSON summary (median, p99, max time_us) with the results");
   q->add_option("--budget-us", args.budget_us, "time-critical query with this budget per pose [us]")->check(CLI::PositiveNumber);
+  q->add_option("--coherence-skin", args.coherence_skin,
+                "poses form a path: keep candidate pairs this far apart [mesh units] and reuse them while B moves less")
+      ->check(CLI::NonNegativeNumber);
   q->callback([&runner] { runner = [] { return run_query(args); }; });
 }
 

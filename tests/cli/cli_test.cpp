@@ -1,0 +1,245 @@
+// The `uh` program as its users call it: `uh ist build/info/preview` and `uh query` with the
+// documented arguments and outputs (docs/collette-queries.md), checked against the library and a
+// brute-force sum over the leaf spheres, and its errors on bad input.
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "uh/collette/ist_file.hpp"
+#include "uh/core/sphere_overlap.hpp"
+
+namespace uh {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A scratch directory per test program run, removed at the end.
+class CliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / fmt::format("uh_cli_test_{}", ::getpid());
+    fs::create_directories(dir_);
+    // one small tree shared by the query tests
+    const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 600 --json", bunny().string(), (dir_ / "bunny.ist").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static fs::path bunny() { return fs::path(UH_TEST_DATA_DIR) / "meshes" / "bunny_npm_3674.obj"; }
+
+  static CommandRun uh(const std::string& arguments) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = fmt::format("'{}' {} > '{}' 2> '{}'", UH_CLI_PATH, arguments, out.string(), err.string());
+    const int status = std::system(command.c_str());
+    CommandRun r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = read_text(out);
+    r.err = read_text(err);
+    return r;
+  }
+
+  static nlohmann::json json_of(const CommandRun& r) {
+    try {
+      return nlohmann::json::parse(r.out);
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not JSON: " << e.what() << "\n" << r.out;
+      return {};
+    }
+  }
+
+  static fs::path dir_;
+};
+
+fs::path CliTest::dir_;
+
+// Poses of B in A: a path sliding B's copy of the bunny through A's, then one far away.
+fs::path write_poses(const fs::path& path, int steps, double from, double to) {
+  std::ofstream out(path);
+  out << "id,tx,ty,tz,qw,qx,qy,qz,comment\n";
+  for (int k = 0; k < steps; ++k) {
+    const double x = from + (to - from) * k / std::max(1, steps - 1);
+    const double half = 0.002 * k;  // a slow turn about y
+    out << "p" << k << "," << x << ",0.1,0," << std::cos(half) << ",0," << std::sin(half) << ",0,extra column\n";
+  }
+  out << "far,50,0,0,1,0,0,0,\n";
+  return path;
+}
+
+// Brute force over all leaf pairs: the intersection volume of the packings at one pose.
+double brute_volume(const collette::SphereTree& a, const collette::SphereTree& b, const Pose& b_in_a) {
+  double v = 0.0;
+  for (const Sphere& sb : b.leaves()) {
+    const Vec3 cb = transform_point(b_in_a, Vec3{sb.x, sb.y, sb.z});
+    for (const Sphere& sa : a.leaves())
+      v += lens_volume<double>(norm(cb - Vec3{sa.x, sa.y, sa.z}), sa.radius, sb.radius);
+  }
+  return v;
+}
+
+TEST_F(CliTest, IstBuildPrintsTheDocumentedFieldsAndInfoAgrees) {
+  const fs::path ist = dir_ / "build.ist", png = dir_ / "build.png";
+  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 400 --preview '{}' --json", bunny().string(), ist.string(), png.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = json_of(r);
+  for (const char* key : {"spheres", "mesh_volume", "sphere_volume", "coverage", "max_gap", "build_seconds", "nodes", "depth"})
+    EXPECT_TRUE(j.contains(key)) << "missing " << key << " in " << r.out;
+  EXPECT_EQ(j.value("spheres", 0), 400);
+  EXPECT_NEAR(j.value("coverage", 0.0), j.value("sphere_volume", 0.0) / j.value("mesh_volume", 1.0), 1e-9);
+  EXPECT_GT(j.value("coverage", 0.0), 0.5);
+  EXPECT_LT(j.value("coverage", 1.0), 1.0);
+  EXPECT_TRUE(fs::exists(ist));
+  EXPECT_EQ(read_text(png).substr(0, 4), "\x89PNG");
+
+  const auto asset = collette::load_ist(ist);
+  ASSERT_TRUE(asset.has_value()) << asset.error().message;
+  EXPECT_EQ(asset->tree.leaf_count(), 400);
+  EXPECT_EQ(asset->tree.node_count(), j.value("nodes", -1));
+  EXPECT_EQ(asset->tree.depth(), j.value("depth", -1));
+
+  const CommandRun info = uh(fmt::format("ist info '{}' --json", ist.string()));
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const auto ji = json_of(info);
+  EXPECT_EQ(ji.value("spheres", 0), 400) << info.out;
+  EXPECT_NEAR(ji.value("coverage", 0.0), j.value("coverage", 0.0), 1e-6);
+
+  const fs::path section = dir_ / "section.png";
+  const CommandRun preview = uh(fmt::format("ist preview '{}' -o '{}' --section", ist.string(), section.string()));
+  ASSERT_EQ(preview.exit_code, 0) << preview.err;
+  EXPECT_EQ(read_text(section).substr(0, 4), "\x89PNG");
+}
+
+TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
+  const fs::path ist = dir_ / "bunny.ist";
+  const fs::path poses = write_poses(dir_ / "poses.csv", 5, -4.0, 2.0);
+  const fs::path csv = dir_ / "results.csv";
+  const CommandRun r = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", ist.string(), poses.string(), csv.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "id,volume,nx,ny,nz,pairs,distance,time_us");
+  const auto asset = collette::load_ist(ist);
+  ASSERT_TRUE(asset.has_value());
+  std::vector<std::string> ids;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream s(line);
+    for (std::string cell; std::getline(s, cell, ',');) f.push_back(cell);
+    ASSERT_EQ(f.size(), 8u) << line;
+    ids.push_back(f[0]);
+    const double volume = std::stod(f[1]);
+    const Vec3 n{std::stod(f[2]), std::stod(f[3]), std::stod(f[4])};
+    const double distance = std::stod(f[6]);
+    if (f[0] == "far") {
+      EXPECT_EQ(volume, 0.0);
+      EXPECT_EQ(norm(n), 0.0);
+      EXPECT_GT(distance, 35.0);  // 50 apart, the bunny is about 10 units wide
+      continue;
+    }
+    const int k = std::stoi(f[0].substr(1));
+    const double x = -4.0 + 6.0 * k / 4.0, half = 0.002 * k;
+    const Pose pose{{std::cos(half), 0.0, std::sin(half), 0.0}, {x, 0.1, 0.0}};
+    const double expected = brute_volume(asset->tree, asset->tree, pose);
+    ASSERT_GT(expected, 0.0) << line;
+    EXPECT_NEAR(volume, expected, 1e-4 * expected) << line;
+    EXPECT_NEAR(norm(n), 1.0, 1e-6) << line;
+    EXPECT_EQ(distance, 0.0) << line;
+    EXPECT_GT(std::stoll(f[5]), 0) << line;
+    // B's copy is shifted along x: the restoring direction pushes it further that way
+    if (std::abs(x) > 1.0) {
+      EXPECT_GT(n.x * x, 0.0) << line;
+    }
+  }
+  EXPECT_EQ(ids, (std::vector<std::string>{"p0", "p1", "p2", "p3", "p4", "far"}));
+}
+
+TEST_F(CliTest, QueryJsonSummaryAndCoherentPathGiveTheSameResults) {
+  const fs::path ist = dir_ / "bunny.ist";
+  const fs::path poses = write_poses(dir_ / "path.csv", 60, -3.0, -2.5);
+  const CommandRun plain = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
+  const CommandRun coherent = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json --coherence-skin 0.2", ist.string(), poses.string()));
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(coherent.exit_code, 0) << coherent.err;
+  const auto jp = json_of(plain), jc = json_of(coherent);
+  for (const char* key : {"median", "p99", "max"}) EXPECT_GT(jp["time_us"].value(key, 0.0), 0.0) << key;
+  ASSERT_EQ(jp["results"].size(), 61u);
+  ASSERT_EQ(jc["results"].size(), 61u);
+  for (std::size_t i = 0; i < 61; ++i) {
+    const auto& a = jp["results"][i];
+    const auto& b = jc["results"][i];
+    EXPECT_EQ(a["pairs"], b["pairs"]) << i;
+    EXPECT_NEAR(a["volume"].get<double>(), b["volume"].get<double>(), 1e-12 + 1e-9 * a["volume"].get<double>()) << i;
+  }
+  EXPECT_GT(jc["coherence"].value("reused_poses", 0), 40) << "small steps along the path should reuse the kept pairs";
+}
+
+TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
+  // an open box: one face missing
+  const fs::path open_mesh = dir_ / "open_box.obj";
+  {
+    std::ofstream out(open_mesh);
+    out << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+           "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\n";
+  }
+  const fs::path out = dir_ / "kept.ist";
+  {
+    std::ofstream keep(out);
+    keep << "an earlier file that must survive";
+  }
+  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 50", open_mesh.string(), out.string()));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("open_box.obj"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("boundary"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text(out), "an earlier file that must survive");
+
+  // a corrupted .ist
+  const fs::path broken = dir_ / "broken.ist";
+  {
+    std::string bytes = read_text(dir_ / "bunny.ist");
+    bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x5a);
+    std::ofstream(broken, std::ios::binary) << bytes;
+  }
+  const CommandRun info = uh(fmt::format("ist info '{}'", broken.string()));
+  EXPECT_NE(info.exit_code, 0);
+  EXPECT_NE(info.err.find("broken.ist"), std::string::npos) << info.err;
+
+  // a poses file without the quaternion columns
+  const fs::path poses = dir_ / "bad_poses.csv";
+  std::ofstream(poses) << "id,tx,ty,tz\na,0,0,0\n";
+  const fs::path results = dir_ / "never.csv";
+  const CommandRun q = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", (dir_ / "bunny.ist").string(), poses.string(),
+                               results.string()));
+  EXPECT_NE(q.exit_code, 0);
+  EXPECT_NE(q.err.find("bad_poses.csv"), std::string::npos) << q.err;
+  EXPECT_NE(q.err.find("qw"), std::string::npos) << q.err;
+  EXPECT_FALSE(fs::exists(results));
+}
+
+}  // namespace
+}  // namespace uh
