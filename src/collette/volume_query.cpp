@@ -269,10 +269,6 @@ struct Traversal {
   }
 };
 
-}  // namespace
-
-namespace {
-
 Traversal make_traversal(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, const VolumeQueryOptions& options,
                          std::vector<VolumeQuery::StackEntry>* stack, PairOverlap* pairs,
                          std::vector<VolumeQuery::Candidate>* candidates) {
