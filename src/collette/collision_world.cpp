@@ -22,7 +22,7 @@ std::uint64_t elapsed_ns(std::chrono::steady_clock::time_point since) {
 // Bounding sphere of the whole object in the world frame.
 Vec3 root_center_world(const SphereTree& tree, const Pose& world_from_object) {
   const SphereTreeNode& r = tree.root();
-  return transform_point(world_from_object, Vec3{r.x, r.y, r.z});
+  return transform_point(world_from_object, Vec3{static_cast<double>(r.x), static_cast<double>(r.y), static_cast<double>(r.z)});
 }
 
 }  // namespace

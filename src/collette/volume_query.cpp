@@ -361,13 +361,16 @@ bool VolumeQuery::candidates_hold(const SphereTree& a, const SphereTree& b, cons
   // for the relative rotation angle theta: twice the vector part of conj(q0) q1.
   const SphereTreeNode& root_b = b.root();
   const SphereTreeNode& root_a = a.root();
-  const Vec3 c{root_b.x, root_b.y, root_b.z};
+  const auto centre = [](const SphereTreeNode& n) {
+    return Vec3{static_cast<double>(n.x), static_cast<double>(n.y), static_cast<double>(n.z)};
+  };
+  const Vec3 c = centre(root_b);
   const Vec3 c_now = transform_point(b_in_a, c);
   const Quat rel = conjugate(normalized(candidate_pose_.rotation)) * normalized(b_in_a.rotation);
   const double sin_half = std::sqrt(rel.x * rel.x + rel.y * rel.y + rel.z * rel.z);
   const double move = norm(c_now - transform_point(candidate_pose_, c)) + 2.0 * sin_half * static_cast<double>(root_b.radius);
   // float round-off of the traversal that kept them, a few ulps of the coordinates' magnitude
-  const double scale = norm(c_now) + static_cast<double>(root_b.radius) + norm(Vec3{root_a.x, root_a.y, root_a.z}) +
+  const double scale = norm(c_now) + static_cast<double>(root_b.radius) + norm(centre(root_a)) +
                        static_cast<double>(root_a.radius);
   return std::isfinite(move) && move + 1e-5 * scale < static_cast<double>(options_.coherence_skin);
 }

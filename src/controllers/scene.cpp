@@ -272,7 +272,9 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
   json root;
   try {
     root = json::parse(json_text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error for bad syntax, out_of_range for a number too large for a double (found by the
+    // scene fuzzer): both are the file's fault
     return Error{fmt::format("{}: not valid JSON: {}", source, e.what())};
   }
   const FieldReader r(source);

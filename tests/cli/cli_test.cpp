@@ -92,12 +92,14 @@ fs::path write_poses(const fs::path& path, int steps, double from, double to) {
 }
 
 // Brute force over all leaf pairs: the intersection volume of the packings at one pose.
+Vec3 centre(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
+
 double brute_volume(const collette::SphereTree& a, const collette::SphereTree& b, const Pose& b_in_a) {
   double v = 0.0;
   for (const Sphere& sb : b.leaves()) {
-    const Vec3 cb = transform_point(b_in_a, Vec3{sb.x, sb.y, sb.z});
+    const Vec3 cb = transform_point(b_in_a, centre(sb));
     for (const Sphere& sa : a.leaves())
-      v += lens_volume<double>(norm(cb - Vec3{sa.x, sa.y, sa.z}), sa.radius, sb.radius);
+      v += lens_volume<double>(norm(cb - centre(sa)), static_cast<double>(sa.radius), static_cast<double>(sb.radius));
   }
   return v;
 }

@@ -82,6 +82,7 @@ TEST(Scene, ReportsFileFieldAndExpectation) {
             "field 'tool': give exactly one of 'mesh'");
   with_base("[1, 2]", "expected a JSON object at the top level");
   with_base("{ \"objects\": ", "not valid JSON");
+  with_base(R"({ "seconds": 1e999 })", "not valid JSON");  // a number no double holds (the fuzzer's first find)
   with_base(R"({ "tool": {} })", "field 'objects': missing");
 }
 
