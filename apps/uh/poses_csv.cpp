@@ -1,5 +1,6 @@
 #include "poses_csv.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -76,10 +77,11 @@ Result<std::vector<PoseRow>> read_poses_csv(const std::filesystem::path& path) {
         return Error{fmt::format("{}:{}: column '{}' is '{}', expected a finite number", path.string(),
                                  line_number, kColumns[k], fields[c])};
     }
-    const Quat q{v[3], v[4], v[5], v[6]};
-    const double qn = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-    if (!(qn > 1e-12))
+    // scaled by its largest component first, so that neither 1e200 nor 1e-200 over- or underflows
+    const double largest = std::max({std::abs(v[3]), std::abs(v[4]), std::abs(v[5]), std::abs(v[6])});
+    if (!(largest > 0.0))
       return Error{fmt::format("{}:{}: quaternion (qw,qx,qy,qz) is zero", path.string(), line_number)};
+    const Quat q{v[3] / largest, v[4] / largest, v[5] / largest, v[6] / largest};
     row.b_in_a = Pose{normalized(q), Vec3{v[0], v[1], v[2]}};
     rows.push_back(std::move(row));
   }

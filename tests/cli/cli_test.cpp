@@ -201,6 +201,25 @@ TEST_F(CliTest, QueryJsonSummaryAndCoherentPathGiveTheSameResults) {
   EXPECT_GT(jc["coherence"].value("reused_poses", 0), 40) << "small steps along the path should reuse the kept pairs";
 }
 
+TEST_F(CliTest, QuaternionsAreNormalisedWhateverTheirScale) {
+  const fs::path ist = dir_ / "bunny.ist";
+  const fs::path poses = dir_ / "scaled.csv";
+  {
+    std::ofstream out(poses);
+    const double c = std::cos(0.1), s = std::sin(0.1);
+    out << "id,tx,ty,tz,qw,qx,qy,qz\n";
+    for (const double scale : {1.0, 1e-200, 1e200, 3.0})
+      out << "s" << scale << ",-2,0.1,0," << c * scale << ",0," << s * scale << ",0\n";
+  }
+  const CommandRun r = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = json_of(r);
+  ASSERT_EQ(j["results"].size(), 4u);
+  const double v0 = j["results"][0]["volume"].get<double>();
+  ASSERT_GT(v0, 0.0);
+  for (const auto& row : j["results"]) EXPECT_NEAR(row["volume"].get<double>(), v0, 1e-9 * v0) << row.dump();
+}
+
 TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
   // an open box: one face missing
   const fs::path open_mesh = dir_ / "open_box.obj";
