@@ -202,7 +202,8 @@ Status read_device(const FieldReader& r, const json& j, const std::string& path,
 
 Status read_force_params(const FieldReader& r, const json& j, const std::string& path, SceneTool& tool) {
   UH_CHECK(r.require_object(j, path));
-  UH_CHECK(r.check_keys(j, path, {"mode", "force_scale", "damping", "mass_kg", "center_of_mass", "max_force_n", "max_torque_nm"}));
+  UH_CHECK(r.check_keys(j, path, {"mode", "force_scale", "damping", "damping_full_volume", "mass_kg", "center_of_mass",
+                                  "max_force_n", "max_torque_nm"}));
   std::string mode = "6dof";
   UH_CHECK(r.string(j, path, "mode", mode, false));
   if (mode == "6dof") {
@@ -215,6 +216,7 @@ Status read_force_params(const FieldReader& r, const json& j, const std::string&
   auto& f = tool.force;
   UH_CHECK(r.number(j, path, "force_scale", f.force_scale, 0.0, 1e15));
   UH_CHECK(r.number(j, path, "damping", f.damping, 0.0, 1e6));
+  UH_CHECK(r.number(j, path, "damping_full_volume", f.damping_full_volume, 0.0, 1.0));
   UH_CHECK(r.number(j, path, "mass_kg", f.mass_kg, 1e-6, 1e4));
   UH_CHECK(r.vec3(j, path, "center_of_mass", f.center_of_mass_body));
   UH_CHECK(r.number(j, path, "max_force_n", f.max_force_n, 1e-6, 1e4));

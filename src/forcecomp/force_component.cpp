@@ -18,6 +18,7 @@ PenaltyInput ForceComponent::penalty_input(const BodyMotion& self, const BodyMot
   PenaltyInput in;
   in.force_scale = options_.params.force_scale;
   in.damping = options_.params.damping;
+  in.damping_full_volume = options_.params.damping_full_volume;
   in.mode = options_.mode;
   in.tool_side = options_.side;
   in.tool = self;

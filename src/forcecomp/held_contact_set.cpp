@@ -170,7 +170,7 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   const BodyMotion tool = to_a(input.tool);
   const BodyMotion other = to_a(input.other);
   const double sign = input.tool_side == ContactSide::kB ? 1.0 : -1.0;
-  const double damping_per_volume = input.damping / total;
+  const double damping_per_volume = input.damping / std::max(total, damping_full_volume(input));
   const bool six_dof = input.mode == ForceMode::k6Dof;
   Vec3 force{};
   Vec3 torque{};

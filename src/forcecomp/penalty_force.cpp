@@ -25,7 +25,7 @@ PenaltyResult evaluate_penalty(std::span<const SpherePairContact> pairs, const P
   if (!(total > 0.0)) return result;
 
   const double sign = input.tool_side == ContactSide::kB ? 1.0 : -1.0;
-  const double damping_per_volume = input.damping / total;
+  const double damping_per_volume = input.damping / std::max(total, damping_full_volume(input));
   const bool six_dof = input.mode == ForceMode::k6Dof;
   for (const SpherePairContact& p : pairs) {
     const double vol = static_cast<double>(p.volume);

@@ -134,10 +134,14 @@ TEST(HeldContactSet, FusedEvaluationMatchesReevaluateThenPenalty) {
   held.hold(*frame);
   EXPECT_EQ(held.dropped_pairs(), 0u);
 
-  for (const ContactSide side : {ContactSide::kA, ContactSide::kB}) {
+  const double held_volume = evaluate_penalty(held.reevaluate(wa, b1), PenaltyInput{}).total_volume;
+  ASSERT_GT(held_volume, 0.0);
+  for (const ContactSide side : {ContactSide::kA, ContactSide::kB})
+  for (const double full_volume : {0.0, 4.0 * held_volume}) {  // the paper's damping, then ramped
     PenaltyInput in;
     in.force_scale = 500.0;
     in.damping = 3.0;
+    in.damping_full_volume = full_volume;
     in.tool_side = side;
     in.tool = {{0.6, 0.3, 0.1}, {0.2, -0.4, 0.1}, {1.0, -2.0, 0.5}};
     in.other = {{0.2, 0.1, -0.1}, {-0.1, 0.0, 0.3}, {0.0, 0.5, 0.0}};

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
@@ -92,6 +93,43 @@ TEST(PenaltyForce, DampingTermIsVolumeWeightedShareOfEpsD) {
   in.other.linear_velocity_world = {-0.1, 0, 0};
   const PenaltyResult same = evaluate_penalty(pairs, in);
   EXPECT_NEAR(same.wrench.force.x, 100.0 * total, 1e-4);
+}
+
+TEST(PenaltyForce, DampingFullVolumeRampsTheDampingUpFromContact) {
+  // one unit sphere pushed into another along x at 0.1 per second, deeper and deeper: the
+  // damping part of the force against the overlap volume
+  PenaltyInput paper;
+  paper.force_scale = 100.0;
+  paper.damping = 50.0;
+  paper.tool.linear_velocity_world = {-0.1, 0, 0};
+  PenaltyInput ramped = paper;
+  const double full = 0.2;  // V_d
+  ramped.damping_full_volume = full;
+  double last_damping = 0.0;
+  for (double d = 1.999; d > 1.2; d -= 0.01) {
+    const SpherePairContact pair = make_pair(sphere(0, 0, 0, 1), Pose{}, sphere(d, 0, 0, 1), Pose{});
+    const double v = static_cast<double>(pair.volume);
+    ASSERT_GT(v, 0.0);
+    const double spring = 100.0 * v;
+    const double damping_paper = evaluate_penalty(std::span(&pair, 1), paper).wrench.force.x - spring;
+    const double damping_ramped = evaluate_penalty(std::span(&pair, 1), ramped).wrench.force.x - spring;
+    // the paper's reading: the full eps_d * v from the first touch on
+    EXPECT_NEAR(damping_paper, 5.0, 1e-6) << "d " << d;
+    // ramped: eps_d * v * min(1, V / V_d), continuous and non-decreasing with depth
+    EXPECT_NEAR(damping_ramped, 5.0 * std::min(1.0, v / full), 1e-6) << "d " << d;
+    EXPECT_GE(damping_ramped, last_damping - 1e-12);
+    last_damping = damping_ramped;
+  }
+  EXPECT_NEAR(last_damping, 5.0, 1e-6) << "deep contacts get the full damping";
+  // at the first touch the ramped damping is a vanishing share of eps_d * v
+  const SpherePairContact grazing = make_pair(sphere(0, 0, 0, 1), Pose{}, sphere(1.999, 0, 0, 1), Pose{});
+  EXPECT_LT(evaluate_penalty(std::span(&grazing, 1), ramped).wrench.force.x, 1e-4 * 5.0);
+  // a nonsense V_d falls back to the paper's reading
+  for (const double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    ramped.damping_full_volume = bad;
+    EXPECT_NEAR(evaluate_penalty(std::span(&grazing, 1), ramped).wrench.force.x,
+                evaluate_penalty(std::span(&grazing, 1), paper).wrench.force.x, 1e-12);
+  }
 }
 
 TEST(PenaltyForce, NeverPullsWhenSeparatingFast) {

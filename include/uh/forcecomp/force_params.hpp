@@ -29,6 +29,11 @@ struct ForceParams {
   Vec3 center_of_mass_body{};           ///< centre of mass in the body (mesh) frame [L]; torques are about it
   double force_scale = 2.0e5;           ///< eps_c [N / L^3], >= 0
   double damping = 0.0;                 ///< eps_d [N s / L], >= 0; total damping along a common normal
+  /// Overlap volume from which the full damping eps_d acts [L^3], >= 0. 0 (default): the paper's
+  /// reading, full damping from the first touching pair on, which is a force step of eps_d * v
+  /// at contact onset. V_d > 0: the damping shares are vol_ij / max(Vol_total, V_d), so the
+  /// damping ramps up with the overlap and is continuous at contact (penalty_force.hpp).
+  double damping_full_volume = 0.0;
   double max_force_n = 10.0;            ///< |force| limit [N], > 0
   double max_torque_nm = 0.5;           ///< |torque| limit [N m], > 0
 };

@@ -22,6 +22,13 @@
 /// per-pair clamp at zero keeps the force from ever pulling the objects together (no sticking
 /// when separating quickly).
 ///
+/// Onset. Because the shares sum to one from the first touching pair on, that reading puts the
+/// full damping force eps_d * v on at the instant of contact: a step (measured in the continuity
+/// scene, which therefore renders without damping). `damping_full_volume` V_d > 0 replaces
+/// Vol_total by max(Vol_total, V_d) in the share: below V_d the damping is eps_d * v * Vol_total / V_d,
+/// which starts at zero with the overlap; from V_d on it is the reading above. A V_d of a few
+/// percent of the volume the tool typically sinks in keeps deep contacts unchanged.
+///
 /// The static part sum_ij eps_c vol_ij n_ij is conservative (per-pair forces along centre lines are
 /// the gradient of eps_c * total overlap volume), so it stores and returns energy; the damping
 /// part only removes energy.
@@ -41,6 +48,7 @@ namespace uh::forcecomp {
 struct PenaltyInput {
   double force_scale = 0.0;           ///< eps_c [N / L^3]
   double damping = 0.0;               ///< eps_d [N s / L]
+  double damping_full_volume = 0.0;   ///< V_d [L^3]: damping shares are vol_ij / max(Vol_total, V_d)
   ForceMode mode = ForceMode::k6Dof;  ///< k3Dof leaves the torque at zero
   ContactSide tool_side = ContactSide::kB;  ///< the object whose force is computed
   BodyMotion tool{};                  ///< the tool's centre of mass and velocities (world frame)
@@ -54,6 +62,12 @@ struct PenaltyResult {
   std::int32_t pair_count = 0;  ///< pairs with positive volume
   std::int32_t pushing_pairs = 0;  ///< pairs whose f_ij was positive after the clamp at zero
 };
+
+/// The V_d in effect: a non-finite or negative setting counts as 0 (the paper's reading).
+inline double damping_full_volume(const PenaltyInput& input) {
+  const double v = input.damping_full_volume;
+  return v > 0.0 && v < 1e300 ? v : 0.0;
+}
 
 /// Evaluates eq. 1 and 2 over `pairs` (world-frame normals and centroids as written by Collette).
 /// Pairs with zero or non-finite volume are skipped. No limits are applied here: see ForceSafety.
