@@ -107,6 +107,31 @@ TEST_F(SessionFixture, MultiRateReevaluationSmoothsTheForceOfASlowCollisionThrea
       << "multi-rate " << multi->report().force_max_step_n << " N vs held " << held->report().force_max_step_n << " N";
 }
 
+TEST_F(SessionFixture, DampingFullVolumeRemovesTheKnockAtContactOnset) {
+  // the stylus strikes the bunny at 0.11 m/s and keeps going in (the run ends before the line
+  // does, so no turn-around changes the velocity); collision every tick, so that every force step
+  // comes from the force law. The paper's damping reading puts eps_d * v on at the first touch.
+  const auto replace = [](std::string s, const std::string& from, const std::string& to) {
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos);
+    if (at != std::string::npos) s.replace(at, from.size(), to);
+    return s;
+  };
+  const std::string paper = replace(small_scene_json(), R"("bounce": true)", R"("bounce": false)");
+  auto with_paper = make(paper);
+  auto ramped = make(replace(paper, R"("damping": 1.0,)", R"("damping": 1.0, "damping_full_volume": 2e-8,)"));
+  auto undamped = make(replace(paper, R"("damping": 1.0,)", R"("damping": 0.0,)"));
+  ASSERT_TRUE(with_paper && ramped && undamped);
+  for (auto* s : {with_paper.get(), ramped.get(), undamped.get()}) ASSERT_TRUE(s->run_stepped(0.45, 1).has_value());
+  ASSERT_GT(undamped->report().contact_ticks, 50) << "the stylus must be in contact for a while";
+  const double step_paper = with_paper->report().force_max_step_n;
+  const double step_ramped = ramped->report().force_max_step_n;
+  const double step_undamped = undamped->report().force_max_step_n;
+  EXPECT_GT(step_paper, 2.0 * step_undamped) << "the onset knock must show, or this test proves nothing";
+  EXPECT_LT(step_ramped, 0.5 * step_paper) << "ramped " << step_ramped << " N, paper " << step_paper << " N";
+  EXPECT_LT(step_ramped, 1.5 * step_undamped) << "ramped " << step_ramped << " N, undamped " << step_undamped << " N";
+}
+
 TEST_F(SessionFixture, CouplingRendersThroughTheProxyAndStaysWithinLimits) {
   auto session = make(small_scene_json(true, true));
   ASSERT_TRUE(session);
