@@ -11,7 +11,9 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_path(UH_READERWRITERQUEUE_INCLUDE_DIR readerwriterqueue/readerwriterqueue.h REQUIRED)
 if(NOT TARGET uh_readerwriterqueue)
   add_library(uh_readerwriterqueue INTERFACE)
-  target_include_directories(uh_readerwriterqueue SYSTEM INTERFACE ${UH_READERWRITERQUEUE_INCLUDE_DIR})
+  # the build's own path only: the installed package config looks the header up again on the
+  # consumer's machine, so the install does not carry this machine's include path
+  target_include_directories(uh_readerwriterqueue SYSTEM INTERFACE $<BUILD_INTERFACE:${UH_READERWRITERQUEUE_INCLUDE_DIR}>)
 endif()
 
 if(UH_BUILD_APPS)
