@@ -3,7 +3,7 @@
 #include <array>
 #include <vector>
 
-#include "allocation_counter.hpp"
+#include "allocation_counter.hpp"  // tests/support
 #include "uh/core/delegator.hpp"
 
 namespace {
@@ -24,10 +24,10 @@ struct Accumulator {
 
 TEST(DelegatorAllocation, CounterSeesAllocations) {
   // guards the guard: an armed counter must see a plain allocation
-  uh::test::arm_allocation_counter();
+  const uh::test::AllocationCounter counter;
   // operator new called directly: a new-expression could be elided by the optimiser
   void* p = ::operator new(64);
-  const std::uint64_t n = uh::test::disarm_allocation_counter();
+  const std::uint64_t n = counter.count();
   ::operator delete(p);
   EXPECT_EQ(n, 1u);
 }
@@ -46,9 +46,9 @@ TEST(DelegatorAllocation, BroadcastNeverAllocates) {
   p.values[1] = 2.0;
   p.values[2] = 3.0;
 
-  uh::test::arm_allocation_counter();
+  const uh::test::AllocationCounter counter;
   for (int i = 0; i < 4; ++i) d.broadcast(p);
-  const std::uint64_t allocations = uh::test::disarm_allocation_counter();
+  const std::uint64_t allocations = counter.count();
   EXPECT_EQ(allocations, 0u);
   EXPECT_DOUBLE_EQ(g_sum, 4.0);
   EXPECT_DOUBLE_EQ(acc.total, 8.0);
@@ -67,10 +67,10 @@ TEST(DelegatorAllocation, BroadcastWithRemovalsDuringItNeverAllocates) {
       if (i + 1 < 8) d.remove_delegate(handles[static_cast<std::size_t>(i + 1)]);
     }));
   }
-  uh::test::arm_allocation_counter();
+  const uh::test::AllocationCounter counter;
   d.broadcast(0);
   d.broadcast(1);
-  const std::uint64_t allocations = uh::test::disarm_allocation_counter();
+  const std::uint64_t allocations = counter.count();
   EXPECT_EQ(allocations, 0u);
   EXPECT_EQ(calls, 4);  // delegates 0, 2, 4, 6
   EXPECT_TRUE(d.empty());

@@ -6,7 +6,7 @@
 #include <memory>
 #include <thread>
 
-#include "allocation_counter.hpp"
+#include "allocation_counter.hpp"  // tests/support
 
 TEST(SpscQueue, FifoOrderAndCapacity) {
   uh::SpscQueue<int> q(8);
@@ -50,14 +50,14 @@ TEST(SpscQueue, MoveOnlyElementsAndEmplace) {
 TEST(SpscQueue, PushAndPopNeverAllocateAfterConstruction) {
   uh::SpscQueue<std::uint64_t> q(64);
   std::uint64_t out = 0;
-  uh::test::arm_allocation_counter();
+  const uh::test::AllocationCounter counter;
   for (std::uint64_t round = 0; round < 10; ++round) {
     for (std::uint64_t i = 0; i < 64; ++i) (void)q.try_push(i);
     for (int i = 0; i < 100; ++i) (void)q.try_push(round);  // full: refused, no growth
     while (q.try_pop(out)) {
     }
   }
-  EXPECT_EQ(uh::test::disarm_allocation_counter(), 0u);
+  EXPECT_EQ(counter.count(), 0u);
 }
 
 TEST(SpscQueue, KeepsOrderAcrossTwoThreads) {
