@@ -34,8 +34,14 @@ int main(int argc, char** argv) {
       }
       uh::collette::IstAsset asset{std::move(*tree), {}};
       asset.meta.coverage = 0.8;
+      asset.meta.mesh_volume = asset.tree.total_volume() / 0.8;
+      if (const uh::Status ok = uh::collette::validate(asset); !ok) {
+        std::fprintf(stderr, "seed %d/%d: %s\n", n, arity, ok.error().message.c_str());
+        return 1;
+      }
       const auto bytes = uh::collette::encode_ist(asset);
-      std::ofstream out(dir / ("seed_" + std::to_string(n) + "_" + std::to_string(arity) + ".ist"), std::ios::binary);
+      std::ofstream out(dir / ("seed_" + std::to_string(n) + "_" + std::to_string(arity) + ".ist"),
+                        std::ios::binary);
       out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
       ++written;
     }

@@ -3,13 +3,18 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
 #include <system_error>
+#include <tuple>
 
 namespace uh::collette {
 namespace {
@@ -21,7 +26,8 @@ constexpr std::size_t kLeafBytes = 16;
 constexpr std::size_t kOffVersion = 8, kOffHeaderSize = 12, kOffNodes = 16, kOffLeaves = 20, kOffDepth = 24,
                       kOffArity = 28, kOffMetersPerUnit = 32, kOffMeshHash = 40, kOffCoverage = 48,
                       kOffMeshVolume = 56, kOffMaxGap = 64, kOffBuildSeconds = 72, kOffSphereCount = 80,
-                      kOffFlags = 84, kOffPayloadBytes = 88, kOffPayloadCrc = 96, kOffHeaderCrc = 100;
+                      kOffFlags = 84, kOffPayloadBytes = 88, kOffPayloadCrc = 96, kOffHeaderCrc = 100,
+                      kOffReserved = 104;
 // a .ist above this size is refused before reading it into memory
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 31;
 
@@ -61,6 +67,92 @@ std::int32_t get_i32(const std::byte* p) { return static_cast<std::int32_t>(get_
 
 std::string str(std::string_view s) { return std::string(s); }
 
+// shortest text that reads back as the same double (-1, nan, 1e-300; not to_string's fixed 6 digits)
+std::string num(double v) {
+  std::array<char, 32> buf{};
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(buf.data(), buf.size(), "%.*g", digits, v);
+    if (!std::isfinite(v) || std::strtod(buf.data(), nullptr) == v) break;
+  }
+  return buf.data();
+}
+
+// derived figures in messages: six digits are enough to act on
+std::string approx(double v) {
+  std::array<char, 32> buf{};
+  std::snprintf(buf.data(), buf.size(), "%.6g", v);
+  return buf.data();
+}
+
+// a leaf radius below this fraction of its centre's largest coordinate is refused: the centre
+// cannot be stored that precisely, and it bounds the grid cell indices below
+constexpr double kMinRadiusPerCoordinate = 1e-9;
+
+// The first two leaf spheres that overlap by more than `tol`. One uniform grid per power-of-two
+// radius class (radius in [2^e, 2^(e+1)), cells 2^(e+2) wide, so at least twice the class's
+// largest radius): a sphere can only overlap a sphere of its own or a larger class whose centre
+// lies in one of the 27 cells around its own centre in that class's grid. Spheres of a packing
+// are disjoint, so a cell holds a bounded number of them and the check is O(n log n) even for
+// a hostile file (a quadratic sweep would not be).
+Status check_leaves_disjoint(std::span<const Sphere> leaves, double tol) {
+  struct Entry {
+    int level;
+    std::int64_t x, y, z;
+    std::int32_t id;
+    auto key() const { return std::tie(level, x, y, z); }
+  };
+  auto cell_of = [](float c, int level) {
+    return static_cast<std::int64_t>(std::floor(static_cast<double>(c) / std::ldexp(4.0, level)));
+  };
+  std::vector<Entry> entries;
+  entries.reserve(leaves.size());
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Sphere& s = leaves[i];
+    const int level = std::ilogb(s.radius);
+    entries.push_back(
+        {level, cell_of(s.x, level), cell_of(s.y, level), cell_of(s.z, level), static_cast<std::int32_t>(i)});
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.key() < b.key() || (a.key() == b.key() && a.id < b.id);
+  });
+  std::vector<int> levels;
+  for (const Entry& e : entries)
+    if (levels.empty() || levels.back() != e.level) levels.push_back(e.level);
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Sphere& s = leaves[i];
+    const int own = std::ilogb(s.radius);
+    for (auto lv = std::lower_bound(levels.begin(), levels.end(), own); lv != levels.end(); ++lv) {
+      const std::int64_t cx = cell_of(s.x, *lv), cy = cell_of(s.y, *lv), cz = cell_of(s.z, *lv);
+      for (std::int64_t dx = -1; dx <= 1; ++dx)
+        for (std::int64_t dy = -1; dy <= 1; ++dy)
+          for (std::int64_t dz = -1; dz <= 1; ++dz) {
+            const Entry probe{*lv, cx + dx, cy + dy, cz + dz, -1};
+            auto it = std::lower_bound(entries.begin(), entries.end(), probe,
+                                       [](const Entry& a, const Entry& b) { return a.key() < b.key(); });
+            for (; it != entries.end() && it->key() == probe.key(); ++it) {
+              const auto j = static_cast<std::size_t>(it->id);
+              if (j == i) continue;
+              const Sphere& t = leaves[j];
+              const double ddx = static_cast<double>(s.x) - static_cast<double>(t.x);
+              const double ddy = static_cast<double>(s.y) - static_cast<double>(t.y);
+              const double ddz = static_cast<double>(s.z) - static_cast<double>(t.z);
+              const double depth = static_cast<double>(s.radius) + static_cast<double>(t.radius) -
+                                   std::sqrt(ddx * ddx + ddy * ddy + ddz * ddz);
+              if (depth > tol)
+                return Error{"invalid tree: leaf spheres " + std::to_string(std::min(i, j)) + " and " +
+                             std::to_string(std::max(i, j)) + " overlap by " + approx(depth) +
+                             " (the leaves of a packing are disjoint; tolerance " + approx(tol) + ")"};
+            }
+          }
+    }
+  }
+  return Ok{};
+}
+
+Error meta_error(const char* field, double value, const std::string& expected) {
+  return Error{std::string("invalid metadata: ") + field + " is " + num(value) + ", expected " + expected};
+}
+
 }  // namespace
 
 std::uint32_t ist_crc32(std::span<const std::byte> bytes) {
@@ -77,6 +169,43 @@ std::uint64_t ist_hash_bytes(std::span<const std::byte> bytes) {
     h *= 0x100000001b3ull;
   }
   return h;
+}
+
+Status validate(const IstAsset& asset) {
+  const SphereTree& tree = asset.tree;
+  if (const Status ok = validate(tree); !ok) return Error{"invalid tree: " + ok.error().message};
+  for (int c = 0; c < tree.node_count(); ++c)
+    if (tree.nodes()[static_cast<std::size_t>(c)].count > tree.arity())
+      return Error{"invalid tree: node " + std::to_string(c) + " has more children than the arity " +
+                   std::to_string(tree.arity())};
+  const IstMetadata& m = asset.meta;
+  if (!(m.meters_per_unit >= kIstMinMetersPerUnit && m.meters_per_unit <= kIstMaxMetersPerUnit))
+    return meta_error("meters_per_unit", m.meters_per_unit,
+                      "the length of one mesh unit in metres, " + approx(kIstMinMetersPerUnit) + " .. " +
+                          approx(kIstMaxMetersPerUnit));
+  if (!(std::isfinite(m.mesh_volume) && m.mesh_volume > 0.0))
+    return meta_error("mesh_volume", m.mesh_volume, "a finite positive volume");
+  if (!(m.coverage > 0.0 && m.coverage <= 1.0))
+    return meta_error("coverage", m.coverage, "a fraction in (0, 1]");
+  const double filled = tree.total_volume() / m.mesh_volume;
+  if (!(std::abs(filled - m.coverage) <= kIstCoverageTolerance * m.coverage))
+    return meta_error("coverage", m.coverage,
+                      "the spheres' volume " + approx(tree.total_volume()) + " / mesh_volume " +
+                          approx(m.mesh_volume) + " = " + approx(filled));
+  if (!(std::isfinite(m.max_gap) && m.max_gap >= 0.0))
+    return meta_error("max_gap", m.max_gap, "a finite length >= 0");
+  if (!(std::isfinite(m.build_seconds) && m.build_seconds >= 0.0))
+    return meta_error("build_seconds", m.build_seconds, "a finite time >= 0");
+  const auto leaves = tree.leaves();
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Sphere& s = leaves[i];
+    const float far = std::max({std::abs(s.x), std::abs(s.y), std::abs(s.z)});
+    if (static_cast<double>(s.radius) < kMinRadiusPerCoordinate * static_cast<double>(far))
+      return Error{"invalid tree: leaf sphere " + std::to_string(i) + " has radius " +
+                   approx(static_cast<double>(s.radius)) + ", below 1e-9 of its centre's coordinate " +
+                   approx(static_cast<double>(far)) + " (a float centre is not that precise)"};
+  }
+  return check_leaves_disjoint(leaves, 1e-5 * static_cast<double>(tree.root().radius));
 }
 
 std::vector<std::byte> encode_ist(const IstAsset& asset) {
@@ -141,19 +270,29 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
                  std::to_string(kIstHeaderSize)};
   const std::uint32_t version = get_u32(h + kOffVersion);
   if (version != kIstFormatVersion)
-    return Error{who + "unsupported .ist format version " + std::to_string(version) + " (this build reads version " +
-                 std::to_string(kIstFormatVersion) + "; rebuild the file with this version)"};
+    return Error{who + "unsupported .ist format version " + std::to_string(version) +
+                 " (this build reads version " + std::to_string(kIstFormatVersion) +
+                 "; rebuild the file with this version)"};
   if (get_u32(h + kOffHeaderCrc) != ist_crc32({h, kOffHeaderCrc}))
     return Error{who + "corrupted: header checksum mismatch"};
   if (get_u32(h + kOffHeaderSize) != kIstHeaderSize)
-    return Error{who + "corrupted: header size " + std::to_string(get_u32(h + kOffHeaderSize)) + ", expected " +
-                 std::to_string(kIstHeaderSize)};
+    return Error{who + "corrupted: header size " + std::to_string(get_u32(h + kOffHeaderSize)) +
+                 ", expected " + std::to_string(kIstHeaderSize)};
+  if (get_u32(h + kOffFlags) != 0)
+    return Error{who + "corrupted: flags " + std::to_string(get_u32(h + kOffFlags)) +
+                 " (format version 1 defines none; expected 0)"};
+  // the reserved bytes are outside the header checksum, so they are checked here
+  for (std::size_t i = kOffReserved; i < kIstHeaderSize; ++i)
+    if (h[i] != std::byte{0})
+      return Error{who + "corrupted: reserved header byte " + std::to_string(i) + " is not zero"};
   const std::uint64_t node_count = get_u32(h + kOffNodes);
   const std::uint64_t leaf_count = get_u32(h + kOffLeaves);
   const std::uint64_t payload = get_u64(h + kOffPayloadBytes);
-  if (node_count == 0 || leaf_count == 0 || node_count > 2 * leaf_count || get_u32(h + kOffSphereCount) != leaf_count)
+  if (node_count == 0 || leaf_count == 0 || node_count > 2 * leaf_count ||
+      get_u32(h + kOffSphereCount) != leaf_count)
     return Error{who + "corrupted: inconsistent counts (" + std::to_string(node_count) + " nodes, " +
-                 std::to_string(leaf_count) + " leaves, " + std::to_string(get_u32(h + kOffSphereCount)) + " spheres)"};
+                 std::to_string(leaf_count) + " leaves, " + std::to_string(get_u32(h + kOffSphereCount)) +
+                 " spheres)"};
   const std::uint64_t expected = node_count * kNodeBytes + leaf_count * kLeafBytes;
   if (payload != expected)
     return Error{who + "corrupted: payload size " + std::to_string(payload) + " does not match the counts (" +
@@ -163,7 +302,8 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
     return Error{who + "truncated: " + std::to_string(size) + " bytes, the header announces " +
                  std::to_string(kIstHeaderSize + payload)};
   if (size - kIstHeaderSize > payload)
-    return Error{who + "corrupted: " + std::to_string(size - kIstHeaderSize - payload) + " unexpected bytes after the payload"};
+    return Error{who + "corrupted: " + std::to_string(size - kIstHeaderSize - payload) +
+                 " unexpected bytes after the payload"};
   if (get_u32(h + kOffPayloadCrc) != ist_crc32({h + kIstHeaderSize, static_cast<std::size_t>(payload)}))
     return Error{who + "corrupted: payload checksum mismatch"};
 
@@ -171,7 +311,7 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
   std::vector<Sphere> leaves(static_cast<std::size_t>(leaf_count));
   const std::byte* p = h + kIstHeaderSize;
   for (SphereTreeNode& n : nodes) {
-    n = {get_f32(p + 0), get_f32(p + 4),  get_f32(p + 8),  get_f32(p + 12),
+    n = {get_f32(p + 0),  get_f32(p + 4),  get_f32(p + 8),  get_f32(p + 12),
          get_f32(p + 16), get_i32(p + 20), get_i32(p + 24), get_i32(p + 28)};
     p += kNodeBytes;
   }
@@ -182,19 +322,17 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
   const std::uint32_t depth = get_u32(h + kOffDepth);
   const std::uint32_t arity = get_u32(h + kOffArity);
   if (depth > node_count || arity < 2 || arity > static_cast<std::uint32_t>(kMaxSphereTreeArity))
-    return Error{who + "corrupted: depth " + std::to_string(depth) + " or arity " + std::to_string(arity) + " out of range"};
-  IstAsset asset{SphereTree(std::move(nodes), std::move(leaves), static_cast<int>(depth), static_cast<int>(arity)), {}};
-  if (const Status ok = validate(asset.tree); !ok) return Error{who + "invalid tree: " + ok.error().message};
-  for (int c = 0; c < asset.tree.node_count(); ++c)
-    if (asset.tree.nodes()[static_cast<std::size_t>(c)].count > asset.tree.arity())
-      return Error{who + "invalid tree: node " + std::to_string(c) + " has more children than the arity " +
-                   std::to_string(arity)};
+    return Error{who + "corrupted: depth " + std::to_string(depth) + " or arity " + std::to_string(arity) +
+                 " out of range"};
+  IstAsset asset{
+      SphereTree(std::move(nodes), std::move(leaves), static_cast<int>(depth), static_cast<int>(arity)), {}};
   asset.meta.meters_per_unit = get_f64(h + kOffMetersPerUnit);
   asset.meta.source_mesh_hash = get_u64(h + kOffMeshHash);
   asset.meta.coverage = get_f64(h + kOffCoverage);
   asset.meta.mesh_volume = get_f64(h + kOffMeshVolume);
   asset.meta.max_gap = get_f64(h + kOffMaxGap);
   asset.meta.build_seconds = get_f64(h + kOffBuildSeconds);
+  if (const Status ok = validate(asset); !ok) return Error{who + ok.error().message};
   return asset;
 }
 
@@ -203,19 +341,21 @@ Result<IstAsset> load_ist(const std::filesystem::path& path) {
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) return Error{name + ": cannot open .ist file: " + ec.message()};
-  if (size > kMaxFileBytes) return Error{name + ": " + std::to_string(size) + " bytes is too large for a .ist file"};
+  if (size > kMaxFileBytes)
+    return Error{name + ": " + std::to_string(size) + " bytes is too large for a .ist file"};
   std::ifstream in(path, std::ios::binary);
   if (!in) return Error{name + ": cannot open .ist file for reading"};
   std::vector<std::byte> bytes(static_cast<std::size_t>(size));
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
   if (static_cast<std::uintmax_t>(in.gcount()) != size)
-    return Error{name + ": read error (got " + std::to_string(in.gcount()) + " of " + std::to_string(size) + " bytes)"};
+    return Error{name + ": read error (got " + std::to_string(in.gcount()) + " of " + std::to_string(size) +
+                 " bytes)"};
   return load_ist_from_memory(bytes, name);
 }
 
 Status save_ist(const std::filesystem::path& path, const IstAsset& asset) {
   const std::string name = path.string();
-  if (const Status ok = validate(asset.tree); !ok) return Error{name + ": not saved: " + ok.error().message};
+  if (const Status ok = validate(asset); !ok) return Error{name + ": not saved: " + ok.error().message};
   const std::vector<std::byte> bytes = encode_ist(asset);
   const std::string tmp = name + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);

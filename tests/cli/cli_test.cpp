@@ -46,7 +46,8 @@ class CliTest : public ::testing::Test {
     dir_ = fs::temp_directory_path() / fmt::format("uh_cli_test_{}", ::getpid());
     fs::create_directories(dir_);
     // one small tree shared by the query tests
-    const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 600 --json", bunny().string(), (dir_ / "bunny.ist").string()));
+    const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 600 --json", bunny().string(),
+                                        (dir_ / "bunny.ist").string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
@@ -55,7 +56,8 @@ class CliTest : public ::testing::Test {
 
   static CommandRun uh(const std::string& arguments) {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = fmt::format("'{}' {} > '{}' 2> '{}'", UH_CLI_PATH, arguments, out.string(), err.string());
+    const std::string command =
+        fmt::format("'{}' {} > '{}' 2> '{}'", UH_CLI_PATH, arguments, out.string(), err.string());
     const int status = std::system(command.c_str());
     CommandRun r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -85,31 +87,37 @@ fs::path write_poses(const fs::path& path, int steps, double from, double to) {
   for (int k = 0; k < steps; ++k) {
     const double x = from + (to - from) * k / std::max(1, steps - 1);
     const double half = 0.002 * k;  // a slow turn about y
-    out << "p" << k << "," << x << ",0.1,0," << std::cos(half) << ",0," << std::sin(half) << ",0,extra column\n";
+    out << "p" << k << "," << x << ",0.1,0," << std::cos(half) << ",0," << std::sin(half)
+        << ",0,extra column\n";
   }
   out << "far,50,0,0,1,0,0,0,\n";
   return path;
 }
 
 // Brute force over all leaf pairs: the intersection volume of the packings at one pose.
-Vec3 centre(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
+Vec3 centre(const Sphere& s) {
+  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+}
 
 double brute_volume(const collette::SphereTree& a, const collette::SphereTree& b, const Pose& b_in_a) {
   double v = 0.0;
   for (const Sphere& sb : b.leaves()) {
     const Vec3 cb = transform_point(b_in_a, centre(sb));
     for (const Sphere& sa : a.leaves())
-      v += lens_volume<double>(norm(cb - centre(sa)), static_cast<double>(sa.radius), static_cast<double>(sb.radius));
+      v += lens_volume<double>(norm(cb - centre(sa)), static_cast<double>(sa.radius),
+                               static_cast<double>(sb.radius));
   }
   return v;
 }
 
 TEST_F(CliTest, IstBuildPrintsTheDocumentedFieldsAndInfoAgrees) {
   const fs::path ist = dir_ / "build.ist", png = dir_ / "build.png";
-  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 400 --preview '{}' --json", bunny().string(), ist.string(), png.string()));
+  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 400 --preview '{}' --json",
+                                      bunny().string(), ist.string(), png.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = json_of(r);
-  for (const char* key : {"spheres", "mesh_volume", "sphere_volume", "coverage", "max_gap", "build_seconds", "nodes", "depth"})
+  for (const char* key :
+       {"spheres", "mesh_volume", "sphere_volume", "coverage", "max_gap", "build_seconds", "nodes", "depth"})
     EXPECT_TRUE(j.contains(key)) << "missing " << key << " in " << r.out;
   EXPECT_EQ(j.value("spheres", 0), 400);
   EXPECT_NEAR(j.value("coverage", 0.0), j.value("sphere_volume", 0.0) / j.value("mesh_volume", 1.0), 1e-9);
@@ -131,7 +139,8 @@ TEST_F(CliTest, IstBuildPrintsTheDocumentedFieldsAndInfoAgrees) {
   EXPECT_NEAR(ji.value("coverage", 0.0), j.value("coverage", 0.0), 1e-6);
 
   const fs::path section = dir_ / "section.png";
-  const CommandRun preview = uh(fmt::format("ist preview '{}' -o '{}' --section", ist.string(), section.string()));
+  const CommandRun preview =
+      uh(fmt::format("ist preview '{}' -o '{}' --section", ist.string(), section.string()));
   ASSERT_EQ(preview.exit_code, 0) << preview.err;
   EXPECT_EQ(read_text(section).substr(0, 4), "\x89PNG");
 }
@@ -140,7 +149,8 @@ TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
   const fs::path ist = dir_ / "bunny.ist";
   const fs::path poses = write_poses(dir_ / "poses.csv", 5, -4.0, 2.0);
   const fs::path csv = dir_ / "results.csv";
-  const CommandRun r = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", ist.string(), poses.string(), csv.string()));
+  const CommandRun r = uh(
+      fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", ist.string(), poses.string(), csv.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(csv);
   std::string line;
@@ -184,8 +194,10 @@ TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
 TEST_F(CliTest, QueryJsonSummaryAndCoherentPathGiveTheSameResults) {
   const fs::path ist = dir_ / "bunny.ist";
   const fs::path poses = write_poses(dir_ / "path.csv", 60, -3.0, -2.5);
-  const CommandRun plain = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
-  const CommandRun coherent = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json --coherence-skin 0.2", ist.string(), poses.string()));
+  const CommandRun plain =
+      uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
+  const CommandRun coherent = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json --coherence-skin 0.2",
+                                             ist.string(), poses.string()));
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   ASSERT_EQ(coherent.exit_code, 0) << coherent.err;
   const auto jp = json_of(plain), jc = json_of(coherent);
@@ -196,9 +208,12 @@ TEST_F(CliTest, QueryJsonSummaryAndCoherentPathGiveTheSameResults) {
     const auto& a = jp["results"][i];
     const auto& b = jc["results"][i];
     EXPECT_EQ(a["pairs"], b["pairs"]) << i;
-    EXPECT_NEAR(a["volume"].get<double>(), b["volume"].get<double>(), 1e-12 + 1e-9 * a["volume"].get<double>()) << i;
+    EXPECT_NEAR(a["volume"].get<double>(), b["volume"].get<double>(),
+                1e-12 + 1e-9 * a["volume"].get<double>())
+        << i;
   }
-  EXPECT_GT(jc["coherence"].value("reused_poses", 0), 40) << "small steps along the path should reuse the kept pairs";
+  EXPECT_GT(jc["coherence"].value("reused_poses", 0), 40)
+      << "small steps along the path should reuse the kept pairs";
 }
 
 TEST_F(CliTest, QuaternionsAreNormalisedWhateverTheirScale) {
@@ -211,7 +226,8 @@ TEST_F(CliTest, QuaternionsAreNormalisedWhateverTheirScale) {
     for (const double scale : {1.0, 1e-200, 1e200, 3.0})
       out << "s" << scale << ",-2,0.1,0," << c * scale << ",0," << s * scale << ",0\n";
   }
-  const CommandRun r = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
+  const CommandRun r =
+      uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = json_of(r);
   ASSERT_EQ(j["results"].size(), 4u);
@@ -233,7 +249,8 @@ TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
     std::ofstream keep(out);
     keep << "an earlier file that must survive";
   }
-  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 50", open_mesh.string(), out.string()));
+  const CommandRun r =
+      uh(fmt::format("ist build '{}' -o '{}' --spheres 50", open_mesh.string(), out.string()));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("open_box.obj"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("boundary"), std::string::npos) << r.err;
@@ -250,12 +267,35 @@ TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
   EXPECT_NE(info.exit_code, 0);
   EXPECT_NE(info.err.find("broken.ist"), std::string::npos) << info.err;
 
+  // meaningless units with valid checksums: refused by every command that loads it, field named
+  const fs::path negative = dir_ / "negative_units.ist";
+  {
+    auto asset = collette::load_ist(dir_ / "bunny.ist");
+    ASSERT_TRUE(asset) << asset.error().message;
+    asset->meta.meters_per_unit = -1.0;
+    const auto bytes = collette::encode_ist(*asset);
+    std::ofstream(negative, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+  const CommandRun units = uh(fmt::format("ist info '{}'", negative.string()));
+  EXPECT_NE(units.exit_code, 0);
+  EXPECT_NE(units.err.find("negative_units.ist"), std::string::npos) << units.err;
+  EXPECT_NE(units.err.find("meters_per_unit is -1"), std::string::npos) << units.err;
+  const fs::path good_poses = write_poses(dir_ / "units_poses.csv", 2, 0.0, 0.1);
+  const fs::path units_out = dir_ / "units.csv";
+  const CommandRun uq =
+      uh(fmt::format("query '{0}' '{1}' --poses '{2}' --out '{3}'", (dir_ / "bunny.ist").string(),
+                     negative.string(), good_poses.string(), units_out.string()));
+  EXPECT_NE(uq.exit_code, 0);
+  EXPECT_NE(uq.err.find("meters_per_unit"), std::string::npos) << uq.err;
+  EXPECT_FALSE(fs::exists(units_out));
+
   // a poses file without the quaternion columns
   const fs::path poses = dir_ / "bad_poses.csv";
   std::ofstream(poses) << "id,tx,ty,tz\na,0,0,0\n";
   const fs::path results = dir_ / "never.csv";
-  const CommandRun q = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", (dir_ / "bunny.ist").string(), poses.string(),
-                               results.string()));
+  const CommandRun q = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'",
+                                      (dir_ / "bunny.ist").string(), poses.string(), results.string()));
   EXPECT_NE(q.exit_code, 0);
   EXPECT_NE(q.err.find("bad_poses.csv"), std::string::npos) << q.err;
   EXPECT_NE(q.err.find("qw"), std::string::npos) << q.err;

@@ -6,7 +6,8 @@
 /// (magic, format version, counts, units, a hash of the source mesh, packing report, payload size,
 /// CRC-32 of the payload and of the header), then the node array (32 bytes a node) and the leaf
 /// spheres (16 bytes each). Loaders check every count against the real size before allocating
-/// and validate() the tree, so a hostile file gives an error message, never a crash.
+/// and validate() the asset (tree and metadata), so a hostile file gives an error message, never
+/// a crash and never a meaningless asset.
 
 #include <cstddef>
 #include <cstdint>
@@ -26,14 +27,24 @@ inline constexpr std::uint32_t kIstFormatVersion = 1;
 inline constexpr std::size_t kIstHeaderSize = 128;
 
 /// Facts stored next to the tree: units, provenance and the packing report.
+/// validate(const IstAsset&) states what each field must hold.
 struct IstMetadata {
-  double meters_per_unit = 1.0;       ///< length of one mesh unit [m]
-  std::uint64_t source_mesh_hash = 0; ///< hash of the source mesh (e.g. ist_hash_bytes of the file), 0 if unknown
-  double coverage = 0.0;              ///< sphere volume / mesh volume, 0..1
-  double mesh_volume = 0.0;           ///< volume of the closed mesh [length^3]
-  double max_gap = 0.0;               ///< largest distance from the surface to the spheres [length]
-  double build_seconds = 0.0;         ///< time the packing and tree build took [s]
+  double meters_per_unit =
+      1.0;  ///< length of one mesh unit [m], in [kIstMinMetersPerUnit, kIstMaxMetersPerUnit]
+  std::uint64_t source_mesh_hash =
+      0;                       ///< hash of the source mesh (e.g. ist_hash_bytes of the file), 0 if unknown
+  double coverage = 0.0;       ///< sphere volume / mesh volume, in (0, 1]
+  double mesh_volume = 0.0;    ///< volume of the closed mesh [length^3], > 0
+  double max_gap = 0.0;        ///< largest distance from the surface to the spheres [length], >= 0
+  double build_seconds = 0.0;  ///< time the packing and tree build took [s], >= 0
 };
+
+/// Accepted range of IstMetadata::meters_per_unit [m]: a nanometre to a million kilometres.
+inline constexpr double kIstMinMetersPerUnit = 1e-9;
+inline constexpr double kIstMaxMetersPerUnit = 1e9;
+/// Largest relative difference accepted between IstMetadata::coverage and the tree's sphere
+/// volume / mesh_volume (the tree sums float volumes; the packing sums doubles).
+inline constexpr double kIstCoverageTolerance = 1e-3;
 
 /// A loaded or to-be-saved asset. The sphere count, node count and depth come from the tree.
 struct IstAsset {
@@ -41,15 +52,28 @@ struct IstAsset {
   IstMetadata meta;
 };
 
+/// Checks that `asset` means what the format says, beyond what validate(const SphereTree&)
+/// checks: no node has more children than the tree's arity; the leaf spheres do not overlap
+/// (they are a packing: the volume query and the coverage assume it; overlaps up to 1e-5 of the
+/// root radius are float rounding and accepted); every leaf radius is at least 1e-9 of its
+/// centre's distance from the origin; meters_per_unit finite and in
+/// [kIstMinMetersPerUnit, kIstMaxMetersPerUnit]; mesh_volume finite, positive and at least the
+/// sphere volume; coverage in (0, 1] and equal to sphere volume / mesh_volume within
+/// kIstCoverageTolerance; max_gap and build_seconds finite and >= 0. The message names the
+/// first broken field ("invalid tree: ..." or "invalid metadata: <field> ..."). Not real-time
+/// safe (allocates); any thread.
+Status validate(const IstAsset& asset);
+
 /// Writes `asset` to `path` atomically: to a temporary file in the same directory, flushed to
 /// disk, then renamed over `path`, so a failure never leaves a half-written or clobbered file.
-/// Fails (message names the file) when the tree is invalid or the file cannot be written.
+/// Fails (message names the file) when validate(asset) fails or the file cannot be written.
 /// Not real-time safe; any thread.
 Status save_ist(const std::filesystem::path& path, const IstAsset& asset);
 
 /// Reads and checks a .ist file. The error names the file and says what is wrong: missing,
-/// truncated, not a .ist file (magic), unsupported format version, corrupted (checksum), or
-/// an invalid tree. Not real-time safe; any thread.
+/// truncated, not a .ist file (magic), unsupported format version, corrupted (checksum, counts,
+/// flags or reserved bytes), or a tree or metadata that fails validate(const IstAsset&), naming
+/// the field. Whatever loads re-encodes to the same bytes. Not real-time safe; any thread.
 Result<IstAsset> load_ist(const std::filesystem::path& path);
 
 /// Decodes a .ist image from memory (the fuzz target's entry point). `name` prefixes messages.
