@@ -3,8 +3,8 @@
 #   1. Release: every test (unit, integration, the installed-package consumer);
 #   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test;
 #   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions);
-#   4. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds) and the scene
-#      parser (the repository's scenes as seeds).
+#   4. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds), the scene
+#      parser (the repository's scenes as seeds) and the CSV reader (fuzz/csv_seeds).
 # Ends with one summary line: "tests: N passed, N failed".
 set -uo pipefail
 source "$(dirname "$0")/common.sh"
@@ -56,9 +56,9 @@ fi
 
 echo "== build (libFuzzer, clang) =="
 if command -v clang++ >/dev/null 2>&1; then
-  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz uh_csv_reader_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
        -DUH_BUILD_FUZZERS=ON -DUH_BUILD_APPS=OFF -DUH_BUILD_BENCHMARKS=OFF; then
-    run_ctest fuzz build/fuzz -R '^(ist_|scene_parser_fuzz)'
+    run_ctest fuzz build/fuzz -R '^(ist_|scene_parser_fuzz|csv_reader_fuzz)'
   else
     echo "test: fuzzer build failed"; status=1; failed=$((failed + 1))
   fi

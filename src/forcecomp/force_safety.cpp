@@ -13,13 +13,6 @@ void bump(std::atomic<std::uint64_t>& counter) {
 
 }  // namespace
 
-bool clamp_norm(Vec3& v, double limit) {
-  const double n = norm(v);
-  if (n <= limit) return false;
-  v = limit > 0.0 ? v * (limit / n) : Vec3{};
-  return true;
-}
-
 Wrench ForceSafety::apply(const Wrench& raw, double now_s, double data_time_s) {
   bump(ticks_);
   // read the stop/fault state before the resume request: resume() publishes the request before it

@@ -1,23 +1,11 @@
 #include "uh/haptico/device_config.hpp"
 
-#include <charconv>
-#include <cmath>
 #include <fmt/format.h>
+#include <vector>
+
+#include "uh/core/csv_reader.hpp"
 
 namespace uh::haptico {
-
-namespace {
-
-bool parse_double(std::string_view s, double& out) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  if (s.empty()) return false;
-  if (s.front() == '+') s.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc{} && end == s.data() + s.size() && std::isfinite(out);
-}
-
-}  // namespace
 
 DeviceConfig& DeviceConfig::set(const std::string& key, std::string value) {
   values_[key] = std::move(value);
@@ -43,7 +31,7 @@ Result<double> DeviceConfig::number(const std::string& key, double fallback) con
   const auto it = values_.find(key);
   if (it == values_.end()) return fallback;
   double v = 0.0;
-  if (!parse_double(it->second, v)) {
+  if (!parse_csv_number(it->second, v)) {
     return Error{fmt::format("device setting '{}': '{}' is not a finite number", key, it->second)};
   }
   return v;
@@ -52,17 +40,14 @@ Result<double> DeviceConfig::number(const std::string& key, double fallback) con
 Result<Vec3> DeviceConfig::vec3(const std::string& key, const Vec3& fallback) const {
   const auto it = values_.find(key);
   if (it == values_.end()) return fallback;
-  const std::string_view s = it->second;
+  // one CSV line of three numbers
+  std::vector<std::string_view> fields;
+  split_csv_line(it->second, fields);
   double c[3] = {};
-  std::size_t begin = 0;
-  for (int i = 0; i < 3; ++i) {
-    const std::size_t comma = s.find(',', begin);
-    const bool last = i == 2;
-    if (last != (comma == std::string_view::npos) ||
-        !parse_double(s.substr(begin, last ? std::string_view::npos : comma - begin), c[i])) {
-      return Error{fmt::format("device setting '{}': '{}' is not a vector \"x,y,z\" of three finite numbers", key, s)};
-    }
-    begin = comma + 1;
+  if (fields.size() != 3 || !parse_csv_number(fields[0], c[0]) || !parse_csv_number(fields[1], c[1]) ||
+      !parse_csv_number(fields[2], c[2])) {
+    return Error{fmt::format("device setting '{}': '{}' is not a vector \"x,y,z\" of three finite numbers", key,
+                             it->second)};
   }
   return Vec3{c[0], c[1], c[2]};
 }

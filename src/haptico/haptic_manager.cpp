@@ -13,14 +13,6 @@ namespace {
 
 bool finite(const DeviceCommand& c) { return is_finite(c.force) && is_finite(c.torque); }
 
-// scales v down to `limit` keeping its direction; true if it did
-bool clamp_norm(Vec3& v, double limit) {
-  const double n = norm(v);
-  if (n <= limit) return false;
-  v = limit > 0.0 ? v * (limit / n) : Vec3{};
-  return true;
-}
-
 FixedRateLoopOptions loop_options(const HapticManagerOptions& o) {
   FixedRateLoopOptions l;
   l.rate_hz = o.rate_hz;

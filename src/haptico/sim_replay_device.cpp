@@ -1,119 +1,70 @@
 #include "uh/haptico/sim_replay_device.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <fmt/format.h>
-#include <fstream>
 #include <string_view>
 #include <utility>
+
+#include "uh/core/csv_reader.hpp"
 
 namespace uh::haptico {
 
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
+constexpr std::string_view kColumns = "time_s,x,y,z,qw,qx,qy,qz";
+constexpr std::string_view kNames[8] = {"time_s", "x", "y", "z", "qw", "qx", "qy", "qz"};
 
-bool to_number(std::string_view s, double& out) {
-  s = trim(s);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  if (s.empty()) return false;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc{} && end == s.data() + s.size();
-}
-
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t begin = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', begin);
-    fields.push_back(line.substr(begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin));
-    if (comma == std::string_view::npos) break;
-    begin = comma + 1;
+Result<std::vector<TrajectorySample>> read_trajectory(CsvReader& csv) {
+  // a file without a header holds the eight columns in order
+  if (auto header = csv.read_header(kNames); !header) {
+    return Error{fmt::format("{}: no samples (expected lines of '{}')", csv.source_name(), kColumns)};
   }
-  return fields;
-}
-
-constexpr const char* kColumns = "time_s,x,y,z,qw,qx,qy,qz";
-
-}  // namespace
-
-Result<std::vector<TrajectorySample>> SimReplayDevice::parse_csv(std::istream& in, const std::string& source_name) {
+  // a `uh run --trace` file names its time column device_time_s
+  std::size_t column[8] = {};
+  for (std::size_t k = 0; k < 8; ++k) {
+    const auto found = k == 0 && !csv.find_column("time_s") ? csv.find_column("device_time_s") : csv.find_column(kNames[k]);
+    if (!found) return csv.column(kNames[k], kColumns).error();
+    column[k] = *found;
+  }
   std::vector<TrajectorySample> samples;
-  std::string line;
-  int line_number = 0;
-  bool seen_content = false;
-  // where each of time_s,x,y,z,qw,qx,qy,qz stands in a row; a header may name them in any order
-  // among other columns (a `uh run --trace` CSV: its device_time_s is the time column)
-  std::size_t column[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-  std::size_t row_fields = 8;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const std::string_view text = trim(line);
-    if (text.empty() || text.front() == '#') continue;
-    const std::vector<std::string_view> fields = split(text);
-    double first = 0.0;
-    if (!seen_content && !to_number(fields.front(), first)) {
-      // a header line: accept it only if it names the expected columns
-      seen_content = true;
-      static constexpr std::string_view kNames[8] = {"time_s", "x", "y", "z", "qw", "qx", "qy", "qz"};
-      bool found[8] = {};
-      for (std::size_t i = 0; i < fields.size(); ++i) {
-        const std::string_view name = trim(fields[i]);
-        for (std::size_t k = 0; k < 8; ++k) {
-          const bool match = name == kNames[k] || (k == 0 && name == "device_time_s" && !found[0]);
-          if (match && !found[k]) {
-            column[k] = i;
-            found[k] = true;
-            break;
-          }
-        }
-      }
-      if (!std::all_of(std::begin(found), std::end(found), [](bool f) { return f; })) {
-        return Error{fmt::format("{}:{}: header '{}' does not match the expected columns '{}'", source_name,
-                                 line_number, text, kColumns)};
-      }
-      row_fields = fields.size();
-      continue;
-    }
-    seen_content = true;
-    if (fields.size() != row_fields) {
-      return Error{fmt::format("{}:{}: expected {} comma-separated numbers ({}), found {} fields", source_name,
-                               line_number, row_fields, row_fields == 8 ? kColumns : "as named by the header",
-                               fields.size())};
-    }
+  while (true) {
+    auto row = csv.next_row();
+    if (!row) return row.error();
+    if (!*row) break;
     double v[8] = {};
-    for (std::size_t i = 0; i < 8; ++i) {
-      if (!to_number(fields[column[i]], v[i]) || !std::isfinite(v[i])) {
-        return Error{fmt::format("{}:{}: field {} ('{}') is not a finite number", source_name, line_number,
-                                 column[i] + 1, trim(fields[column[i]]))};
-      }
+    for (std::size_t k = 0; k < 8; ++k) {
+      auto number = csv.number(column[k]);
+      if (!number) return number.error();
+      v[k] = *number;
     }
     const double qn = std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
     if (!(qn >= 1e-6) || !std::isfinite(qn)) {
-      return Error{fmt::format("{}:{}: quaternion (qw,qx,qy,qz) must have a finite, non-zero length", source_name,
-                               line_number)};
+      return csv.error("quaternion (qw,qx,qy,qz) must have a finite, non-zero length");
     }
     if (!samples.empty() && !(v[0] > samples.back().time_s)) {
-      return Error{fmt::format("{}:{}: time {} s is not after the previous sample's {} s (times must increase)",
-                               source_name, line_number, v[0], samples.back().time_s)};
+      return csv.error(fmt::format("time {} s is not after the previous sample's {} s (times must increase)", v[0],
+                                   samples.back().time_s));
     }
     samples.push_back({v[0], Pose{Quat{v[4] / qn, v[5] / qn, v[6] / qn, v[7] / qn}, Vec3{v[1], v[2], v[3]}}});
   }
   if (samples.empty()) {
-    return Error{fmt::format("{}: no samples (expected lines of '{}')", source_name, kColumns)};
+    return Error{fmt::format("{}: no samples (expected lines of '{}')", csv.source_name(), kColumns)};
   }
   return samples;
 }
 
+}  // namespace
+
+Result<std::vector<TrajectorySample>> SimReplayDevice::parse_csv(std::istream& in, const std::string& source_name) {
+  CsvReader csv(in, source_name);
+  return read_trajectory(csv);
+}
+
 Result<std::vector<TrajectorySample>> SimReplayDevice::load_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Error{fmt::format("{}: cannot open the trajectory file", path)};
-  return parse_csv(in, path);
+  auto csv = CsvReader::open(path, "trajectory file");
+  if (!csv) return csv.error();
+  return read_trajectory(*csv);
 }
 
 SimReplayDevice::SimReplayDevice(std::vector<TrajectorySample> samples, const SimReplayOptions& options)

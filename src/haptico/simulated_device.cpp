@@ -9,10 +9,9 @@ namespace uh::haptico {
 namespace {
 
 // motors saturate: keep the direction, cap the magnitude
-Vec3 saturate(const Vec3& v, double limit) {
-  if (!is_finite(v)) return {};
-  const double n = norm(v);
-  return n > limit ? v * (limit / n) : v;
+Vec3 saturate(Vec3 v, double limit) {
+  clamp_norm(v, limit);
+  return v;
 }
 
 }  // namespace

@@ -222,9 +222,10 @@ TEST_F(CliTest, QuaternionsAreNormalisedWhateverTheirScale) {
   {
     std::ofstream out(poses);
     const double c = std::cos(0.1), s = std::sin(0.1);
-    out << "id,tx,ty,tz,qw,qx,qy,qz\n";
+    // comment lines and blank lines are skipped
+    out << "# scaled copies of one rotation\nid,tx,ty,tz,qw,qx,qy,qz\n\n";
     for (const double scale : {1.0, 1e-200, 1e200, 3.0})
-      out << "s" << scale << ",-2,0.1,0," << c * scale << ",0," << s * scale << ",0\n";
+      out << "s" << scale << ",-2,0.1,0," << c * scale << ",0," << s * scale << ",0\n# next\n";
   }
   const CommandRun r =
       uh(fmt::format("query '{0}' '{0}' --poses '{1}' --json", ist.string(), poses.string()));
@@ -299,6 +300,16 @@ TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
   EXPECT_NE(q.exit_code, 0);
   EXPECT_NE(q.err.find("bad_poses.csv"), std::string::npos) << q.err;
   EXPECT_NE(q.err.find("qw"), std::string::npos) << q.err;
+  EXPECT_FALSE(fs::exists(results));
+
+  // a field that is not a number: the message names the file, line and column
+  const fs::path bad_number = dir_ / "bad_number.csv";
+  std::ofstream(bad_number) << "# poses\nid,tx,ty,tz,qw,qx,qy,qz\na,0,0,0,1,0,0,0\nb,0,oops,0,1,0,0,0\n";
+  const CommandRun n = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", (dir_ / "bunny.ist").string(),
+                                      bad_number.string(), results.string()));
+  EXPECT_NE(n.exit_code, 0);
+  EXPECT_NE(n.err.find("bad_number.csv:4: column 'ty' (field 3) is 'oops', expected a finite number"), std::string::npos)
+      << n.err;
   EXPECT_FALSE(fs::exists(results));
 }
 

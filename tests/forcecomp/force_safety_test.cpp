@@ -104,13 +104,5 @@ TEST(ForceSafety, DeviceFaultZeroesUntilResume) {
   EXPECT_FALSE(safety.faulted());
 }
 
-TEST(ForceSafety, ClampNormHandlesZeroLimit) {
-  Vec3 v{1, 0, 0};
-  EXPECT_TRUE(clamp_norm(v, 0.0));
-  EXPECT_EQ(v, Vec3{});
-  Vec3 w{0.5, 0, 0};
-  EXPECT_FALSE(clamp_norm(w, 1.0));
-}
-
 }  // namespace
 }  // namespace uh::forcecomp

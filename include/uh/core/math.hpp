@@ -41,6 +41,24 @@ inline Vec3 normalized(const Vec3& a) {
   return (n > 0.0 && std::isfinite(n)) ? a / n : Vec3{};
 }
 inline bool is_finite(const Vec3& a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
+/// Scales `v` down to length `limit` if it is longer, keeping its direction; returns whether it
+/// changed `v`. A vector that is not finite, and any non-zero vector under a limit that is not
+/// positive (or NaN), become zero: the result is always finite and no longer than `limit`.
+/// The one norm clamp of the project (tool, safety and device limits all use it).
+inline bool clamp_norm(Vec3& v, double limit) {
+  if (!is_finite(v)) {
+    v = {};
+    return true;
+  }
+  // the length through the largest component, so that 1e200-sized vectors keep their direction
+  const double m = std::fmax(std::fabs(v.x), std::fmax(std::fabs(v.y), std::fabs(v.z)));
+  if (m == 0.0) return false;
+  const Vec3 u = v / m;
+  const double n_u = norm(u);  // in [1, sqrt(3)]
+  if (m * n_u <= limit) return false;
+  v = limit > 0.0 ? u * (limit / n_u) : Vec3{};
+  return true;
+}
 
 /// A rotation as a unit quaternion, w first (the order used by scene files and the CLI).
 struct Quat {

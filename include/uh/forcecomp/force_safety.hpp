@@ -74,7 +74,4 @@ class ForceSafety {
   std::atomic<std::uint64_t> zeroed_ticks_{0};
 };
 
-/// Scales `v` down to length `limit` if it is longer; returns whether it did. Real-time safe.
-bool clamp_norm(Vec3& v, double limit);
-
 }  // namespace uh::forcecomp
