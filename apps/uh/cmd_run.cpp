@@ -87,10 +87,10 @@ int run_session(const RunArgs& args) {
 
   Status ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
                             : (*session)->run(seconds,
-                                              [live](const controllers::LiveStatus& s) {
+                                              [live](const controllers::SessionState& s) {
                                                 if (!live) return;
                                                 std::fprintf(stderr, "\r  t %5.1f s | haptic %6.0f Hz | collision %6.0f Hz | force %5.2f N | pairs %6d ",
-                                                             s.time_s, s.haptic_rate_hz, s.collision_rate_hz, s.force_n, s.pairs);
+                                                             s.time_s, s.haptic_rate_hz, s.collision_rate_hz, norm(s.force_world), s.contact_pairs);
                                               },
                                               trace);
   if (live) std::fputc('\n', stderr);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <thread>
 
 #include <fmt/format.h>
@@ -24,9 +25,11 @@ double steady_seconds() {
 
 }  // namespace
 
+HapticSession::HapticSession() = default;
+
 HapticSession::~HapticSession() {
-  if (manager_) manager_->stop();
-  if (world_) world_->stop();
+  const Status stopped = stop();
+  (void)stopped;  // nobody is left to tell; the owner calls stop() to learn it
 }
 
 Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene, const SessionOptions& options,
@@ -95,80 +98,197 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       world, session->tool_id_, scene.tool.workspace, session->force_controller_.get());
   session->bridging_controller_->bind(*session->manager_);
   session->force_controller_->bind(world, *session->manager_);
-  session->report_.scene = scene.name;
+  HapticSession& self = *session;
+  self.sent_connection_ = self.manager_->sent_on_haptic_tick().connect<&HapticSession::on_tick_sent>(self);
+  self.collision_connection_ = world.on_collision().connect<&HapticSession::on_collision>(self);
+  self.touching_.assign(scene.objects.size(), 0);
+  self.object_ids_ = object_ids;
+  self.report_.scene = scene.name;
   return session;
 }
 
-void HapticSession::begin_run() {
+Status HapticSession::begin_run() {
+  if (phase_ != Phase::kReady)
+    return Error{"HapticSession: a session runs once; create a new one to run again"};
   report_.timeline.clear();
   report_.collision_rates.clear();
   report_.force_max_step_n = 0.0;
   have_last_sent_ = false;
+  ticks_at_start_ = manager_->ticks();
+  return Ok{};
 }
 
-void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace, double t0) {
+void HapticSession::on_tick_sent(const haptico::TraceSample& sample) {
+  // haptic thread: one snapshot per tick through the triple buffer, no lock, no allocation
+  SessionState& s = state_out_.write_buffer();
+  const WorkspaceMapping& mapping = bridging_controller_->mapping();
+  const Pose& tool = bridging_controller_->last_pose();
+  s.time_s = sample.tick_time_s - t0_s_;
+  s.tool_position_world = tool.position;
+  s.tool_orientation_world = tool.rotation;
+  s.force_world = mapping.to_world(sample.sent.force);
+  s.torque_world = mapping.to_world(sample.sent.torque);
+  s.contact_pairs = force_controller_->last_pairs();
+  s.haptic_ticks = manager_->ticks() - ticks_at_start_;
+  s.missed_deadlines = manager_->missed_deadlines();
+  s.haptic_rate_hz = haptic_rate_hz_.load(std::memory_order_relaxed);
+  s.collision_rate_hz = collision_rate_hz_.load(std::memory_order_relaxed);
+  tick_event_.broadcast(s);
+  state_out_.publish();
+}
+
+void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
+  // collision thread: edges of the overlap become events for the owner
+  if (b != tool_id_ || a < 0 || static_cast<std::size_t>(a) >= touching_.size()) return;
+  const bool touching = frame.total_volume > 0.0;
+  if (touching == (touching_[static_cast<std::size_t>(a)] != 0)) return;
+  touching_[static_cast<std::size_t>(a)] = touching ? 1 : 0;
+  const ContactEvent event{.kind = touching ? ContactEventKind::kBegin : ContactEventKind::kEnd,
+                           .object = a,
+                           .time_s = frame.time_s - t0_s_,
+                           .volume = touching ? frame.total_volume : 0.0,
+                           .pairs = touching ? frame.pair_count : 0};
+  if (!events_.try_push(event)) dropped_events_.increment();
+}
+
+SessionState HapticSession::state() {
+  const std::lock_guard lock(state_readers_);
+  if (state_out_.update()) last_state_ = state_out_.read_buffer();
+  return last_state_;
+}
+
+Status HapticSession::set_object_pose(std::int32_t object, const Pose& world_from_object) {
+  if (object < 0 || static_cast<std::size_t>(object) >= object_ids_.size())
+    return Error{
+        fmt::format("{}: there is no object {} (the scene has {})", scene_.name, object, object_ids_.size())};
+  world_->set_pose(object_ids_[static_cast<std::size_t>(object)], world_from_object);
+  return Ok{};
+}
+
+bool HapticSession::poll_event(ContactEvent& out) { return events_.try_pop(out); }
+
+void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace) {
   buffer.clear();
   manager_->drain_trace(buffer);
+  const double halted_at_s = halted_at_s_.load(std::memory_order_relaxed);
   for (const auto& s : buffer) {
+    if (trace != nullptr) haptico::write_trace_row(*trace, s);
+    // the ticks after stop() asked for zero force are in the trace, not in the report: the
+    // report describes the run, not its end
+    if (s.tick_time_s >= halted_at_s) continue;
     if (have_last_sent_)
       report_.force_max_step_n = std::max(report_.force_max_step_n, norm(s.sent.force - last_sent_.force));
     last_sent_ = s.sent;
     have_last_sent_ = true;
-    report_.timeline.push_back({.time_s = s.tick_time_s - t0, .force_n = norm(s.sent.force), .torque_nm = norm(s.sent.torque)});
-    if (trace != nullptr) haptico::write_trace_row(*trace, s);
+    report_.timeline.push_back(
+        {.time_s = s.tick_time_s - t0_s_, .force_n = norm(s.sent.force), .torque_nm = norm(s.sent.torque)});
   }
 }
 
-Status HapticSession::run(double seconds, const std::function<void(const LiveStatus&)>& on_status, std::ostream* trace) {
-  if (!(seconds > 0.0)) return Error{"HapticSession::run: the duration must be positive"};
-  begin_run();
-  report_.timeline.reserve(static_cast<std::size_t>(seconds * haptic_hz_ * 1.05) + 16);
-  if (trace != nullptr) haptico::write_trace_header(*trace);
+void HapticSession::monitor(std::stop_token stop) {
   std::vector<haptico::TraceSample> buffer;
   buffer.reserve(static_cast<std::size_t>(haptic_hz_) + 16);
+  std::mutex wake_mutex;
+  std::condition_variable_any wake;
+  const double start_s = started_s_;
+  std::uint64_t last_steps = 0;
+  std::uint64_t last_ticks = manager_->ticks();
+  double last_window_s = 0.0;
+  while (!stop.stop_requested()) {
+    {
+      std::unique_lock lock(wake_mutex);
+      wake.wait_for(lock, stop, std::chrono::milliseconds(20), [] { return false; });
+    }
+    take_trace(buffer, trace_);
+    const double now_s = steady_seconds() - start_s;
+    if (now_s - last_window_s >= 0.1) {
+      const std::uint64_t steps = world_->stats().steps;
+      const std::uint64_t ticks = manager_->ticks();
+      const double window = now_s - last_window_s;
+      const double collision_rate = static_cast<double>(steps - last_steps) / window;
+      report_.collision_rates.push_back({.time_s = now_s, .rate_hz = collision_rate});
+      collision_rate_hz_.store(collision_rate, std::memory_order_relaxed);
+      haptic_rate_hz_.store(static_cast<double>(ticks - last_ticks) / window, std::memory_order_relaxed);
+      last_steps = steps;
+      last_ticks = ticks;
+      last_window_s = now_s;
+    }
+  }
+}
 
+Status HapticSession::start(std::ostream* trace) {
+  if (auto ready = begin_run(); !ready) return ready;
+  report_.timeline.reserve(static_cast<std::size_t>(10.0 * haptic_hz_) + 16);
+  trace_ = trace;
+  if (trace != nullptr) haptico::write_trace_header(*trace);
+  started_s_ = steady_seconds();
+  t0_s_ = started_s_;
   if (auto started = world_->start(); !started) return started;
-  const double t0 = steady_seconds();
   if (auto started = manager_->start(); !started) {
     world_->stop();
     return started;
   }
-  const auto start = std::chrono::steady_clock::now();
-  const auto end = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
-  std::uint64_t last_steps = 0;
-  double last_window_s = 0.0;
-  auto next_status = start;
-  while (std::chrono::steady_clock::now() < end) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    take_trace(buffer, trace, t0);
-    const double now_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (now_s - last_window_s >= 0.1) {
-      const std::uint64_t steps = world_->stats().steps;
-      report_.collision_rates.push_back({.time_s = now_s, .rate_hz = static_cast<double>(steps - last_steps) / (now_s - last_window_s)});
-      last_steps = steps;
-      last_window_s = now_s;
-    }
-    if (on_status && std::chrono::steady_clock::now() >= next_status) {
-      next_status += std::chrono::milliseconds(250);
-      const auto fc = force_controller_->stats();
-      on_status({.time_s = now_s,
-                 .haptic_rate_hz = manager_->stats().loop.achieved_rate_hz,
-                 .collision_rate_hz = report_.collision_rates.empty() ? 0.0 : report_.collision_rates.back().rate_hz,
-                 .force_n = fc.last_force_n,
-                 .pairs = fc.last_pairs});
-    }
-  }
-  collect_report(seconds, false);  // before stop(): the loop statistics describe the run itself
+  phase_ = Phase::kRunning;
+  monitor_thread_ = std::jthread([this](std::stop_token stop) { monitor(stop); });
+  return Ok{};
+}
+
+Status HapticSession::stop() {
+  if (phase_ != Phase::kRunning) return stopped_;
+  // zero force from the next tick on, before anything that takes time
+  const double halted_at_s = steady_seconds();
+  halted_at_s_.store(halted_at_s, std::memory_order_relaxed);
+  manager_->halt();
+  const bool haptic_alive = manager_->running();
+  const bool collision_alive = world_->running();
+  const double seconds = halted_at_s - started_s_;
+  monitor_thread_.request_stop();
+  monitor_thread_.join();
+  collect_report(seconds, false);  // before the loops stop: their statistics describe the run itself
   manager_->stop();
   world_->stop();
-  take_trace(buffer, trace, t0);
-  return Ok{};
+  // the haptic thread is joined and the device got zero: this thread becomes the state's writer
+  SessionState last = state();
+  last.force_world = {};
+  last.torque_world = {};
+  state_out_.write(last);
+  std::vector<haptico::TraceSample> buffer;
+  take_trace(buffer, trace_);
+  phase_ = Phase::kStopped;
+  if (!haptic_alive)
+    stopped_ = Error{"the haptic thread ended before the session was stopped"};
+  else if (!collision_alive)
+    stopped_ = Error{"the collision thread ended before the session was stopped"};
+  else if (trace_ != nullptr && !*trace_)
+    stopped_ = Error{"the trace could not be written"};
+  return stopped_;
+}
+
+Status HapticSession::run(double seconds, const std::function<void(const SessionState&)>& on_status,
+                          std::ostream* trace) {
+  if (!(seconds > 0.0)) return Error{"HapticSession::run: the duration must be positive"};
+  if (auto started = start(trace); !started) return started;
+  const auto begin = std::chrono::steady_clock::now();
+  const auto end = begin + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                               std::chrono::duration<double>(seconds));
+  auto next_status = begin + std::chrono::milliseconds(250);
+  while (std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_until(std::min(end, next_status));
+    if (on_status && std::chrono::steady_clock::now() >= next_status) {
+      next_status += std::chrono::milliseconds(250);
+      on_status(state());
+    }
+  }
+  return stop();
 }
 
 Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, std::ostream* trace) {
   if (!(seconds > 0.0)) return Error{"HapticSession::run_stepped: the duration must be positive"};
   if (ticks_per_collision_step < 1) return Error{"HapticSession::run_stepped: ticks per collision step must be >= 1"};
-  begin_run();
+  if (auto ready = begin_run(); !ready) return ready;
+  t0_s_ = 0.0;
+  haptic_rate_hz_.store(haptic_hz_, std::memory_order_relaxed);
+  collision_rate_hz_.store(haptic_hz_ / ticks_per_collision_step, std::memory_order_relaxed);
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
@@ -177,11 +297,12 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
     // the collision step sees the tool pose of the previous tick, as the threaded world would
     if (k % ticks_per_collision_step == 0) world_->step(t);
     manager_->step(t);
-    if (k % 256 == 255) take_trace(buffer, trace, 0.0);
+    if (k % 256 == 255) take_trace(buffer, trace);
   }
-  take_trace(buffer, trace, 0.0);
+  take_trace(buffer, trace);
   collision_hz_ = haptic_hz_ / ticks_per_collision_step;
   collect_report(seconds, true);
+  phase_ = Phase::kStopped;
   return Ok{};
 }
 

@@ -151,6 +151,7 @@ TraceSample HapticManager::tick(double now_s) {
   device_->command(out);
 
   if (trace_ && !trace_->try_push(sample)) trace_dropped_.increment();
+  sent_event_.broadcast(sample);
   return sample;
 }
 

@@ -13,6 +13,32 @@ namespace {
 using testing::small_scene_json;
 using testing::test_assets;
 
+// A trace CSV (haptico::write_trace_header) as numbers, columns found by name.
+struct TraceTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+  int column(const std::string& name) const {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return static_cast<int>(i);
+    return -1;
+  }
+};
+
+TraceTable read_trace(const std::string& csv) {
+  TraceTable t;
+  std::istringstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  std::istringstream h(header);
+  for (std::string name; std::getline(h, name, ',');) t.names.push_back(name);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<double>& v = t.rows.emplace_back();
+    std::istringstream l(line);
+    for (std::string cell; std::getline(l, cell, ',');) v.push_back(std::atof(cell.c_str()));
+  }
+  return t;
+}
+
 struct SessionFixture : ::testing::Test {
   static void SetUpTestSuite() { cache_ = new std::filesystem::path(testing::fresh_cache("session")); }
   static void TearDownTestSuite() {
@@ -63,28 +89,12 @@ TEST_F(SessionFixture, ForceOnTheStylusPointsUpOutOfTheBunny) {
   ASSERT_TRUE(session);
   std::ostringstream trace;
   ASSERT_TRUE(session->run_stepped(0.5, 1, &trace).has_value());
-  // columns: see haptico::write_trace_header; find the sent force columns by name
-  std::istringstream in(trace.str());
-  std::string header;
-  std::getline(in, header);
-  std::vector<std::string> names;
-  {
-    std::istringstream h(header);
-    for (std::string name; std::getline(h, name, ',');) names.push_back(name);
-  }
-  const auto column = [&](const std::string& name) {
-    for (std::size_t i = 0; i < names.size(); ++i)
-      if (names[i] == name) return static_cast<int>(i);
-    return -1;
-  };
-  const int fx = column("fx"), fz = column("fz");
-  ASSERT_GE(fz, 0) << header;
-  ASSERT_GE(fx, 0) << header;
+  const TraceTable table = read_trace(trace.str());
+  const int fx = table.column("fx"), fz = table.column("fz");
+  ASSERT_GE(fz, 0);
+  ASSERT_GE(fx, 0);
   int pushing = 0, contact = 0;
-  for (std::string line; std::getline(in, line);) {
-    std::vector<double> v;
-    std::istringstream l(line);
-    for (std::string cell; std::getline(l, cell, ',');) v.push_back(std::atof(cell.c_str()));
+  for (const std::vector<double>& v : table.rows) {
     const double force_z = v[static_cast<std::size_t>(fz)];
     const double force_x = v[static_cast<std::size_t>(fx)];
     if (std::abs(force_z) + std::abs(force_x) < 1e-3) continue;
@@ -142,6 +152,85 @@ TEST_F(SessionFixture, CouplingRendersThroughTheProxyAndStaysWithinLimits) {
   EXPECT_GT(r.force_max_n, 0.1);
   EXPECT_LE(r.force_max_n, 6.0 + 1e-9);
   EXPECT_EQ(r.force_nonfinite, 0u);
+}
+
+TEST_F(SessionFixture, StateAfterASteppedRunIsTheLastTickOfTheTrace) {
+  auto session = make(small_scene_json());
+  ASSERT_TRUE(session);
+  const SessionState before = session->state();
+  EXPECT_EQ(before.haptic_ticks, 0u);
+  std::ostringstream trace;
+  ASSERT_TRUE(session->run_stepped(0.5, 4, &trace).has_value());
+  const SessionState s = session->state();
+  const TraceTable table = read_trace(trace.str());
+  ASSERT_EQ(table.rows.size(), 500u);
+  const std::vector<double>& last = table.rows.back();
+  const auto at = [&](const char* name) { return last[static_cast<std::size_t>(table.column(name))]; };
+  EXPECT_EQ(s.haptic_ticks, 500u);
+  EXPECT_NEAR(s.time_s, at("tick_time_s"), 1e-9);
+  // the scene's workspace mapping is the identity: the tool sits at the handle, forces are the device's
+  EXPECT_NEAR(s.tool_position_world.x, at("x"), 1e-9);
+  EXPECT_NEAR(s.tool_position_world.z, at("z"), 1e-9);
+  EXPECT_NEAR(s.tool_orientation_world.w, at("qw"), 1e-9);
+  EXPECT_NEAR(s.force_world.z, at("fz"), 1e-6);
+  EXPECT_NEAR(s.torque_world.x, at("tx"), 1e-6);
+  EXPECT_GT(norm(s.force_world), 0.1) << "at 0.5 s the stylus is at its deepest in the bunny";
+  EXPECT_GT(s.contact_pairs, 0);
+  EXPECT_EQ(s.missed_deadlines, 0u);
+}
+
+TEST_F(SessionFixture, ContactEventsAlternateAndMatchTheForceOnsets) {
+  auto session = make(small_scene_json());
+  ASSERT_TRUE(session);
+  ASSERT_TRUE(session->run_stepped(2.2, 1).has_value());
+  std::vector<ContactEvent> events;
+  for (ContactEvent e; session->poll_event(e);) events.push_back(e);
+  // the stylus dips into the bunny and back twice in 2.2 s (0.5 s each way)
+  ASSERT_GE(events.size(), 4u);
+  EXPECT_EQ(session->dropped_events(), 0u);
+  const auto& timeline = session->report().timeline;
+  const auto force_at = [&](double t) {
+    const auto k = static_cast<std::size_t>(std::llround(t * 1000.0));
+    return k < timeline.size() ? timeline[k].force_n : 0.0;
+  };
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const ContactEvent& e = events[i];
+    SCOPED_TRACE(i);
+    EXPECT_EQ(e.object, 0);
+    EXPECT_EQ(e.kind, i % 2 == 0 ? ContactEventKind::kBegin : ContactEventKind::kEnd)
+        << "begin and end alternate";
+    if (i > 0) {
+      EXPECT_GT(e.time_s, events[i - 1].time_s);
+    }
+    // an independent path: the force the haptic thread sent, from the trace
+    if (e.kind == ContactEventKind::kBegin) {
+      EXPECT_GT(e.volume, 0.0);
+      EXPECT_GT(e.pairs, 0);
+      EXPECT_EQ(force_at(e.time_s - 0.002), 0.0) << "no force before the overlap begins";
+      EXPECT_GT(force_at(e.time_s + 0.002), 0.0) << "force once it has";
+    } else {
+      // (just before the end the damping of the withdrawing tool may already cancel the push)
+      EXPECT_EQ(e.volume, 0.0);
+      if (i > 0) {
+        EXPECT_GT(force_at(0.5 * (events[i - 1].time_s + e.time_s)), 0.0) << "force during the contact";
+      }
+      EXPECT_EQ(force_at(e.time_s + 0.002), 0.0) << "none after it";
+    }
+  }
+}
+
+TEST_F(SessionFixture, ASessionRunsOnceAndStopIsIdempotent) {
+  auto session = make(small_scene_json());
+  ASSERT_TRUE(session);
+  EXPECT_TRUE(session->stop().has_value()) << "stop before any run does nothing";
+  ASSERT_TRUE(session->run_stepped(0.1, 4).has_value());
+  EXPECT_TRUE(session->stop().has_value());
+  EXPECT_TRUE(session->stop().has_value());
+  const Status again = session->start();
+  ASSERT_FALSE(again.has_value());
+  EXPECT_NE(again.error().message.find("runs once"), std::string::npos) << again.error().message;
+  EXPECT_FALSE(session->run_stepped(0.1, 4).has_value());
+  EXPECT_FALSE(session->running());
 }
 
 TEST_F(SessionFixture, UnknownDriverIsAnErrorNamingTheScene) {

@@ -2,6 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+#include <vector>
+
 #include "scene_test_support.hpp"
 
 namespace uh::controllers {
@@ -18,7 +24,7 @@ TEST(HapticSessionThreaded, TwoSecondSessionRunsAllThreadsAndEndsWithZeroForce) 
   auto session = HapticSession::create(*scene, options);
   ASSERT_TRUE(session.has_value()) << session.error().message;
   int status_calls = 0;
-  ASSERT_TRUE((*session)->run(2.0, [&](const LiveStatus&) { ++status_calls; }).has_value());
+  ASSERT_TRUE((*session)->run(2.0, [&](const SessionState&) { ++status_calls; }).has_value());
   const SessionReport& r = (*session)->report();
   EXPECT_GT(r.haptic_ticks, 500u) << "about 2000 ticks at 1 kHz; loose bound for sanitizer builds";
   EXPECT_GT(r.collision_steps, 50u);
@@ -28,6 +34,75 @@ TEST(HapticSessionThreaded, TwoSecondSessionRunsAllThreadsAndEndsWithZeroForce) 
   EXPECT_GT(status_calls, 2);
   ASSERT_FALSE(r.timeline.empty());
   EXPECT_FALSE((*session)->world().running());
+  std::filesystem::remove_all(cache);
+}
+
+// The non-blocking lifecycle: the owner polls the newest state and the contact events while the
+// haptic and collision threads run, then stops; a second thread reads the state at the same time.
+TEST(HapticSessionThreaded, StartPollStopReadsContactAndForceAndEndsAtZero) {
+  const auto cache = testing::fresh_cache("lifecycle");
+  auto scene = parse_scene(testing::small_scene_json(), "small.json", testing::test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  SessionOptions options;
+  options.cache_dir = cache;
+  auto created = HapticSession::create(*scene, options);
+  ASSERT_TRUE(created.has_value()) << created.error().message;
+  HapticSession& session = **created;
+  ASSERT_TRUE(session.start().has_value());
+  EXPECT_TRUE(session.running());
+  EXPECT_FALSE(session.start().has_value()) << "already running";
+
+  std::atomic<bool> done{false};
+  std::uint64_t watcher_reads = 0;
+  std::thread watcher([&] {
+    while (!done.load()) {
+      const SessionState s = session.state();
+      EXPECT_TRUE(std::isfinite(s.force_world.z));
+      ++watcher_reads;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  double max_force = 0.0;
+  std::int32_t max_pairs = 0;
+  std::uint64_t last_ticks = 0;
+  bool ticks_increase = true;
+  std::vector<ContactEvent> events;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
+  while (std::chrono::steady_clock::now() < until) {
+    const SessionState s = session.state();
+    ticks_increase = ticks_increase && s.haptic_ticks >= last_ticks;
+    last_ticks = s.haptic_ticks;
+    max_force = std::max(max_force, norm(s.force_world));
+    max_pairs = std::max(max_pairs, s.contact_pairs);
+    for (ContactEvent e; session.poll_event(e);) events.push_back(e);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(session.stop().has_value());
+  done.store(true);
+  watcher.join();
+  EXPECT_FALSE(session.running());
+  EXPECT_TRUE(session.stop().has_value()) << "stop is idempotent";
+  for (ContactEvent e; session.poll_event(e);) events.push_back(e);
+
+  EXPECT_TRUE(ticks_increase);
+  EXPECT_GT(last_ticks, 300u) << "about 1500 ticks at 1 kHz; loose bound for sanitizer builds";
+  EXPECT_GT(max_force, 0.1) << "the stylus reaches the bunny within 1.5 s";
+  EXPECT_LE(max_force, 6.0 + 1e-9);
+  EXPECT_GT(max_pairs, 0);
+  EXPECT_GT(watcher_reads, 10u);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.front().kind, ContactEventKind::kBegin);
+  EXPECT_GT(events.front().volume, 0.0);
+
+  const SessionState after = session.state();
+  EXPECT_EQ(norm(after.force_world), 0.0) << "the state after stop shows the zero force the device got";
+  const SessionReport& r = session.report();
+  // the report is taken as stop() begins, the last state when the haptic thread has ended
+  EXPECT_GE(after.haptic_ticks, r.haptic_ticks);
+  EXPECT_LE(after.haptic_ticks, r.haptic_ticks + 100);
+  EXPECT_GT(r.seconds, 1.4);
+  EXPECT_FALSE(r.timeline.empty());
+  EXPECT_FALSE(session.world().running());
   std::filesystem::remove_all(cache);
 }
 

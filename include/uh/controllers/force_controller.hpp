@@ -85,6 +85,8 @@ class ForceController {
   /// Zero force from the next tick on (ForceSafety::stop). Any thread.
   void stop() { safety_.stop(); }
   ForceControllerStats stats() const;
+  /// Pairs the force of the last tick used (ForceControllerStats::last_pairs), cheaply. Any thread.
+  std::int32_t last_pairs() const { return last_pairs_.load(std::memory_order_relaxed); }
   const ForceControllerOptions& options() const { return options_; }
 
  private:

@@ -1,22 +1,32 @@
 #pragma once
 /// \file
 /// HapticSession: a whole scene running: the device and haptic thread (Haptico), the collision
-/// world and its thread (Collette), the controllers and forces (ForceComp), and the application
-/// thread that watches them. What `uh run` runs.
+/// world and its thread (Collette), the controllers and forces (ForceComp), and a monitor thread
+/// that records them. The owner starts it, reads its newest state and contact events while it
+/// runs, and stops it. What `uh run`, the C API and the Python module run.
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <ostream>
+#include <stop_token>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "uh/collette/collision_world.hpp"
 #include "uh/controllers/bridging_controller.hpp"
 #include "uh/controllers/force_controller.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/core/delegator.hpp"
+#include "uh/core/event_counter.hpp"
+#include "uh/core/latest_value.hpp"
 #include "uh/core/result.hpp"
+#include "uh/core/spsc_queue.hpp"
 #include "uh/haptico/device_registry.hpp"
 #include "uh/haptico/haptic_manager.hpp"
 
@@ -82,13 +92,33 @@ struct SessionReport {
   std::vector<RateSample> collision_rates;
 };
 
-/// Live figures for a status line, sampled by the application thread.
-struct LiveStatus {
-  double time_s = 0.0;
-  double haptic_rate_hz = 0.0;
-  double collision_rate_hz = 0.0;
-  double force_n = 0.0;
-  std::int32_t pairs = 0;
+/// The newest state of a session, as the haptic thread sent it in its last tick (plain data).
+struct SessionState {
+  double time_s = 0.0;                 ///< that tick's time since start() [s] (stepped: simulated time)
+  Vec3 tool_position_world{};          ///< origin of the tool's mesh frame in the world [m]
+  Quat tool_orientation_world{};       ///< the tool's orientation in the world (unit quaternion)
+  Vec3 force_world{};                  ///< force sent to the device, in the world frame [N]
+  Vec3 torque_world{};                 ///< torque sent to the device, in the world frame [N m]
+  std::int32_t contact_pairs = 0;      ///< sphere pairs the force of that tick used
+  std::uint64_t haptic_ticks = 0;      ///< haptic ticks since start()
+  std::uint64_t missed_deadlines = 0;  ///< haptic ticks that started more than a period late
+  double haptic_rate_hz = 0.0;         ///< haptic ticks per second over the last ~100 ms [Hz]
+  double collision_rate_hz = 0.0;      ///< collision steps per second over the last ~100 ms [Hz]
+};
+
+/// Whether a contact began or ended.
+enum class ContactEventKind : std::uint8_t {
+  kBegin,  ///< the tool started to overlap the object (positive overlap volume)
+  kEnd,    ///< the overlap ended
+};
+
+/// A contact between the tool and a watched object began or ended (plain data).
+struct ContactEvent {
+  ContactEventKind kind = ContactEventKind::kBegin;
+  std::int32_t object = -1;  ///< index of the object in Scene::objects
+  double time_s = 0.0;       ///< time of the collision step that saw it, since start() [s]
+  double volume = 0.0;       ///< overlap volume of that step [m^3] (0 for kEnd)
+  std::int32_t pairs = 0;    ///< overlapping sphere pairs of that step (0 for kEnd)
 };
 
 class HapticSession {
@@ -102,25 +132,65 @@ class HapticSession {
   HapticSession(const HapticSession&) = delete;
   HapticSession& operator=(const HapticSession&) = delete;
 
-  /// Runs the three threads for `seconds`: haptic, collision, and this (application) thread, which
-  /// samples statistics every 20 ms, calls `on_status` about every 250 ms, and writes the trace
-  /// CSV to `trace` if given. Stops both threads and zeroes the force at the end.
-  Status run(double seconds, const std::function<void(const LiveStatus&)>& on_status = {},
+  /// Starts the haptic and collision threads and a monitor thread, and returns. The monitor
+  /// drains the haptic trace every 20 ms into the report's timeline (and as CSV into `trace`,
+  /// which must outlive stop()) and samples the rates every 100 ms. A session runs once: start()
+  /// after a run is an error. Owner thread.
+  Status start(std::ostream* trace = nullptr);
+
+  /// The newest state (see SessionState); before the first tick, a zero state. Any thread but the
+  /// haptic and collision threads; never blocks them (they only publish through a LatestValue);
+  /// concurrent callers are serialised among themselves.
+  SessionState state();
+
+  /// Takes the oldest contact event not yet taken; false when none is waiting. Events queue up
+  /// (up to kEventCapacity; more are dropped and counted) from start() or run_stepped() on.
+  /// One consumer thread at a time (the owner).
+  bool poll_event(ContactEvent& out);
+  static constexpr std::size_t kEventCapacity = 1024;
+  /// Contact events dropped because nobody took them in time. Any thread.
+  std::uint64_t dropped_events() const { return dropped_events_.load(); }
+
+  /// Moves scene object `object` (its index in Scene::objects) to `world_from_object` [m]; the
+  /// collision thread uses it from its next step. One thread per object (the owner); real-time safe.
+  Status set_object_pose(std::int32_t object, const Pose& world_from_object);
+
+  /// Binding side of OnHapticTick(const SessionState&): each tick's state as it is published, on
+  /// the haptic thread (the calling thread in stepped runs). Delegates must be real-time safe.
+  /// Bind before start(), from the owner thread.
+  DelegateSink<const SessionState&> on_haptic_tick() { return DelegateSink{tick_event_}; }
+
+  /// Sends zero force at once, stops and joins all threads, and completes the report. Idempotent:
+  /// later calls return what the first returned. An error says which thread ended on its own or
+  /// what failed (the report is still complete). Without a start(), does nothing. Owner thread.
+  Status stop();
+
+  /// True from start() until stop(). Owner thread.
+  bool running() const { return phase_ == Phase::kRunning; }
+
+  /// start(), then calls `on_status` on this thread about every 250 ms for `seconds`, then stop().
+  Status run(double seconds, const std::function<void(const SessionState&)>& on_status = {},
              std::ostream* trace = nullptr);
 
   /// Runs deterministically on the calling thread without any other thread: haptic ticks at the
   /// haptic rate in simulated time, one collision step every `ticks_per_collision_step` ticks.
   Status run_stepped(double seconds, int ticks_per_collision_step, std::ostream* trace = nullptr);
 
+  /// The report of the run (complete after stop() or run_stepped()).
   const SessionReport& report() const { return report_; }
   const Scene& scene() const { return scene_; }
   const collette::CollisionWorld& world() const { return *world_; }
 
  private:
-  HapticSession() = default;
-  void begin_run();
+  enum class Phase : std::uint8_t { kReady, kRunning, kStopped };
+
+  HapticSession();
+  Status begin_run();
   void collect_report(double seconds, bool stepped);
-  void take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace, double t0);
+  void take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
+  void monitor(std::stop_token stop);
+  void on_tick_sent(const haptico::TraceSample& sample);
+  void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
 
   Scene scene_;
   haptico::DeviceCommand last_sent_{};
@@ -133,6 +203,33 @@ class HapticSession {
   std::unique_ptr<BridgingController> bridging_controller_;
   collette::ObjectId tool_id_ = -1;
   SessionReport report_;
+  ScopedConnection sent_connection_;
+  ScopedConnection collision_connection_;
+
+  Phase phase_ = Phase::kReady;
+  Status stopped_{Ok{}};    // what the first stop() returned
+  double t0_s_ = 0.0;       // steady-clock time of start() (0 in stepped runs) [s]
+  double started_s_ = 0.0;  // steady-clock time of start(), for the report's duration [s]
+
+  // haptic thread -> readers of state()
+  Delegator<const SessionState&> tick_event_;
+  LatestValue<SessionState> state_out_;
+  std::mutex state_readers_;   // serialises state() callers; the haptic thread never takes it
+  SessionState last_state_{};  // guarded by state_readers_
+  std::uint64_t ticks_at_start_ = 0;
+  std::atomic<double> haptic_rate_hz_{0.0};     // monitor thread -> haptic thread
+  std::atomic<double> collision_rate_hz_{0.0};  // monitor thread -> haptic thread
+
+  // collision thread -> owner
+  SpscQueue<ContactEvent> events_{kEventCapacity};
+  EventCounter dropped_events_;
+  std::vector<std::uint8_t> touching_;          // per scene object; collision thread
+  std::vector<collette::ObjectId> object_ids_;  // per scene object
+
+  std::ostream* trace_ = nullptr;  // written by the monitor thread while it runs, then by stop()
+  // steady-clock time stop() zeroed the force [s]; owner -> monitor thread
+  std::atomic<double> halted_at_s_{std::numeric_limits<double>::infinity()};
+  std::jthread monitor_thread_;
 };
 
 /// The report as the JSON object `uh run --json` prints (nested: haptic.*, collision.*, force.*,

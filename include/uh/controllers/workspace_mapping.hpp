@@ -36,6 +36,8 @@ struct WorkspaceMapping {
   }
   /// A world-frame vector (force, torque) in the device base frame.
   Vec3 to_device(const Vec3& v_world) const { return rotate(conjugate(world_from_device_base.rotation), v_world); }
+  /// A device-base-frame vector (a force or torque sent to the device) in the world.
+  Vec3 to_world(const Vec3& v_device) const { return rotate(world_from_device_base.rotation, v_device); }
 };
 
 }  // namespace uh::controllers

@@ -100,6 +100,11 @@ class FixedRateLoop {
 
   /// Lock-free snapshot of the statistics. Any thread; not real-time safe (reads ~30 KB).
   [[nodiscard]] FixedRateLoopStats stats() const;
+  /// Missed deadlines since the last start() (FixedRateLoopStats::missed_deadlines) without the
+  /// cost of stats(). Any thread; real-time safe.
+  [[nodiscard]] std::uint64_t missed_deadlines() const {
+    return missed_deadlines_.load(std::memory_order_relaxed);
+  }
 
   [[nodiscard]] const FixedRateLoopOptions& options() const { return options_; }
 

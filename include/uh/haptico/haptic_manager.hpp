@@ -61,7 +61,8 @@ struct HapticStats {
 ///      device's max_force_n / max_torque_nm (counted); torque zeroed on 3-DOF devices; zero while
 ///      halted or after a device error (latched until clear_fault()); a linear fade-in over
 ///      soft_start_s after open(), start(), resume() and clear_fault();
-///   5. device.command(command); the tick is pushed to the trace queue if enabled.
+///   5. device.command(command); the tick is pushed to the trace queue if enabled;
+///   6. SentOnHapticTick.broadcast(sample)  (what was read, asked for and sent this tick).
 /// The same tick code runs in threaded sessions (start()/stop()) and stepped ones (step()).
 ///
 /// Frames and units: those of the device (DeviceState, DeviceCommand), SI.
@@ -106,6 +107,9 @@ class HapticManager {
     restart_fade_.store(true, std::memory_order_release);
     faulted_.store(false, std::memory_order_release);
   }
+  /// Binding side of SentOnHapticTick(const TraceSample&): the tick as sent to the device, after
+  /// the safety stage (e.g. to publish the newest state to another thread). See the thread rules.
+  DelegateSink<const TraceSample&> sent_on_haptic_tick() { return DelegateSink{sent_event_}; }
 
   /// Binding side of MoveOnHapticTick(const DeviceState&). See the thread rules above.
   DelegateSink<const DeviceState&> move_on_haptic_tick() { return DelegateSink{move_event_}; }
@@ -124,6 +128,11 @@ class HapticManager {
   std::size_t drain_trace(std::ostream& csv);
 
   HapticStats stats() const;
+  /// Missed deadlines of the haptic thread since start(), without the cost of stats(). Any
+  /// thread; real-time safe (so a delegate may read it during a tick).
+  std::uint64_t missed_deadlines() const { return loop_.missed_deadlines(); }
+  /// Ticks run (HapticStats::ticks) without the cost of stats(). Any thread; real-time safe.
+  std::uint64_t ticks() const { return ticks_.load(); }
   bool running() const { return loop_.running(); }
   bool is_open() const { return open_; }
   /// The device's description as read by open().
@@ -140,6 +149,7 @@ class HapticManager {
   FixedRateLoop loop_;
   Delegator<const DeviceState&> move_event_;
   Delegator<const DeviceState&, DeviceCommand&> force_event_;
+  Delegator<const TraceSample&> sent_event_;
   std::unique_ptr<SpscQueue<TraceSample>> trace_;
   double tick_time_s_ = 0.0;
   std::int64_t fade_count_ = 0;
