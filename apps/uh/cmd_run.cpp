@@ -41,9 +41,12 @@ void print_summary(const controllers::SessionReport& r) {
   std::printf("  collision median %.0f Hz, min %.0f Hz (target %.0f); query median %.1f us, p99 %.1f us, max %.1f us; up to %lld pairs\n",
               r.collision_rate_median_hz, r.collision_rate_min_hz, r.collision_target_hz, r.query_median_us, r.query_p99_us,
               r.query_max_us, static_cast<long long>(r.max_pairs));
-  std::printf("  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu clamped, %llu non-finite\n",
+  std::printf("  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu non-finite\n",
               r.force_max_n, r.torque_max_nm, r.force_max_step_n, r.multi_rate ? "multi-rate" : "held forces",
-              static_cast<unsigned long long>(r.force_clamped), static_cast<unsigned long long>(r.force_nonfinite));
+              static_cast<unsigned long long>(r.force_nonfinite));
+  std::printf("  limits    ticks limited by the device %llu, the tool %llu, the safety limit %llu, the rate limit %llu\n",
+              static_cast<unsigned long long>(r.limits.device), static_cast<unsigned long long>(r.limits.tool),
+              static_cast<unsigned long long>(r.limits.safety), static_cast<unsigned long long>(r.limits.rate));
   std::printf("  contact   %llu ticks in contact; energy into the hand %.4f J%s\n",
               static_cast<unsigned long long>(r.contact_ticks), r.work_on_hand_j, r.coupling ? " (virtual coupling)" : "");
 }

@@ -80,7 +80,11 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       std::move(device).value(),
       haptico::HapticManagerOptions{.rate_hz = session->haptic_hz_,
                                     .raise_priority = options.raise_priority,
-                                    .trace_capacity = trace_capacity});
+                                    .trace_capacity = trace_capacity,
+                                    .limits = {.tool = {.max_force_n = scene.tool.force.max_force_n,
+                                                        .max_torque_nm = scene.tool.force.max_torque_nm},
+                                               .safety = scene.safety_limits,
+                                               .rate = scene.rate_limit}});
   if (auto opened = session->manager_->open(); !opened)
     return Error{fmt::format("{}: tool.device: {}", scene.source, opened.error().message)};
 
@@ -113,6 +117,8 @@ Status HapticSession::begin_run() {
   report_.timeline.clear();
   report_.collision_rates.clear();
   report_.force_max_step_n = 0.0;
+  report_.force_max_n = 0.0;
+  report_.torque_max_nm = 0.0;
   have_last_sent_ = false;
   ticks_at_start_ = manager_->ticks();
   return Ok{};
@@ -180,6 +186,8 @@ void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::o
       report_.force_max_step_n = std::max(report_.force_max_step_n, norm(s.sent.force - last_sent_.force));
     last_sent_ = s.sent;
     have_last_sent_ = true;
+    report_.force_max_n = std::max(report_.force_max_n, norm(s.sent.force));
+    report_.torque_max_nm = std::max(report_.torque_max_nm, norm(s.sent.torque));
     report_.timeline.push_back(
         {.time_s = s.tick_time_s - t0_s_, .force_n = norm(s.sent.force), .torque_nm = norm(s.sent.torque)});
   }
@@ -348,12 +356,11 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     r.collision_rate_mean_hz = ws.rate_hz;
   }
   const ForceControllerStats fc = force_controller_->stats();
-  r.force_max_n = fc.max_force_n;
-  r.torque_max_nm = fc.max_torque_nm;
   r.force_max_raw_step_n = fc.max_force_step_n;
   r.force_nonfinite = fc.safety.nonfinite + hs.nonfinite;
-  r.force_clamped = fc.safety.force_clamped + hs.force_clamped;
-  r.torque_clamped = fc.safety.torque_clamped + hs.torque_clamped;
+  r.force_clamped = hs.force_clamped;
+  r.torque_clamped = hs.torque_clamped;
+  r.limits = hs.limits;
   r.stale_ticks = fc.safety.stale_ticks;
   r.contact_ticks = fc.contact_ticks;
   r.work_on_hand_j = fc.work_on_hand_j;
@@ -390,6 +397,11 @@ std::string session_report_json(const SessionReport& r) {
         {"nonfinite", r.force_nonfinite},
         {"clamped", r.force_clamped},
         {"torque_clamped", r.torque_clamped},
+        {"limited",
+         {{"device", r.limits.device},
+          {"tool", r.limits.tool},
+          {"safety", r.limits.safety},
+          {"rate", r.limits.rate}}},
         {"stale_ticks", r.stale_ticks},
         {"multi_rate", r.multi_rate},
         {"coupling", r.coupling}}},

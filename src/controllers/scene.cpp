@@ -234,16 +234,21 @@ Status read_workspace(const FieldReader& r, const json& j, const std::string& pa
   return Ok{};
 }
 
-Status read_force_options(const FieldReader& r, const json& j, const std::string& path, ForceControllerOptions& o) {
+Status read_force_options(const FieldReader& r, const json& j, const std::string& path, Scene& scene) {
+  ForceControllerOptions& o = scene.force;
   UH_CHECK(r.require_object(j, path));
   UH_CHECK(r.check_keys(j, path, {"multi_rate", "safety", "coupling"}));
   UH_CHECK(r.boolean(j, path, "multi_rate", o.multi_rate));
   if (const auto it = j.find("safety"); it != j.end()) {
     const std::string p = FieldReader::join(path, "safety");
     UH_CHECK(r.require_object(*it, p));
-    UH_CHECK(r.check_keys(*it, p, {"max_force_n", "max_torque_nm", "watchdog_max_age_s", "watchdog_ramp_s"}));
-    UH_CHECK(r.number(*it, p, "max_force_n", o.safety.max_force_n, 1e-6, 1e4));
-    UH_CHECK(r.number(*it, p, "max_torque_nm", o.safety.max_torque_nm, 1e-6, 1e3));
+    UH_CHECK(r.check_keys(*it, p,
+                          {"max_force_n", "max_torque_nm", "max_force_rate_n_per_s",
+                           "max_torque_rate_nm_per_s", "watchdog_max_age_s", "watchdog_ramp_s"}));
+    UH_CHECK(r.number(*it, p, "max_force_n", scene.safety_limits.max_force_n, 1e-6, 1e4));
+    UH_CHECK(r.number(*it, p, "max_torque_nm", scene.safety_limits.max_torque_nm, 1e-6, 1e3));
+    UH_CHECK(r.number(*it, p, "max_force_rate_n_per_s", scene.rate_limit.max_force_n_per_s, 1e-3, 1e9));
+    UH_CHECK(r.number(*it, p, "max_torque_rate_nm_per_s", scene.rate_limit.max_torque_nm_per_s, 1e-3, 1e9));
     UH_CHECK(r.number(*it, p, "watchdog_max_age_s", o.safety.watchdog.max_age_s, 1e-4, 10.0));
     UH_CHECK(r.number(*it, p, "watchdog_ramp_s", o.safety.watchdog.ramp_s, 1e-4, 10.0));
   }
@@ -348,7 +353,7 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
     for (const auto& o : scene.objects) scene.watch.push_back(o.name);
   }
 
-  if (const auto it = root.find("force"); it != root.end()) UH_CHECK(read_force_options(r, *it, "force", scene.force));
+  if (const auto it = root.find("force"); it != root.end()) UH_CHECK(read_force_options(r, *it, "force", scene));
   scene.force.coupling.period_s = 1.0 / scene.haptic_hz;
   return scene;
 }

@@ -30,8 +30,6 @@ Wrench ForceSafety::apply(const Wrench& raw, double now_s, double data_time_s) {
   if (watchdog_.stale()) bump(stale_ticks_);
   w.force *= gain;
   w.torque *= gain;
-  if (clamp_norm(w.force, options_.max_force_n)) bump(force_clamped_);
-  if (clamp_norm(w.torque, options_.max_torque_nm)) bump(torque_clamped_);
   if (zero) {
     bump(zeroed_ticks_);
     return Wrench{};
@@ -48,8 +46,6 @@ void ForceSafety::resume() {
 ForceSafetyCounters ForceSafety::counters() const {
   ForceSafetyCounters c;
   c.ticks = ticks_.load(std::memory_order_relaxed);
-  c.force_clamped = force_clamped_.load(std::memory_order_relaxed);
-  c.torque_clamped = torque_clamped_.load(std::memory_order_relaxed);
   c.nonfinite = nonfinite_.load(std::memory_order_relaxed);
   c.stale_ticks = stale_ticks_.load(std::memory_order_relaxed);
   c.zeroed_ticks = zeroed_ticks_.load(std::memory_order_relaxed);

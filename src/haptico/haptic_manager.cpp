@@ -59,6 +59,7 @@ Status HapticManager::open() {
   if (info_.dof_actuated == 6 && !(info_.max_torque_nm > 0.0 && std::isfinite(info_.max_torque_nm))) {
     return refuse("is 6-DOF actuated but reports no valid max_torque_nm; refusing to send it torques");
   }
+  limiter_ = ForceLimiter(info_, options_.limits, options_.rate_hz);
   open_ = true;
   fade_count_ = 0;
   return Ok{};
@@ -116,43 +117,49 @@ TraceSample HapticManager::tick(double now_s) {
   }
 
   DeviceCommand out = sample.requested;
-  if (!finite(out)) {
-    nonfinite_.increment();
-    sample.flags |= kTraceNonFinite;
-    out = DeviceCommand{};
-  }
+  const bool nonfinite = !finite(out);
+  if (nonfinite) sample.flags |= kTraceNonFinite;
   if (info_.dof_actuated < 6) out.torque = {};
-  if (clamp_norm(out.force, info_.max_force_n)) {
-    force_clamped_.increment();
-    sample.flags |= kTraceForceClamped;
-  }
-  if (clamp_norm(out.torque, info_.max_torque_nm)) {
-    torque_clamped_.increment();
-    sample.flags |= kTraceTorqueClamped;
-  }
   // the halt/fault state first: resume() and clear_fault() publish the fade restart before they
   // clear it, so a tick that sees it cleared also sees the restart
   const bool zero = halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire);
   if (restart_fade_.exchange(false, std::memory_order_acq_rel)) fade_count_ = 0;
-  if (zero) {
-    zeroed_ticks_.increment();
-    sample.flags |= kTraceZeroed;
+  if (zero || nonfinite) {
+    // zero at once, past the rate limit: the chain ramps up from it afterwards
+    if (zero) {
+      sample.flags |= kTraceZeroed;
+      fade_count_ = 0;
+    }
     out = DeviceCommand{};
-    fade_count_ = 0;
-  } else if (static_cast<double>(fade_count_) < fade_ticks_) {
-    // gain from the tick count, not a running sum, so that it reaches exactly 1
-    ++fade_count_;
-    const double gain = std::min(1.0, static_cast<double>(fade_count_) / fade_ticks_);
-    out.force *= gain;
-    out.torque *= gain;
-    if (gain < 1.0) sample.flags |= kTraceFading;
+    limiter_.zero();
+  } else {
+    double gain = 1.0;
+    if (static_cast<double>(fade_count_) < fade_ticks_) {
+      // gain from the tick count, not a running sum, so that it reaches exactly 1
+      ++fade_count_;
+      gain = std::min(1.0, static_cast<double>(fade_count_) / fade_ticks_);
+      if (gain < 1.0) sample.flags |= kTraceFading;
+    }
+    out = limiter_.apply(out, gain, sample.flags);
   }
+  count(sample.flags);
   sample.sent = out;
   device_->command(out);
 
   if (trace_ && !trace_->try_push(sample)) trace_dropped_.increment();
   sent_event_.broadcast(sample);
   return sample;
+}
+
+void HapticManager::count(std::uint32_t flags) {
+  if ((flags & kTraceNonFinite) != 0) nonfinite_.increment();
+  if ((flags & kTraceZeroed) != 0) zeroed_ticks_.increment();
+  if ((flags & kTraceForceClamped) != 0) force_clamped_.increment();
+  if ((flags & kTraceTorqueClamped) != 0) torque_clamped_.increment();
+  if ((flags & kTraceDeviceLimit) != 0) device_limited_.increment();
+  if ((flags & kTraceToolLimit) != 0) tool_limited_.increment();
+  if ((flags & kTraceSafetyLimit) != 0) safety_limited_.increment();
+  if ((flags & kTraceRateLimit) != 0) rate_limited_.increment();
 }
 
 std::size_t HapticManager::drain_trace(std::vector<TraceSample>& out) {
@@ -183,6 +190,10 @@ HapticStats HapticManager::stats() const {
   s.ticks = ticks_.load();
   s.force_clamped = force_clamped_.load();
   s.torque_clamped = torque_clamped_.load();
+  s.limits = {.device = device_limited_.load(),
+              .tool = tool_limited_.load(),
+              .safety = safety_limited_.load(),
+              .rate = rate_limited_.load()};
   s.nonfinite = nonfinite_.load();
   s.device_errors = device_errors_.load();
   s.zeroed_ticks = zeroed_ticks_.load();

@@ -10,34 +10,11 @@
 namespace uh::controllers {
 namespace {
 
+using testing::parse_trace;
+using testing::replaced;
 using testing::small_scene_json;
+using testing::small_scene_with_limits;
 using testing::test_assets;
-
-// A trace CSV (haptico::write_trace_header) as numbers, columns found by name.
-struct TraceTable {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> rows;
-  int column(const std::string& name) const {
-    for (std::size_t i = 0; i < names.size(); ++i)
-      if (names[i] == name) return static_cast<int>(i);
-    return -1;
-  }
-};
-
-TraceTable read_trace(const std::string& csv) {
-  TraceTable t;
-  std::istringstream in(csv);
-  std::string header;
-  std::getline(in, header);
-  std::istringstream h(header);
-  for (std::string name; std::getline(h, name, ',');) t.names.push_back(name);
-  for (std::string line; std::getline(in, line);) {
-    std::vector<double>& v = t.rows.emplace_back();
-    std::istringstream l(line);
-    for (std::string cell; std::getline(l, cell, ',');) v.push_back(std::atof(cell.c_str()));
-  }
-  return t;
-}
 
 struct SessionFixture : ::testing::Test {
   static void SetUpTestSuite() { cache_ = new std::filesystem::path(testing::fresh_cache("session")); }
@@ -89,17 +66,13 @@ TEST_F(SessionFixture, ForceOnTheStylusPointsUpOutOfTheBunny) {
   ASSERT_TRUE(session);
   std::ostringstream trace;
   ASSERT_TRUE(session->run_stepped(0.5, 1, &trace).has_value());
-  const TraceTable table = read_trace(trace.str());
-  const int fx = table.column("fx"), fz = table.column("fz");
-  ASSERT_GE(fz, 0);
-  ASSERT_GE(fx, 0);
+  const auto table = parse_trace(trace.str());
   int pushing = 0, contact = 0;
-  for (const std::vector<double>& v : table.rows) {
-    const double force_z = v[static_cast<std::size_t>(fz)];
-    const double force_x = v[static_cast<std::size_t>(fx)];
-    if (std::abs(force_z) + std::abs(force_x) < 1e-3) continue;
+  for (std::size_t i = 0; i < table.rows.size(); ++i) {
+    const Vec3 f = table.force(i);
+    if (std::abs(f.z) + std::abs(f.x) < 1e-3) continue;
     ++contact;
-    if (force_z > std::abs(force_x)) ++pushing;
+    if (f.z > std::abs(f.x)) ++pushing;
   }
   EXPECT_GT(contact, 50);
   EXPECT_GT(pushing, contact * 9 / 10) << "the force lifts the stylus out of the bunny";
@@ -121,16 +94,11 @@ TEST_F(SessionFixture, DampingFullVolumeRemovesTheKnockAtContactOnset) {
   // the stylus strikes the bunny at 0.11 m/s and keeps going in (the run ends before the line
   // does, so no turn-around changes the velocity); collision every tick, so that every force step
   // comes from the force law. The paper's damping reading puts eps_d * v on at the first touch.
-  const auto replace = [](std::string s, const std::string& from, const std::string& to) {
-    const auto at = s.find(from);
-    EXPECT_NE(at, std::string::npos);
-    if (at != std::string::npos) s.replace(at, from.size(), to);
-    return s;
-  };
-  const std::string paper = replace(small_scene_json(), R"("bounce": true)", R"("bounce": false)");
+  const std::string paper = replaced(small_scene_json(), R"("bounce": true)", R"("bounce": false)");
   auto with_paper = make(paper);
-  auto ramped = make(replace(paper, R"("damping": 1.0,)", R"("damping": 1.0, "damping_full_volume": 2e-8,)"));
-  auto undamped = make(replace(paper, R"("damping": 1.0,)", R"("damping": 0.0,)"));
+  auto ramped =
+      make(replaced(paper, R"("damping": 1.0,)", R"("damping": 1.0, "damping_full_volume": 2e-8,)"));
+  auto undamped = make(replaced(paper, R"("damping": 1.0,)", R"("damping": 0.0,)"));
   ASSERT_TRUE(with_paper && ramped && undamped);
   for (auto* s : {with_paper.get(), ramped.get(), undamped.get()}) ASSERT_TRUE(s->run_stepped(0.45, 1).has_value());
   ASSERT_GT(undamped->report().contact_ticks, 50) << "the stylus must be in contact for a while";
@@ -162,7 +130,7 @@ TEST_F(SessionFixture, StateAfterASteppedRunIsTheLastTickOfTheTrace) {
   std::ostringstream trace;
   ASSERT_TRUE(session->run_stepped(0.5, 4, &trace).has_value());
   const SessionState s = session->state();
-  const TraceTable table = read_trace(trace.str());
+  const auto table = parse_trace(trace.str());
   ASSERT_EQ(table.rows.size(), 500u);
   const std::vector<double>& last = table.rows.back();
   const auto at = [&](const char* name) { return last[static_cast<std::size_t>(table.column(name))]; };
@@ -233,6 +201,62 @@ TEST_F(SessionFixture, ASessionRunsOnceAndStopIsIdempotent) {
   EXPECT_FALSE(session->running());
 }
 
+// The limit chain through the whole pipeline: the stylus pushed into the bunny asks for up to
+// 6 N; whichever of the tool's, the session's and the device's limits is smallest bounds every
+// tick, and only that limit is counted.
+TEST_F(SessionFixture, SmallestOfToolSafetyAndDeviceLimitBoundsEveryTick) {
+  struct Case {
+    double tool, safety, device;
+    double smallest;
+    std::uint64_t haptico::LimitCounters::*counter;
+  };
+  const Case cases[] = {{1.0, 10.0, 6.0, 1.0, &haptico::LimitCounters::tool},
+                        {2.0, 1.5, 6.0, 1.5, &haptico::LimitCounters::safety},
+                        {2.0, 1.5, 1.2, 1.2, &haptico::LimitCounters::device}};
+  for (const Case& c : cases) {
+    auto session = make(small_scene_with_limits(c.tool, c.safety, c.device));
+    ASSERT_TRUE(session);
+    std::ostringstream trace;
+    ASSERT_TRUE(session->run_stepped(1.0, 4, &trace).has_value());
+    const SessionReport& r = session->report();
+    const auto table = parse_trace(trace.str());
+    ASSERT_EQ(table.rows.size(), 1000u);
+    std::uint64_t clamped_rows = 0;
+    for (std::size_t i = 0; i < table.rows.size(); ++i) {
+      ASSERT_LE(norm(table.force(i)), c.smallest * (1 + 1e-12)) << "tick " << i << ", limit " << c.smallest;
+      if ((table.flags(i) & haptico::kTraceForceClamped) != 0) ++clamped_rows;
+    }
+    EXPECT_LE(r.force_max_n, c.smallest * (1 + 1e-12));
+    EXPECT_GT(r.force_max_n, 0.99 * c.smallest) << "the contact asks for more than the limit";
+    EXPECT_GT(r.limits.*c.counter, 0u);
+    EXPECT_EQ(r.limits.tool + r.limits.safety + r.limits.device, r.limits.*c.counter)
+        << "only the smallest is counted";
+    EXPECT_EQ(r.force_clamped, clamped_rows) << "the counters agree with the trace";
+  }
+}
+
+// A late collision frame (one every 25 ticks, forces held between frames) would step the force;
+// the rate limit spreads every change over ticks of at most rate / haptic rate.
+TEST_F(SessionFixture, RateLimitBoundsEveryTickToTickStep) {
+  const std::string held = replaced(small_scene_with_limits(6.0, 10.0, 6.0, 100.0), R"("multi_rate": true)",
+                                    R"("multi_rate": false)");
+  auto session = make(held);
+  ASSERT_TRUE(session);
+  std::ostringstream trace;
+  ASSERT_TRUE(session->run_stepped(1.0, 25, &trace).has_value());
+  const SessionReport& r = session->report();
+  EXPECT_GT(r.force_max_raw_step_n, 0.5) << "held frames step the contact force";
+  const auto table = parse_trace(trace.str());
+  std::uint64_t limited_rows = 0;
+  for (std::size_t i = 1; i < table.rows.size(); ++i) {
+    EXPECT_LE(norm(table.force(i) - table.force(i - 1)), 0.1 * (1 + 1e-12)) << "tick " << i;
+    if ((table.flags(i) & haptico::kTraceRateLimit) != 0) ++limited_rows;
+  }
+  EXPECT_LE(r.force_max_step_n, 0.1 * (1 + 1e-12));
+  EXPECT_GT(r.limits.rate, 20u);
+  EXPECT_EQ(r.limits.rate, limited_rows);
+}
+
 TEST_F(SessionFixture, UnknownDriverIsAnErrorNamingTheScene) {
   std::string json = small_scene_json();
   json.replace(json.find("sim-line"), 8, "phantom-omni");
@@ -251,9 +275,11 @@ TEST_F(SessionFixture, ReportJsonHasTheDocumentedFields) {
   ASSERT_TRUE(session);
   ASSERT_TRUE(session->run_stepped(0.2, 4).has_value());
   const std::string json = session_report_json(session->report());
-  for (const char* key : {"\"target_hz\"", "\"rate_hz\"", "\"ticks\"", "\"missed_deadlines\"", "\"jitter_us\"", "\"p50\"",
-                          "\"p99\"", "\"max\"", "\"min\"", "\"median\"", "\"query_us\"", "\"max_n\"", "\"max_torque_nm\"",
-                          "\"nonfinite\"", "\"clamped\"", "\"contact\""})
+  for (const char* key : {"\"target_hz\"",     "\"rate_hz\"",   "\"ticks\"",    "\"missed_deadlines\"",
+                          "\"jitter_us\"",     "\"p50\"",       "\"p99\"",      "\"max\"",
+                          "\"min\"",           "\"median\"",    "\"query_us\"", "\"max_n\"",
+                          "\"max_torque_nm\"", "\"nonfinite\"", "\"clamped\"",  "\"limited\"",
+                          "\"device\"",        "\"tool\"",      "\"safety\"",   "\"contact\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
 }
 

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -103,6 +104,31 @@ TEST(HapticSessionThreaded, StartPollStopReadsContactAndForceAndEndsAtZero) {
   EXPECT_GT(r.seconds, 1.4);
   EXPECT_FALSE(r.timeline.empty());
   EXPECT_FALSE(session.world().running());
+  std::filesystem::remove_all(cache);
+}
+
+// A scene with a 1 N tool limit (device 6 N, safety 10 N) never sends more than 1 N, with the
+// real threads and the wall clock.
+TEST(HapticSessionThreaded, ToolLimitOfOneNewtonBoundsEveryTick) {
+  const auto cache = testing::fresh_cache("threaded-limit");
+  auto scene =
+      parse_scene(testing::small_scene_with_limits(1.0, 10.0, 6.0), "small.json", testing::test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  SessionOptions options;
+  options.cache_dir = cache;
+  auto session = HapticSession::create(*scene, options);
+  ASSERT_TRUE(session.has_value()) << session.error().message;
+  std::ostringstream trace;
+  ASSERT_TRUE((*session)->run(1.5, {}, &trace).has_value());
+  const SessionReport& r = (*session)->report();
+  const auto table = testing::parse_trace(trace.str());
+  ASSERT_GT(table.rows.size(), 300u);
+  for (std::size_t i = 0; i < table.rows.size(); ++i)
+    ASSERT_LE(norm(table.force(i)), 1.0 + 1e-12) << "row " << i;
+  EXPECT_GT(r.limits.tool, 0u) << "the stylus pushed into the bunny asks for more than 1 N";
+  EXPECT_EQ(r.limits.device, 0u);
+  EXPECT_EQ(r.limits.safety, 0u);
+  EXPECT_LE(r.force_max_n, 1.0 + 1e-12);
   std::filesystem::remove_all(cache);
 }
 

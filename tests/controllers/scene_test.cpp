@@ -10,6 +10,7 @@
 namespace uh::controllers {
 namespace {
 
+using testing::replaced;
 using testing::small_scene_json;
 using testing::test_assets;
 
@@ -20,13 +21,6 @@ void expect_error(const std::string& text, const std::string& needle) {
   ASSERT_FALSE(scene.has_value()) << "expected an error containing: " << needle;
   EXPECT_NE(scene.error().message.find(needle), std::string::npos) << scene.error().message;
   EXPECT_EQ(scene.error().message.rfind("test.json", 0), 0u) << "errors start with the file name: " << scene.error().message;
-}
-
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
 }
 
 TEST(Scene, ParsesTheSmallTestScene) {
@@ -84,6 +78,31 @@ TEST(Scene, ReportsFileFieldAndExpectation) {
   with_base("{ \"objects\": ", "not valid JSON");
   with_base(R"({ "seconds": 1e999 })", "not valid JSON");  // a number no double holds (the fuzzer's first find)
   with_base(R"({ "tool": {} })", "field 'objects': missing");
+}
+
+TEST(Scene, ReadsTheSafetyLimitsAndTheRateLimit) {
+  const auto defaults = parse_scene(small_scene_json(), "small.json", test_assets());
+  ASSERT_TRUE(defaults.has_value()) << defaults.error().message;
+  EXPECT_EQ(defaults->safety_limits.max_force_n, 10.0);
+  EXPECT_EQ(defaults->safety_limits.max_torque_nm, 0.5);
+  EXPECT_EQ(defaults->rate_limit.max_force_n_per_s, 1000.0) << "the rate limit is on by default";
+  EXPECT_EQ(defaults->rate_limit.max_torque_nm_per_s, 50.0);
+  const std::string with_safety = replaced(
+      small_scene_json(), R"("force": { "multi_rate")",
+      R"("force": { "safety": { "max_force_n": 2.5, "max_torque_nm": 0.1, "max_force_rate_n_per_s": 300,
+                                "max_torque_rate_nm_per_s": 7 }, "multi_rate")");
+  const auto scene = parse_scene(with_safety, "small.json", test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  EXPECT_EQ(scene->safety_limits.max_force_n, 2.5);
+  EXPECT_EQ(scene->safety_limits.max_torque_nm, 0.1);
+  EXPECT_EQ(scene->rate_limit.max_force_n_per_s, 300.0);
+  EXPECT_EQ(scene->rate_limit.max_torque_nm_per_s, 7.0);
+  EXPECT_EQ(scene->tool.force.max_force_n, 6.0);
+  const auto bad = parse_scene(replaced(with_safety, "300", "0"), "small.json", test_assets());
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find("field 'force.safety.max_force_rate_n_per_s': expected a number in"),
+            std::string::npos)
+      << bad.error().message;
 }
 
 TEST(Scene, LoadSceneNamesAMissingFile) {

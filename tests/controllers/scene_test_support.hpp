@@ -2,10 +2,17 @@
 // A small scene over the committed meshes (few spheres, so that tests stay fast under sanitizers),
 // written as JSON text like the files in scenes/.
 
+#include <gtest/gtest.h>
+
+#include <cstdlib>
 #include <filesystem>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
+
+#include "uh/core/math.hpp"
 
 namespace uh::controllers::testing {
 
@@ -48,6 +55,71 @@ inline std::string small_scene_json(bool multi_rate = true, bool coupling = fals
 }})",
                      fmt::arg("collision_hz", collision_hz), fmt::arg("multi_rate", multi_rate ? "true" : "false"),
                      fmt::arg("coupling", coupling ? "true" : "false"));
+}
+
+/// `text` with the first `from` replaced by `to`; a test failure if `from` is not there.
+inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "not in the scene: " << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+/// The small scene with force limits [N] of the tool (`tool.force`), of the session
+/// (`force.safety`) and of the device (`tool.device.config`), and a force rate limit [N/s].
+inline std::string small_scene_with_limits(double tool_n, double safety_n, double device_n,
+                                           double rate_n_per_s = 1000.0, double collision_hz = 1000) {
+  std::string s = small_scene_json(true, false, collision_hz);
+  s = replaced(s, R"("max_force_n": 6.0, "max_torque_nm": 0.3)",
+               fmt::format(R"("max_force_n": {}, "max_torque_nm": 0.3)", tool_n));
+  s = replaced(s, R"("dof_actuated": 6, "max_force_n": 6)",
+               fmt::format(R"("dof_actuated": 6, "max_force_n": {})", device_n));
+  return replaced(
+      s, R"("force": { "multi_rate")",
+      fmt::format(
+          R"("force": {{ "safety": {{ "max_force_n": {}, "max_force_rate_n_per_s": {} }}, "multi_rate")",
+          safety_n, rate_n_per_s));
+}
+
+/// The rows of a trace CSV (haptico::write_trace_header / write_trace_row) by column name.
+struct TraceTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+
+  int column(const std::string& name) const {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return static_cast<int>(i);
+    ADD_FAILURE() << "no trace column " << name;
+    return 0;
+  }
+  /// The sent force of row `i` [N].
+  Vec3 force(std::size_t i) const {
+    const auto& r = rows[i];
+    return {r[static_cast<std::size_t>(column("fx"))], r[static_cast<std::size_t>(column("fy"))],
+            r[static_cast<std::size_t>(column("fz"))]};
+  }
+  std::uint32_t flags(std::size_t i) const {
+    return static_cast<std::uint32_t>(rows[i][static_cast<std::size_t>(column("flags"))]);
+  }
+};
+
+inline TraceTable parse_trace(const std::string& csv) {
+  TraceTable t;
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  {
+    std::istringstream h(line);
+    for (std::string name; std::getline(h, name, ',');) t.names.push_back(name);
+  }
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream l(line);
+    for (std::string cell; std::getline(l, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
+    EXPECT_EQ(row.size(), t.names.size()) << line;
+    t.rows.push_back(std::move(row));
+  }
+  return t;
 }
 
 }  // namespace uh::controllers::testing

@@ -251,15 +251,5 @@ TEST(ForceComponent, BodyMotionShiftsVelocityToCentreOfMass) {
   EXPECT_NEAR(m.linear_velocity_world.y, 0.0, 1e-12);
 }
 
-TEST(ForceComponent, SafetyOptionsCarryTheObjectLimits) {
-  ForceComponentOptions options;
-  options.params.max_force_n = 3.0;
-  options.params.max_torque_nm = 0.25;
-  const ForceSafetyOptions s = ForceComponent(options).safety_options({.max_age_s = 0.1});
-  EXPECT_EQ(s.max_force_n, 3.0);
-  EXPECT_EQ(s.max_torque_nm, 0.25);
-  EXPECT_EQ(s.watchdog.max_age_s, 0.1);
-}
-
 }  // namespace
 }  // namespace uh::forcecomp

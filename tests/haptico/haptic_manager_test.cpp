@@ -73,12 +73,17 @@ void wait_for_ticks(const HapticManager& manager, std::uint64_t ticks) {
   }
 }
 
+// most tests check one stage of the tick: these options take the rate limit out of the way
+constexpr ForceLimitOptions kNoRateLimit{
+    .rate = {.max_force_n_per_s = kNoLimit, .max_torque_nm_per_s = kNoLimit}};
+
 struct Fixture {
   std::vector<std::string> log;
   FakeDevice* device = nullptr;
   std::unique_ptr<HapticManager> manager;
 
-  explicit Fixture(HapticManagerOptions options = {.soft_start_s = 0.0}, bool with_log = true) {
+  explicit Fixture(HapticManagerOptions options = {.soft_start_s = 0.0, .limits = kNoRateLimit},
+                   bool with_log = true) {
     auto d = std::make_unique<FakeDevice>(with_log ? &log : nullptr);
     device = d.get();
     manager = std::make_unique<HapticManager>(std::move(d), options);
@@ -123,9 +128,73 @@ TEST(HapticManager, ClampsToDeviceLimitsKeepingDirection) {
   EXPECT_NEAR(f.device->last.force.z, 4.0, 1e-12);
   EXPECT_NEAR(f.device->last.torque.y, 0.2, 1e-12);
   EXPECT_EQ(t.requested.force, (Vec3{30, 0, 40}));
-  EXPECT_EQ(t.flags, kTraceForceClamped | kTraceTorqueClamped);
+  EXPECT_EQ(t.flags, kTraceForceClamped | kTraceTorqueClamped | kTraceDeviceLimit);
   EXPECT_EQ(f.manager->stats().force_clamped, 1u);
   EXPECT_EQ(f.manager->stats().torque_clamped, 1u);
+  EXPECT_EQ(f.manager->stats().limits.device, 1u);
+}
+
+// The tool's and the safety limits join the device's (5 N, 0.2 N m): in every combination the
+// force and torque sent are those of the smallest limit, and that limit is the one counted.
+TEST(HapticManager, SmallestOfDeviceToolAndSafetyLimitWins) {
+  struct Case {
+    WrenchLimit tool, safety;
+    double force, torque;  // expected |force|, |torque| sent
+    std::uint32_t source;  // the limit credited
+  };
+  const Case cases[] = {
+      {{}, {}, 5.0, 0.2, kTraceDeviceLimit},
+      {{2.0, 0.1}, {}, 2.0, 0.1, kTraceToolLimit},
+      {{}, {3.0, 0.15}, 3.0, 0.15, kTraceSafetyLimit},
+      {{2.0, 0.1}, {3.0, 0.15}, 2.0, 0.1, kTraceToolLimit},
+      {{3.0, 0.15}, {2.0, 0.1}, 2.0, 0.1, kTraceSafetyLimit},
+      {{7.0, 0.3}, {6.0, 0.25}, 5.0, 0.2, kTraceDeviceLimit},
+      {{5.0, 0.2}, {5.0, 0.2}, 5.0, 0.2, kTraceDeviceLimit},  // ties go to the device
+      {{4.0, 0.1}, {4.0, 0.1}, 4.0, 0.1, kTraceToolLimit},    // then to the tool
+  };
+  for (const Case& c : cases) {
+    Fixture f(
+        {.soft_start_s = 0.0, .limits = {.tool = c.tool, .safety = c.safety, .rate = kNoRateLimit.rate}});
+    ASSERT_TRUE(f.manager->open());
+    f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) {
+      cmd.force = {0, 30, 40};
+      cmd.torque = {1, 0, 0};
+    });
+    const TraceSample t = f.manager->step(0.0);
+    EXPECT_NEAR(norm(t.sent.force), c.force, 1e-12) << c.force;
+    EXPECT_NEAR(t.sent.force.z / t.sent.force.y, 4.0 / 3.0, 1e-12) << "direction kept";
+    EXPECT_NEAR(norm(t.sent.torque), c.torque, 1e-12) << c.torque;
+    EXPECT_EQ(t.flags, kTraceForceClamped | kTraceTorqueClamped | c.source) << c.force;
+    const LimitCounters n = f.manager->stats().limits;
+    EXPECT_EQ(n.device, c.source == kTraceDeviceLimit ? 1u : 0u);
+    EXPECT_EQ(n.tool, c.source == kTraceToolLimit ? 1u : 0u);
+    EXPECT_EQ(n.safety, c.source == kTraceSafetyLimit ? 1u : 0u);
+    EXPECT_EQ(n.rate, 0u);
+  }
+}
+
+// A force that jumps (a late collision frame) reaches the device in steps of at most rate / tick
+// rate; zero (halt) is sent at once, and the force ramps up again from it.
+TEST(HapticManager, RateLimitBoundsEveryStepButNeverDelaysZero) {
+  Fixture f({.rate_hz = 1000.0, .soft_start_s = 0.0, .limits = {.rate = {.max_force_n_per_s = 500.0}}});
+  ASSERT_TRUE(f.manager->open());
+  Vec3 wanted{};
+  f.manager->force_on_haptic_tick().add_delegate(
+      [&](const DeviceState&, DeviceCommand& cmd) { cmd.force = wanted; });
+  wanted = {0, 0, 4.0};
+  std::uint64_t limited = 0;
+  for (int i = 1; i <= 8; ++i) {
+    const TraceSample t = f.manager->step(0.001 * i);
+    EXPECT_NEAR(t.sent.force.z, 0.5 * i, 1e-12) << "tick " << i;
+    if ((t.flags & kTraceRateLimit) != 0) ++limited;
+  }
+  EXPECT_EQ(limited, 7u) << "the eighth step reaches 4 N exactly, within the limit";
+  EXPECT_EQ(f.manager->step(0.009).sent.force.z, 4.0);
+  f.manager->halt();
+  EXPECT_EQ(f.manager->step(0.010).sent.force, Vec3{}) << "zero at once";
+  f.manager->resume();
+  EXPECT_NEAR(f.manager->step(0.011).sent.force.z, 0.5, 1e-12) << "from zero again";
+  EXPECT_EQ(f.manager->stats().limits.rate, 8u);
 }
 
 TEST(HapticManager, NonFiniteCommandReplacedByZero) {
@@ -263,7 +332,7 @@ TEST(HapticManager, OpenFailuresAreErrors) {
 }
 
 TEST(HapticManager, TraceRecordsTicksAndWritesCsv) {
-  Fixture f({.trace_capacity = 4, .soft_start_s = 0.0});
+  Fixture f({.trace_capacity = 4, .soft_start_s = 0.0, .limits = kNoRateLimit});
   ASSERT_TRUE(f.manager->open());
   f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {0, 0, 2}; });
   // the queue may round its capacity up: overfill it by far and check that nothing is lost unseen

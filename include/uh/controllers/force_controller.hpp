@@ -26,7 +26,8 @@ struct ForceControllerOptions {
   /// Re-evaluate the held pair set at the current tool pose every haptic tick (multi-rate). When
   /// false, the force computed from the newest collision frame is held until the next frame.
   bool multi_rate = true;
-  /// Limits, NaN guard and contact-age watchdog applied before the command leaves the controller.
+  /// NaN guard and contact-age watchdog applied before the command leaves the controller (the
+  /// limits are the haptic manager's limit chain, applied to the summed command).
   forcecomp::ForceSafetyOptions safety{};
   /// Optional spring-damper between the handle and a simulated tool (proxy).
   bool use_coupling = false;
@@ -38,8 +39,8 @@ struct ForceControllerStats {
   std::uint64_t ticks = 0;              ///< force ticks run
   std::uint64_t contact_ticks = 0;      ///< ticks with at least one held pair of positive volume
   std::uint64_t frames_received = 0;    ///< contact frames taken over from the collision thread
-  double max_force_n = 0.0;             ///< largest |force| sent to the device [N]
-  double max_torque_nm = 0.0;           ///< largest |torque| sent [N m]
+  double max_force_n = 0.0;             ///< largest |force| it asked for [N], before the limit chain
+  double max_torque_nm = 0.0;           ///< largest |torque| it asked for [N m], before the limit chain
   double max_force_step_n = 0.0;        ///< largest tick-to-tick change of the contact force before limits [N]
   double last_force_n = 0.0;            ///< |force| of the last tick [N]
   std::int32_t last_pairs = 0;          ///< pairs used in the last tick
@@ -52,8 +53,9 @@ struct ForceControllerStats {
 /// On the collision thread, on_collision() copies each frame about the tool into a lock-free
 /// LatestValue per watched pair. On the haptic thread, on_force() takes the newest frame, holds its
 /// pairs, evaluates the volumetric penalty force and torque on the tool (ForceComponent, eq. 1-2),
-/// optionally through a virtual coupling, applies ForceSafety (limits, NaN guard, watchdog on the
-/// age of the contact data) and adds the result, in the device frame, to the command.
+/// optionally through a virtual coupling, applies ForceSafety (NaN guard, watchdog on the age of
+/// the contact data) and adds the result, in the device frame, to the command; the manager's
+/// limit chain bounds the sum.
 ///
 /// Threads: construct, add_watched() and bind() on the controlling thread before the threads start;
 /// stats() from any thread. Memory for all watched pairs is allocated in add_watched(); the tick

@@ -80,10 +80,11 @@ struct SessionReport {
   std::uint64_t truncated_frames = 0;
   std::uint64_t coherent_queries = 0;   ///< collision queries that reused their kept candidates
   // forces
-  double force_max_n = 0.0, torque_max_nm = 0.0;
+  double force_max_n = 0.0, torque_max_nm = 0.0;  ///< largest |force|, |torque| sent to the device [N], [N m]
   double force_max_step_n = 0.0;       ///< largest tick-to-tick change of the force sent to the device [N]
   double force_max_raw_step_n = 0.0;   ///< same for the contact force before coupling, limits and fades [N]
   std::uint64_t force_nonfinite = 0, force_clamped = 0, torque_clamped = 0, stale_ticks = 0;
+  haptico::LimitCounters limits{};     ///< ticks in which each limit of the chain engaged
   std::uint64_t contact_ticks = 0;
   double work_on_hand_j = 0.0;         ///< energy the device put into the hand [J]
   bool multi_rate = true;

@@ -65,7 +65,13 @@ struct Scene {
   double seconds = 10.0;               ///< default session length [s]
   double contact_margin = 0.001;       ///< collision pairs delivered this far [m] before they touch (multi-rate)
   double coherence_skin = 0.0;         ///< frame-to-frame coherence skin of the volume query [m]; 0 = off
-  ForceControllerOptions force{};      ///< multi-rate, safety limits, watchdog, coupling
+  ForceControllerOptions force{};      ///< multi-rate, watchdog, coupling
+  /// The session's safety limits (`force.safety.max_force_n`, `max_torque_nm`); the session's
+  /// limit chain applies the smallest of these, the tool's (`tool.force`) and the device's.
+  haptico::WrenchLimit safety_limits{.max_force_n = 10.0, .max_torque_nm = 0.5};
+  /// `force.safety.max_force_rate_n_per_s`, `max_torque_rate_nm_per_s`: the largest change of the
+  /// command per second (per tick: divided by the haptic rate); zero is always sent at once.
+  haptico::ForceRateLimit rate_limit{};
 };
 
 /// Reads a scene file. Errors name the file, the field (as a JSON path such as

@@ -7,7 +7,6 @@
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
 #include "uh/forcecomp/force_params.hpp"
-#include "uh/forcecomp/force_safety.hpp"
 #include "uh/forcecomp/penalty_force.hpp"
 
 namespace uh::forcecomp {
@@ -25,7 +24,8 @@ struct ForceComponentOptions {
 ///
 /// Holds only parameters: it is a value type, cheap to copy, and its const methods may be called
 /// from any thread (typically the haptic thread). All methods are real-time safe. It applies no
-/// limits; pass its result through ForceSafety before sending it to a device.
+/// limits: pass its result through ForceSafety (NaN guard, watchdog) and let the haptic manager's
+/// limit chain (haptico::ForceLimiter) bound it.
 class ForceComponent {
  public:
   ForceComponent() = default;
@@ -50,11 +50,6 @@ class ForceComponent {
   /// force (HeldContactSet::evaluate). `held` is not const: it writes its preallocated scratch.
   PenaltyResult evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
                          const BodyMotion& self, const BodyMotion& other = {}) const;
-
-  /// Options for a ForceSafety stage using this object's max_force_n and max_torque_nm.
-  ForceSafetyOptions safety_options(const ContactWatchdogOptions& watchdog = {}) const {
-    return ForceSafetyOptions{options_.params.max_force_n, options_.params.max_torque_nm, watchdog};
-  }
 
   /// The PenaltyInput this component uses for the given motions.
   PenaltyInput penalty_input(const BodyMotion& self, const BodyMotion& other) const;

@@ -34,8 +34,10 @@ struct ForceParams {
   /// at contact onset. V_d > 0: the damping shares are vol_ij / max(Vol_total, V_d), so the
   /// damping ramps up with the overlap and is continuous at contact (penalty_force.hpp).
   double damping_full_volume = 0.0;
-  double max_force_n = 10.0;            ///< |force| limit [N], > 0
-  double max_torque_nm = 0.5;           ///< |torque| limit [N m], > 0
+  /// |force| limit of this object as a tool [N], > 0. Applied by the session's limit chain
+  /// (haptico::ForceLimiter) together with the device's and the safety limits: the smallest wins.
+  double max_force_n = 10.0;
+  double max_torque_nm = 0.5;  ///< |torque| limit [N m], > 0; see max_force_n
 };
 
 }  // namespace uh::forcecomp

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// ForceSafety: the last stage before a force reaches a device.
+/// ForceSafety: the NaN guard, the contact watchdog and the stop of a force controller's wrench.
 
 #include <atomic>
 #include <cstdint>
@@ -12,27 +12,24 @@ namespace uh::forcecomp {
 
 /// Options of a ForceSafety stage (options aggregate).
 struct ForceSafetyOptions {
-  double max_force_n = 10.0;     ///< |force| limit [N], > 0
-  double max_torque_nm = 0.5;    ///< |torque| limit [N m], > 0
   ContactWatchdogOptions watchdog{};
 };
 
 /// Counters of a ForceSafety stage; a snapshot, trivially copyable.
 struct ForceSafetyCounters {
-  std::uint64_t ticks = 0;              ///< calls to apply()
-  std::uint64_t force_clamped = 0;      ///< ticks whose force exceeded max_force_n
-  std::uint64_t torque_clamped = 0;     ///< ticks whose torque exceeded max_torque_nm
-  std::uint64_t nonfinite = 0;          ///< ticks with a NaN/inf component (replaced by zero)
-  std::uint64_t stale_ticks = 0;        ///< ticks with stale contact data (watchdog ramping down / held at 0)
-  std::uint64_t zeroed_ticks = 0;       ///< ticks zeroed because of stop() or a device fault
+  std::uint64_t ticks = 0;         ///< calls to apply()
+  std::uint64_t nonfinite = 0;     ///< ticks with a NaN/inf component (replaced by zero)
+  std::uint64_t stale_ticks = 0;   ///< ticks with stale contact data (watchdog ramping down / held at 0)
+  std::uint64_t zeroed_ticks = 0;  ///< ticks zeroed because of stop() or a device fault
 };
 
-/// Makes a computed wrench safe to send: replaces any non-finite wrench by zero, scales the force
-/// and the torque down to their limits (keeping their directions), fades them out with a
-/// ContactWatchdog when the contact data is old, and outputs zero while stopped or faulted.
+/// Makes a computed wrench fit to send: replaces any non-finite wrench by zero, fades it out with
+/// a ContactWatchdog when the contact data is old, and outputs zero while stopped or faulted.
 ///
-/// Order: non-finite guard, watchdog gain, clamp, stop/fault. Clamping after the gain keeps the
-/// output bounded whatever the gain.
+/// Order: non-finite guard, watchdog gain, stop/fault. Force and torque limits are not applied
+/// here: the device's, the tool's and the session's limits and the rate limit form one chain at
+/// the end of the haptic tick (haptico::ForceLimiter, applied by HapticManager to the summed
+/// command of all delegates).
 ///
 /// Threads: apply() belongs to one thread (the haptic thread) and is real-time safe (no allocation,
 /// lock, throw or log: it counts). stop(), resume(), report_fault() and counters() may be called
@@ -67,8 +64,6 @@ class ForceSafety {
   std::atomic<bool> faulted_{false};
   std::atomic<bool> resume_requested_{false};
   std::atomic<std::uint64_t> ticks_{0};
-  std::atomic<std::uint64_t> force_clamped_{0};
-  std::atomic<std::uint64_t> torque_clamped_{0};
   std::atomic<std::uint64_t> nonfinite_{0};
   std::atomic<std::uint64_t> stale_ticks_{0};
   std::atomic<std::uint64_t> zeroed_ticks_{0};

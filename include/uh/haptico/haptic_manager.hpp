@@ -15,6 +15,7 @@
 #include "uh/core/fixed_rate_loop.hpp"
 #include "uh/core/result.hpp"
 #include "uh/core/spsc_queue.hpp"
+#include "uh/haptico/force_limiter.hpp"
 #include "uh/haptico/haptic_device.hpp"
 #include "uh/haptico/trace_sample.hpp"
 
@@ -35,14 +36,26 @@ struct HapticManagerOptions {
   /// Consecutive ticks whose DeviceState::time_s does not advance before the device counts as
   /// frozen (a stalled driver repeating an old pose): treated as a device error. 0 disables.
   int max_frozen_ticks = 50;
+  /// The tool's and the session's limits and the rate limit, applied with the device's own limits
+  /// by one ForceLimiter (default: no tool or safety limit, the default rate limit).
+  ForceLimitOptions limits{};
+};
+
+/// Ticks in which each limit of the chain engaged (ForceLimiter); plain data.
+struct LimitCounters {
+  std::uint64_t device = 0;  ///< the device's limit was the smallest and clamped force or torque
+  std::uint64_t tool = 0;    ///< the tool's limit was the smallest and clamped
+  std::uint64_t safety = 0;  ///< the session's safety limit was the smallest and clamped
+  std::uint64_t rate = 0;    ///< the rate limit bounded the change from the previous tick
 };
 
 /// Counters of a HapticManager; a snapshot, plain data.
 struct HapticStats {
   FixedRateLoopStats loop{};          ///< timing of the haptic thread (zero in stepped sessions)
   std::uint64_t ticks = 0;            ///< ticks run (threaded and stepped)
-  std::uint64_t force_clamped = 0;    ///< ticks whose force was scaled down to max_force_n
-  std::uint64_t torque_clamped = 0;   ///< ticks whose torque was scaled down to max_torque_nm
+  std::uint64_t force_clamped = 0;    ///< ticks whose force was scaled down to the smallest limit
+  std::uint64_t torque_clamped = 0;   ///< ticks whose torque was scaled down to the smallest limit
+  LimitCounters limits{};             ///< which limit engaged how often
   std::uint64_t nonfinite = 0;        ///< ticks whose requested command had a NaN/inf (zero sent)
   std::uint64_t device_errors = 0;    ///< ticks whose read_state() failed
   std::uint64_t zeroed_ticks = 0;     ///< ticks that sent zero because of halt() or a fault
@@ -57,10 +70,12 @@ struct HapticStats {
 ///   2. MoveOnHapticTick.broadcast(state)            (e.g. move the tool in the scene);
 ///   3. ForceOnHapticTick.broadcast(state, command)  (each delegate adds its force to `command`,
 ///      which starts at zero);
-///   4. safety: a NaN/inf anywhere -> zero (counted); force and torque scaled down to the
-///      device's max_force_n / max_torque_nm (counted); torque zeroed on 3-DOF devices; zero while
-///      halted or after a device error (latched until clear_fault()); a linear fade-in over
-///      soft_start_s after open(), start(), resume() and clear_fault();
+///   4. safety: a NaN/inf anywhere -> zero (counted); torque zeroed on 3-DOF devices; zero while
+///      halted or after a device error (latched until clear_fault()); otherwise the limit chain
+///      (ForceLimiter): force and torque scaled down to the smallest of the device's, the tool's
+///      and the safety limits, a linear fade-in over soft_start_s after open(), start(), resume()
+///      and clear_fault(), and the rate limit on the change from the previous tick. Zero is sent
+///      at once, never rate-limited; each engaged limit is counted (stats().limits);
 ///   5. device.command(command); the tick is pushed to the trace queue if enabled;
 ///   6. SentOnHapticTick.broadcast(sample)  (what was read, asked for and sent this tick).
 /// The same tick code runs in threaded sessions (start()/stop()) and stepped ones (step()).
@@ -137,14 +152,19 @@ class HapticManager {
   bool is_open() const { return open_; }
   /// The device's description as read by open().
   const DeviceInfo& device_info() const { return info_; }
+  /// The limit chain built by open() from the device's and options().limits (controlling thread,
+  /// while no threaded session runs).
+  const ForceLimiter& limiter() const { return limiter_; }
   const HapticManagerOptions& options() const { return options_; }
 
  private:
   TraceSample tick(double now_s);
+  void count(std::uint32_t flags);
 
   HapticManagerOptions options_;
   std::unique_ptr<HapticDevice> device_;
   DeviceInfo info_{};
+  ForceLimiter limiter_{};  // haptic thread while running
   bool open_ = false;
   FixedRateLoop loop_;
   Delegator<const DeviceState&> move_event_;
@@ -163,6 +183,10 @@ class HapticManager {
   EventCounter ticks_;
   EventCounter force_clamped_;
   EventCounter torque_clamped_;
+  EventCounter device_limited_;
+  EventCounter tool_limited_;
+  EventCounter safety_limited_;
+  EventCounter rate_limited_;
   EventCounter nonfinite_;
   EventCounter device_errors_;
   EventCounter zeroed_ticks_;

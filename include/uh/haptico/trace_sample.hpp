@@ -13,12 +13,17 @@ namespace uh::haptico {
 
 /// Bits of TraceSample::flags: what the safety stage did in that tick.
 enum TraceFlag : std::uint32_t {
-  kTraceForceClamped = 1u << 0,   ///< |force| was above the device limit and was scaled down
-  kTraceTorqueClamped = 1u << 1,  ///< |torque| was above the device limit and was scaled down
+  kTraceForceClamped = 1u << 0,   ///< |force| was above the smallest limit and was scaled down
+  kTraceTorqueClamped = 1u << 1,  ///< |torque| was above the smallest limit and was scaled down
   kTraceNonFinite = 1u << 2,      ///< the requested command had a NaN/inf and was replaced by zero
   kTraceZeroed = 1u << 3,         ///< zero was sent because of halt() or a latched device fault
   kTraceDeviceError = 1u << 4,    ///< read_state() reported an error this tick
   kTraceFading = 1u << 5,         ///< the soft-start fade scaled the command down
+  kTraceDeviceLimit = 1u << 6,    ///< the device's limit (DeviceInfo) clamped the force or torque
+  kTraceToolLimit = 1u << 7,      ///< the tool's limit clamped the force or torque
+  kTraceSafetyLimit = 1u << 8,    ///< the session's safety limit clamped the force or torque
+  kTraceRateLimit = 1u << 9,      ///< the change from the previous tick was bounded by the rate limit
+  kTraceStopped = 1u << 10,       ///< not a tick: the zero command sent when the haptic loop ended
 };
 
 /// One tick: when, what the device reported, what the delegates asked for and what was sent.
