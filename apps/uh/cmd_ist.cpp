@@ -1,4 +1,6 @@
 // uh ist build | info | preview
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -41,48 +43,89 @@ struct IstPreviewArgs {
 
 std::string mesh_assumptions(const collette::MeshReport& r) {
   std::string text;
-  if (r.welded_vertices > 0) text += fmt::format("welded {} duplicate vertices; ", r.welded_vertices);
-  if (r.winding_flipped) text += "inverted winding fixed (all triangles flipped); ";
   if (r.assumed_open)
-    text += fmt::format("accepted an open mesh ({} boundary edges): inside tests use the winding number; ", r.boundary_edges);
-  if (r.degenerate_faces > 0) text += fmt::format("dropped {} degenerate faces; ", r.degenerate_faces);
+    text += fmt::format(
+        "accepted an open mesh ({} boundary edges): holes capped, inside tests use the winding number; ",
+        r.boundary_edges);
   if (!text.empty()) text.resize(text.size() - 2);
   return text;
+}
+
+std::string mesh_repairs(const collette::MeshReport& r) {
+  std::string text;
+  if (r.degenerate_faces > 0) text += fmt::format("dropped {} degenerate faces; ", r.degenerate_faces);
+  if (r.duplicate_faces > 0) text += fmt::format("dropped {} duplicate faces; ", r.duplicate_faces);
+  if (r.winding_flipped) text += "inverted winding fixed (all triangles flipped); ";
+  if (!text.empty()) text.resize(text.size() - 2);
+  return text;
+}
+
+// The mesh as `ist build` accepts it: repaired, and open only with --allow-open. It is loaded as
+// if open meshes were allowed, so that this command, not the library, decides and can name its
+// own option.
+Result<collette::TriangleMesh> load_build_mesh(const IstBuildArgs& args) {
+  const collette::MeshLoadOptions defaults{};
+  collette::MeshLoadOptions options{.allow_open = true, .max_open_boundary_edges = INT64_MAX, .repair = true};
+  auto mesh = collette::load_mesh(args.mesh, options);
+  if (!mesh) return mesh;
+  const collette::MeshReport& r = mesh->report;
+  if (!r.assumed_open) return mesh;
+  const std::string repaired = r.repaired
+                                   ? fmt::format(" after dropping {} degenerate and {} duplicate faces",
+                                                 r.degenerate_faces, r.duplicate_faces)
+                                   : std::string();
+  const std::string what = fmt::format("{}: mesh is not closed{}: {} boundary edges, 0 non-manifold edges",
+                                       mesh->source_name, repaired, r.boundary_edges);
+  if (r.boundary_edges > defaults.max_open_boundary_edges)
+    return Error{fmt::format("{} (a closed mesh is required; --allow-open caps at most {} boundary edges)",
+                             what, defaults.max_open_boundary_edges)};
+  if (!args.allow_open)
+    return Error{fmt::format(
+        "{} (a closed mesh is required; --allow-open accepts it with its holes capped by flat fans)", what)};
+  return mesh;
 }
 
 int run_build(const IstBuildArgs& args) {
   if (std::filesystem::path(args.out).extension() != ".ist")
     return fail(fmt::format("{}: the output file must end in .ist", args.out));
+  const auto start = std::chrono::steady_clock::now();
+  auto mesh = load_build_mesh(args);
+  if (!mesh) return fail(mesh.error().message);
+  auto hash = collette::hash_file(args.mesh);
+  if (!hash) return fail(hash.error().message);
+  const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ProgressBar bar("packing");
   collette::IstBuildOptions options{.sphere_count = args.spheres,
                                     .voxel_size = args.voxel,
                                     .meters_per_unit = args.meters_per_unit,
                                     .progress = [&bar](double f) { bar.update(f); }};
-  options.mesh.allow_open = args.allow_open;
-  auto built = collette::build_ist_asset(args.mesh, options);
+  auto built = collette::build_ist_asset(*mesh, *hash, options);
   bar.finish();
-  if (!built) {
-    const bool open_mesh = built.error().message.find("allow_open") != std::string::npos;
-    return fail(built.error().message + (open_mesh ? "; on the command line: --allow-open" : ""));
-  }
+  if (!built) return fail(built.error().message);
+  built->asset.meta.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (auto saved = collette::save_ist(args.out, built->asset); !saved) return fail(saved.error().message);
   if (!args.preview.empty()) {
     std::vector<Sphere> leaves(built->asset.tree.leaves().begin(), built->asset.tree.leaves().end());
-    if (auto png = collette::write_packing_preview(leaves, args.preview, {}); !png) return fail(png.error().message);
+    if (auto png = collette::write_packing_preview(leaves, args.preview, {}); !png)
+      return fail(png.error().message);
   }
   const auto& p = built->packing;
   const auto& tree = built->asset.tree;
-  const std::string assumed = mesh_assumptions(built->mesh);
+  const auto& m = built->mesh;
+  const std::string assumed = mesh_assumptions(m);
+  const std::string repaired = mesh_repairs(m);
   if (args.json) {
     nlohmann::json j = {{"mesh", args.mesh},
                         {"output", args.out},
-                        {"triangles", built->mesh.triangle_count},
+                        {"triangles", m.triangle_count},
                         {"spheres", p.sphere_count},
                         {"mesh_volume", p.mesh_volume},
                         {"sphere_volume", p.sphere_volume},
                         {"coverage", p.coverage},
                         {"max_gap", p.max_gap},
                         {"build_seconds", built->asset.meta.build_seconds},
+                        {"load_seconds", load_seconds},
                         {"packing_seconds", p.build_seconds},
                         {"tree_seconds", built->tree_seconds},
                         {"voxel_size", p.voxel_size},
@@ -91,17 +134,27 @@ int run_build(const IstBuildArgs& args) {
                         {"nodes", tree.node_count()},
                         {"depth", tree.depth()},
                         {"arity", tree.arity()},
+                        {"repaired",
+                         {{"degenerate_faces", m.degenerate_faces},
+                          {"duplicate_faces", m.duplicate_faces},
+                          {"winding_flipped", m.winding_flipped}}},
+                        {"welded_vertices", m.welded_vertices},
+                        {"open_boundary_edges", m.assumed_open ? m.boundary_edges : 0},
                         {"assumed", assumed}};
     if (!args.preview.empty()) j["preview"] = args.preview;
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("%s: %lld triangles -> %s\n", args.mesh.c_str(), static_cast<long long>(built->mesh.triangle_count),
+    std::printf("%s: %lld triangles -> %s\n", args.mesh.c_str(), static_cast<long long>(m.triangle_count),
                 args.out.c_str());
+    if (!repaired.empty()) std::printf("  repaired: %s\n", repaired.c_str());
     if (!assumed.empty()) std::printf("  assumed: %s\n", assumed.c_str());
     std::printf("  spheres %lld, coverage %.1f%% (sphere volume %.6g of %.6g), max gap %.4g\n",
-                static_cast<long long>(p.sphere_count), 100.0 * p.coverage, p.sphere_volume, p.mesh_volume, p.max_gap);
-    std::printf("  radii %.4g..%.4g, voxel %.4g; tree: %d nodes, depth %d; built in %.2f s\n", p.min_radius,
-                p.max_radius, p.voxel_size, tree.node_count(), tree.depth(), built->asset.meta.build_seconds);
+                static_cast<long long>(p.sphere_count), 100.0 * p.coverage, p.sphere_volume, p.mesh_volume,
+                p.max_gap);
+    std::printf("  radii %.4g..%.4g, voxel %.4g; tree: %d nodes, depth %d\n", p.min_radius, p.max_radius,
+                p.voxel_size, tree.node_count(), tree.depth());
+    std::printf("  built in %.2f s (mesh %.2f s, packing %.2f s, tree %.2f s)\n",
+                built->asset.meta.build_seconds, load_seconds, p.build_seconds, built->tree_seconds);
   }
   return 0;
 }
@@ -137,10 +190,10 @@ int run_info(const IstInfoArgs& args) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("%s: Inner Sphere Tree, format %u\n", args.file.c_str(), collette::kIstFormatVersion);
-    std::printf("  spheres %d (radii %.4g..%.4g), nodes %d, depth %d, arity %d\n", tree.leaf_count(), min_r, max_r,
-                tree.node_count(), tree.depth(), tree.arity());
-    std::printf("  coverage %.1f%% (sphere volume %.6g of mesh volume %.6g), max gap %.4g\n", 100.0 * m.coverage,
-                tree.total_volume(), m.mesh_volume, m.max_gap);
+    std::printf("  spheres %d (radii %.4g..%.4g), nodes %d, depth %d, arity %d\n", tree.leaf_count(), min_r,
+                max_r, tree.node_count(), tree.depth(), tree.arity());
+    std::printf("  coverage %.1f%% (sphere volume %.6g of mesh volume %.6g), max gap %.4g\n",
+                100.0 * m.coverage, tree.total_volume(), m.mesh_volume, m.max_gap);
     std::printf("  units: %g m per unit; source mesh hash %016llx; built in %.2f s\n", m.meters_per_unit,
                 static_cast<unsigned long long>(m.source_mesh_hash), m.build_seconds);
   }
@@ -155,9 +208,10 @@ int run_preview(const IstPreviewArgs& args) {
   options.width = args.width;
   options.height = args.height;
   options.section = args.section;
-  if (auto png = collette::write_packing_preview(leaves, args.out, options); !png) return fail(png.error().message);
-  std::printf("%s: %zu spheres%s -> %s\n", args.file.c_str(), leaves.size(), args.section ? " (half section)" : "",
-              args.out.c_str());
+  if (auto png = collette::write_packing_preview(leaves, args.out, options); !png)
+    return fail(png.error().message);
+  std::printf("%s: %zu spheres%s -> %s\n", args.file.c_str(), leaves.size(),
+              args.section ? " (half section)" : "", args.out.c_str());
   return 0;
 }
 
@@ -169,13 +223,25 @@ void add_ist_commands(CLI::App& app, CommandRunner& runner) {
 
   static IstBuildArgs build;
   auto* b = ist->add_subcommand("build", "fill a closed mesh with spheres and write the tree to a .ist file");
-  b->add_option("mesh", build.mesh, "mesh file (OBJ, STL, PLY, OFF, ... anything assimp reads)")->required()->check(CLI::ExistingFile);
+  b->add_option("mesh", build.mesh, "mesh file (OBJ, STL, PLY, OFF, ... anything assimp reads)")
+      ->required()
+      ->check(CLI::ExistingFile);
   b->add_option("-o,--output", build.out, "output .ist file (written atomically)")->required();
-  b->add_option("--spheres", build.spheres, "target number of spheres")->default_val(10000)->check(CLI::Range(1, 10000000));
-  b->add_option("--voxel", build.voxel, "distance-field voxel size in mesh units (0 = automatic)")->default_val(0.0)->check(CLI::NonNegativeNumber);
-  b->add_option("--meters-per-unit", build.meters_per_unit, "length of one mesh unit in metres")->default_val(1.0)->check(CLI::PositiveNumber);
+  b->add_option("--spheres", build.spheres, "target number of spheres")
+      ->default_val(10000)
+      ->check(CLI::Range(1, 10000000));
+  b->add_option("--voxel", build.voxel, "distance-field voxel size in mesh units (0 = automatic)")
+      ->default_val(0.0)
+      ->check(CLI::NonNegativeNumber);
+  b->add_option("--meters-per-unit", build.meters_per_unit, "length of one mesh unit in metres")
+      ->default_val(1.0)
+      ->check(CLI::PositiveNumber);
   b->add_option("--preview", build.preview, "also write a PNG picture of the packing");
-  b->add_flag("--allow-open", build.allow_open, "accept slightly open meshes (inside test by winding number)");
+  b->add_flag(
+      "--allow-open", build.allow_open,
+      fmt::format(
+          "accept a mesh that stays open after repair (at most {} boundary edges; holes capped by flat fans)",
+          collette::MeshLoadOptions{}.max_open_boundary_edges));
   b->add_flag("--json", build.json, "print one JSON object");
   b->callback([&runner] { runner = [] { return run_build(build); }; });
 

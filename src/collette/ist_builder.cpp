@@ -3,6 +3,7 @@
 #include <chrono>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
@@ -38,34 +39,48 @@ SphereTree scale_sphere_tree(const SphereTree& tree, double factor) {
   return SphereTree(std::move(nodes), std::move(leaves), tree.depth(), tree.arity());
 }
 
-Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path, const IstBuildOptions& options) {
-  if (options.sphere_count <= 0)
-    return Error{fmt::format("{}: the sphere count must be positive (got {})", mesh_path.string(), options.sphere_count)};
-  if (!(options.meters_per_unit > 0.0))
-    return Error{fmt::format("{}: meters per unit must be positive (got {})", mesh_path.string(), options.meters_per_unit)};
+Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path,
+                                       const IstBuildOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-
   auto mesh = load_mesh(mesh_path, options.mesh);
   if (!mesh) return mesh.error();
   auto hash = hash_file(mesh_path);
   if (!hash) return hash.error();
+  auto built = build_ist_asset(*mesh, *hash, options);
+  // the build time covers loading too
+  if (built)
+    built->asset.meta.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return built;
+}
+
+Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t source_mesh_hash,
+                                       const IstBuildOptions& options) {
+  const std::string& name = mesh.source_name;
+  if (options.sphere_count <= 0)
+    return Error{fmt::format("{}: the sphere count must be positive (got {})", name, options.sphere_count)};
+  if (!(options.meters_per_unit >= kIstMinMetersPerUnit && options.meters_per_unit <= kIstMaxMetersPerUnit))
+    return Error{fmt::format("{}: meters per unit must be between {} and {} (got {})", name,
+                             kIstMinMetersPerUnit, kIstMaxMetersPerUnit, options.meters_per_unit)};
+  const auto start = std::chrono::steady_clock::now();
 
   PackingOptions packing_options;
   packing_options.target_sphere_count = options.sphere_count;
   packing_options.voxel_size = options.voxel_size;
   packing_options.progress = options.progress;
-  auto packing = pack_spheres(*mesh, packing_options);
-  if (!packing) return Error{fmt::format("{}: {}", mesh_path.string(), packing.error().message)};
+  auto packing = pack_spheres(mesh, packing_options);
+  if (!packing) return Error{fmt::format("{}: {}", name, packing.error().message)};
 
   const auto tree_start = std::chrono::steady_clock::now();
   auto tree = build_sphere_tree(packing->spheres, options.tree);
-  if (!tree) return Error{fmt::format("{}: sphere tree: {}", mesh_path.string(), tree.error().message)};
+  if (!tree) return Error{fmt::format("{}: sphere tree: {}", name, tree.error().message)};
   const auto end = std::chrono::steady_clock::now();
 
-  IstBuildResult result{.asset = {std::move(tree).value(), {}}, .mesh = mesh->report, .packing = packing->report};
+  IstBuildResult result{
+      .asset = {std::move(tree).value(), {}}, .mesh = mesh.report, .packing = packing->report};
   result.tree_seconds = std::chrono::duration<double>(end - tree_start).count();
   result.asset.meta = IstMetadata{.meters_per_unit = options.meters_per_unit,
-                                  .source_mesh_hash = *hash,
+                                  .source_mesh_hash = source_mesh_hash,
                                   .coverage = packing->report.coverage,
                                   .mesh_volume = packing->report.mesh_volume,
                                   .max_gap = packing->report.max_gap,

@@ -1,12 +1,12 @@
 #include "uh/collette/mesh_import.hpp"
 
-#include <algorithm>
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <fmt/format.h>
+#include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstdint>
-#include <fmt/format.h>
 #include <numeric>
 #include <system_error>
 #include <unordered_map>
@@ -31,7 +31,8 @@ struct CellKey {
 };
 struct CellHash {
   std::size_t operator()(const CellKey& k) const {
-    const auto h = static_cast<std::uint64_t>(k.x) * 73856093ULL ^ static_cast<std::uint64_t>(k.y) * 19349663ULL ^
+    const auto h = static_cast<std::uint64_t>(k.x) * 73856093ULL ^
+                   static_cast<std::uint64_t>(k.y) * 19349663ULL ^
                    static_cast<std::uint64_t>(k.z) * 83492791ULL;
     return static_cast<std::size_t>(h);
   }
@@ -67,7 +68,8 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
   cells.reserve(v.size());
   const double tol2 = tol * tol;
   for (std::size_t i = 0; i < v.size(); ++i) {
-    const CellKey k{static_cast<std::int64_t>(std::floor(v[i].x / tol)), static_cast<std::int64_t>(std::floor(v[i].y / tol)),
+    const CellKey k{static_cast<std::int64_t>(std::floor(v[i].x / tol)),
+                    static_cast<std::int64_t>(std::floor(v[i].y / tol)),
                     static_cast<std::int64_t>(std::floor(v[i].z / tol))};
     std::int32_t found = -1;
     for (std::int64_t dx = -1; dx <= 1; ++dx) {
@@ -76,7 +78,8 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
           const auto it = cells.find({k.x + dx, k.y + dy, k.z + dz});
           if (it == cells.end()) continue;
           for (const std::int32_t j : it->second) {
-            if (squared_norm(v[static_cast<std::size_t>(j)] - v[i]) <= tol2 && (found < 0 || j < found)) found = j;
+            if (squared_norm(v[static_cast<std::size_t>(j)] - v[i]) <= tol2 && (found < 0 || j < found))
+              found = j;
           }
         }
       }
@@ -91,9 +94,40 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
   return map;
 }
 
+// Marks in `skip` every triangle on the same three vertices as an earlier one, whatever its
+// winding (faces already marked are ignored); the first in file order is kept, and the winding
+// check that follows judges it. A double-sided export (every face twice, once reversed) thus
+// keeps one side. With `drop` false nothing is marked. Returns the number of such faces.
+std::int64_t mark_duplicate_faces(const std::vector<std::array<std::int32_t, 3>>& triangles,
+                                  std::vector<char>& skip, bool drop) {
+  struct Key {
+    std::array<std::int32_t, 3> sorted;
+    std::int32_t face;
+  };
+  std::vector<Key> keys;
+  keys.reserve(triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    if (skip[f] != 0) continue;
+    auto sorted = triangles[f];
+    std::sort(sorted.begin(), sorted.end());
+    keys.push_back({sorted, static_cast<std::int32_t>(f)});
+  }
+  std::sort(keys.begin(), keys.end(), [](const Key& x, const Key& y) {
+    return x.sorted < y.sorted || (x.sorted == y.sorted && x.face < y.face);
+  });
+  std::int64_t duplicates = 0;
+  for (std::size_t k = 1; k < keys.size(); ++k) {
+    if (keys[k].sorted != keys[k - 1].sorted) continue;
+    ++duplicates;
+    if (drop) skip[static_cast<std::size_t>(keys[k].face)] = 1;
+  }
+  return duplicates;
+}
+
 std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t i) {
   while (parent[static_cast<std::size_t>(i)] != i) {
-    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    parent[static_cast<std::size_t>(i)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
     i = parent[static_cast<std::size_t>(i)];
   }
   return i;
@@ -106,8 +140,9 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
   MeshReport report{};
   report.input_vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
   if (mesh.triangles.empty() || mesh.vertices.empty()) {
-    return Error{fmt::format("{}: mesh is empty: {} vertices, {} triangles (a closed triangle mesh is required)", name,
-                             mesh.vertices.size(), mesh.triangles.size())};
+    return Error{
+        fmt::format("{}: mesh is empty: {} vertices, {} triangles (a closed triangle mesh is required)", name,
+                    mesh.vertices.size(), mesh.triangles.size())};
   }
   for (const auto& t : mesh.triangles) {
     for (const std::int32_t i : t) {
@@ -128,13 +163,13 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     for (std::int32_t& i : t) i = map[static_cast<std::size_t>(i)];
   }
   std::int64_t distinct_inputs = 0;
-  for (std::size_t i = 0; i < map.size(); ++i) distinct_inputs += (map[i] == static_cast<std::int32_t>(i)) ? 1 : 0;
+  for (std::size_t i = 0; i < map.size(); ++i)
+    distinct_inputs += (map[i] == static_cast<std::int32_t>(i)) ? 1 : 0;
   report.welded_vertices = report.input_vertex_count - distinct_inputs;
 
-  // degenerate faces: repeated vertices after welding, or (near) zero area
-  std::vector<std::array<std::int32_t, 3>> kept;
-  kept.reserve(mesh.triangles.size());
-  std::vector<char> degenerate(mesh.triangles.size(), 0);
+  // degenerate faces: repeated vertices after welding, or (near) zero area. Unrepaired, they are
+  // kept out of the edge counts so that one bad face is reported once.
+  std::vector<char> skip(mesh.triangles.size(), 0);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const auto& t = mesh.triangles[f];
     const Vec3& a = mesh.vertices[static_cast<std::size_t>(t[0])];
@@ -144,12 +179,18 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     const bool tiny = norm(cross(b - a, c - a)) <= options.degenerate_area_tolerance * diag * diag;
     if (rep || tiny) {
       ++report.degenerate_faces;
-      degenerate[f] = 1;  // kept out of the edge counts, so one bad face is reported once
-      if (options.drop_degenerate) continue;
+      skip[f] = 1;
     }
-    kept.push_back(t);
   }
-  if (options.drop_degenerate) mesh.triangles = std::move(kept);
+  report.duplicate_faces = mark_duplicate_faces(mesh.triangles, skip, options.repair);
+  if (options.repair) {
+    std::size_t kept = 0;
+    for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+      if (skip[f] == 0) mesh.triangles[kept++] = mesh.triangles[f];
+    mesh.triangles.resize(kept);
+    skip.assign(kept, 0);
+    report.repaired = report.degenerate_faces + report.duplicate_faces > 0;
+  }
 
   // drop vertices no triangle uses and number the rest in order of first use
   std::vector<std::int32_t> compact(mesh.vertices.size(), -1);
@@ -168,7 +209,8 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
   report.triangle_count = static_cast<std::int64_t>(mesh.triangles.size());
   report.vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
   if (mesh.triangles.empty()) {
-    return Error{fmt::format("{}: mesh is empty after dropping {} degenerate faces", name, report.degenerate_faces)};
+    return Error{fmt::format("{}: mesh is empty after dropping {} degenerate and {} duplicate faces", name,
+                             report.degenerate_faces, report.duplicate_faces)};
   }
 
   // edge use counts and directions, by sorting (deterministic, no hashing)
@@ -181,7 +223,7 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
   uses.reserve(mesh.triangles.size() * 3);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const auto& t = mesh.triangles[f];
-    if (!options.drop_degenerate && degenerate[f] != 0) continue;
+    if (skip[f] != 0) continue;
     for (int e = 0; e < 3; ++e) {
       const std::int32_t a = t[static_cast<std::size_t>(e)];
       const std::int32_t b = t[static_cast<std::size_t>((e + 1) % 3)];
@@ -203,7 +245,8 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     if (n >= 3) ++report.non_manifold_edges;
     if (n == 2 && uses[i].forward == uses[i + 1].forward) ++report.inconsistent_edges;
     const std::int32_t first_face = uses[i].face;
-    for (auto it = uses.begin() + static_cast<std::ptrdiff_t>(i) + 1; it != uses.begin() + static_cast<std::ptrdiff_t>(j); ++it) {
+    for (auto it = uses.begin() + static_cast<std::ptrdiff_t>(i) + 1;
+         it != uses.begin() + static_cast<std::ptrdiff_t>(j); ++it) {
       const std::int32_t ra = find_root(parent, first_face);
       const std::int32_t rb = find_root(parent, it->face);
       if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
@@ -211,30 +254,36 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     i = j;
   }
   for (std::size_t f = 0; f < parent.size(); ++f) {
-    report.components += (find_root(parent, static_cast<std::int32_t>(f)) == static_cast<std::int32_t>(f)) ? 1 : 0;
+    report.components +=
+        (find_root(parent, static_cast<std::int32_t>(f)) == static_cast<std::int32_t>(f)) ? 1 : 0;
   }
 
   const bool open_ok = options.allow_open && report.boundary_edges <= options.max_open_boundary_edges;
-  const bool degenerate_bad = report.degenerate_faces > 0 && !options.drop_degenerate;
-  if ((report.boundary_edges > 0 && !open_ok) || report.non_manifold_edges > 0 || degenerate_bad) {
+  const bool unrepaired = !options.repair && report.degenerate_faces + report.duplicate_faces > 0;
+  if ((report.boundary_edges > 0 && !open_ok) || report.non_manifold_edges > 0 || unrepaired) {
     const char* what = report.non_manifold_edges > 0 ? "mesh is not 2-manifold"
                        : report.boundary_edges > 0   ? "mesh is not closed"
-                                                     : "mesh has degenerate faces";
+                                                     : "mesh has degenerate or duplicate faces";
+    const std::string repaired = report.repaired
+                                     ? fmt::format(" after dropping {} degenerate and {} duplicate faces",
+                                                   report.degenerate_faces, report.duplicate_faces)
+                                     : std::string();
+    const std::string counts = options.repair ? std::string()
+                                              : fmt::format(", {} degenerate faces, {} duplicate faces",
+                                                            report.degenerate_faces, report.duplicate_faces);
     std::string hint;
-    if (report.boundary_edges > 0 && report.non_manifold_edges == 0) {
-      hint += options.allow_open
-                  ? fmt::format("; allow_open accepts at most {} boundary edges", options.max_open_boundary_edges)
-                  : std::string("; MeshLoadOptions{.allow_open = true} accepts slightly open meshes");
-    }
-    if (degenerate_bad) hint += "; MeshLoadOptions{.drop_degenerate = true} drops degenerate faces";
-    return Error{fmt::format("{}: {}: {} boundary edges, {} non-manifold edges, {} degenerate faces "
-                             "(a closed 2-manifold mesh is required{})",
-                             name, what, report.boundary_edges, report.non_manifold_edges, report.degenerate_faces, hint)};
+    if (options.allow_open && report.boundary_edges > options.max_open_boundary_edges &&
+        report.non_manifold_edges == 0)
+      hint = fmt::format("; at most {} boundary edges are accepted as open", options.max_open_boundary_edges);
+    return Error{fmt::format(
+        "{}: {}{}: {} boundary edges, {} non-manifold edges{} (a closed 2-manifold mesh is required{})", name,
+        what, repaired, report.boundary_edges, report.non_manifold_edges, counts, hint)};
   }
   if (report.inconsistent_edges > 0) {
-    return Error{fmt::format("{}: mesh orientation is inconsistent: {} edges where neighbouring triangles run the "
-                             "same way (their normals disagree); fix the winding in a modelling tool",
-                             name, report.inconsistent_edges)};
+    return Error{
+        fmt::format("{}: mesh orientation is inconsistent: {} edges where neighbouring triangles run the "
+                    "same way (their normals disagree); fix the winding in a modelling tool",
+                    name, report.inconsistent_edges)};
   }
   report.assumed_open = report.boundary_edges > 0;
 
@@ -266,7 +315,8 @@ Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoad
   }
   Assimp::Importer importer;
   // no JoinIdenticalVertices: it also compares normals, so STL stays unwelded; we weld ourselves
-  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices);
+  const aiScene* scene =
+      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices);
   if (scene == nullptr) {
     return Error{fmt::format("{}: cannot read mesh: {}", name, importer.GetErrorString())};
   }

@@ -185,7 +185,7 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   const std::string& name = mesh.source_name;
   if (mesh.triangles.empty()) return Error{fmt::format("{}: cannot pack spheres into an empty mesh", name)};
   if (!mesh.report.closed_manifold() && !mesh.report.assumed_open) {
-    return Error{fmt::format("{}: cannot pack spheres: the mesh is not closed and 2-manifold (load it with load_mesh)", name)};
+    return Error{fmt::format("{}: cannot pack spheres: the mesh is not closed and 2-manifold (validate it first)", name)};
   }
   // open meshes are packed as if their holes were closed by flat fans
   const TriangleMesh capped = mesh.report.assumed_open ? cap_holes(mesh) : TriangleMesh{};
@@ -208,7 +208,7 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   const std::int64_t ny = static_cast<std::int64_t>(std::ceil(ext.y / h)) + 2;
   const std::int64_t nz = static_cast<std::int64_t>(std::ceil(ext.z / h)) + 2;
   if (static_cast<double>(nx) * static_cast<double>(ny) * static_cast<double>(nz) > static_cast<double>(kMaxGridVoxels)) {
-    return Error{fmt::format("{}: voxel size {} needs a {}x{}x{} grid, more than {} voxels; use a larger voxel_size",
+    return Error{fmt::format("{}: voxel size {} needs a {}x{}x{} grid, more than {} voxels; use a larger voxel size",
                              name, h, nx, ny, nz, kMaxGridVoxels)};
   }
   const std::int64_t grid_size = nx * ny * nz;
@@ -263,7 +263,7 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   }
   const auto n_interior = static_cast<std::int64_t>(interior_cell.size());
   if (n_interior == 0) {
-    return Error{fmt::format("{}: no voxel centre lies inside the mesh at voxel size {}; use a smaller voxel_size", name, h)};
+    return Error{fmt::format("{}: no voxel centre lies inside the mesh at voxel size {}; use a smaller voxel size", name, h)};
   }
 
   // 2. distance to the surface for interior voxels: exact near the surface (every triangle

@@ -187,15 +187,15 @@ std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k
 }  // namespace
 
 Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options) {
-  if (leaves.empty()) return Error{"build_sphere_tree: no leaf spheres (a tree needs at least one)"};
+  if (leaves.empty()) return Error{"no leaf spheres (a tree needs at least one)"};
   if (options.arity < 2 || options.arity > kMaxSphereTreeArity)
-    return Error{"build_sphere_tree: arity " + std::to_string(options.arity) + " outside 2.." + std::to_string(kMaxSphereTreeArity)};
+    return Error{"arity " + std::to_string(options.arity) + " outside 2.." + std::to_string(kMaxSphereTreeArity)};
   if (leaves.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() / 2))
-    return Error{"build_sphere_tree: too many leaves (" + std::to_string(leaves.size()) + ")"};
+    return Error{"too many leaf spheres (" + std::to_string(leaves.size()) + ")"};
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     const Sphere& s = leaves[i];
     if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !std::isfinite(s.radius) || !(s.radius > 0.f))
-      return Error{"build_sphere_tree: leaf " + std::to_string(i) + " has a non-finite centre or a radius that is not positive"};
+      return Error{"leaf sphere " + std::to_string(i) + " has a non-finite centre or a radius that is not positive"};
   }
 
   std::vector<int> idx(leaves.size());

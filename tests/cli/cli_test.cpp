@@ -237,6 +237,80 @@ TEST_F(CliTest, QuaternionsAreNormalisedWhateverTheirScale) {
   for (const auto& row : j["results"]) EXPECT_NEAR(row["volume"].get<double>(), v0, 1e-9 * v0) << row.dump();
 }
 
+// A unit cube as OBJ with extra faces appended (1-based indices as OBJ has them).
+fs::path write_cube(const fs::path& path, bool drop_top, const std::string& extra_faces) {
+  std::ofstream out(path);
+  out << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv 0.5 0 0\n"
+         "f 1 3 2\nf 1 4 3\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 1 5 8\nf 1 8 4\n";
+  if (!drop_top) out << "f 5 6 7\nf 5 7 8\n";
+  out << extra_faces;
+  return path;
+}
+
+TEST_F(CliTest, IstBuildRepairsDegenerateAndDuplicateFacesAndSaysWhat) {
+  // two degenerate faces (a repeated vertex; a needle through vertex 9 on edge 1-2) and four
+  // duplicates (a copy and a reversed copy of one face, two copies of another)
+  const std::string extra = "f 1 1 2\nf 1 2 9\nf 1 3 2\nf 1 2 3\nf 3 8 7\nf 3 8 7\n";
+  const fs::path mesh = write_cube(dir_ / "repairable.obj", false, extra);
+  const fs::path out = dir_ / "repairable.ist";
+  const CommandRun r =
+      uh(fmt::format("ist build '{}' -o '{}' --spheres 30 --json", mesh.string(), out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = json_of(r);
+  EXPECT_EQ(j["repaired"]["degenerate_faces"], 2);
+  EXPECT_EQ(j["repaired"]["duplicate_faces"], 4);
+  EXPECT_EQ(j["triangles"], 12);
+  EXPECT_EQ(j["open_boundary_edges"], 0);
+  EXPECT_NEAR(j["mesh_volume"].get<double>(), 1.0, 1e-12);
+  EXPECT_TRUE(collette::load_ist(out));
+  const CommandRun human =
+      uh(fmt::format("ist build '{}' -o '{}' --spheres 30", mesh.string(), out.string()));
+  ASSERT_EQ(human.exit_code, 0) << human.err;
+  EXPECT_NE(human.out.find("repaired: dropped 2 degenerate faces; dropped 4 duplicate faces\n"),
+            std::string::npos)
+      << human.out;
+}
+
+TEST_F(CliTest, IstBuildRefusesAMeshStillOpenAfterRepairNamingAllowOpen) {
+  const fs::path mesh = write_cube(dir_ / "holey.obj", true, "f 1 1 2\nf 1 3 2\n");
+  const fs::path out = dir_ / "holey.ist";
+  std::ofstream(out) << "an earlier file that must survive";
+  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 30", mesh.string(), out.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("holey.obj: mesh is not closed after dropping 1 degenerate and 1 duplicate faces: 4 "
+                       "boundary edges"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("--allow-open"), std::string::npos) << r.err;
+  for (const char* cpp : {"MeshLoadOptions", "allow_open", "{.", "::"})
+    EXPECT_EQ(r.err.find(cpp), std::string::npos) << cpp << " in " << r.err;
+  EXPECT_EQ(read_text(out), "an earlier file that must survive");
+  // with the option it builds, capping the hole, and says so
+  const CommandRun open =
+      uh(fmt::format("ist build '{}' -o '{}' --spheres 30 --allow-open --json", mesh.string(), out.string()));
+  ASSERT_EQ(open.exit_code, 0) << open.err;
+  const auto j = json_of(open);
+  EXPECT_EQ(j["open_boundary_edges"], 4);
+  EXPECT_EQ(j["repaired"]["degenerate_faces"], 1);
+  EXPECT_NE(j["assumed"].get<std::string>().find("open mesh"), std::string::npos) << open.out;
+  EXPECT_TRUE(collette::load_ist(out));
+}
+
+TEST_F(CliTest, NonManifoldMeshIsRefusedWithoutHintingAtAllowOpen) {
+  // the repository's shared asset folder sits beside it (as the benchmarks read it)
+  const fs::path shared = fs::path(UH_TEST_DATA_DIR).parent_path().parent_path() / "shared" / "assets";
+  fs::path mesh = shared / "dragon_stanford_res4_11k_nonmanifold.ply";
+  // the shared bad mesh when present; else a cube with a fin (a third face on one edge)
+  if (!fs::exists(mesh)) mesh = write_cube(dir_ / "fin.obj", false, "v 0.5 -0.5 1.5\nf 5 6 10\n");
+  const fs::path out = dir_ / "never_written.ist";
+  const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 30", mesh.string(), out.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(mesh.filename().string() + ": mesh is not 2-manifold"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("non-manifold edges"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("allow"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
   // an open box: one face missing
   const fs::path open_mesh = dir_ / "open_box.obj";
@@ -255,6 +329,7 @@ TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("open_box.obj"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("boundary"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--allow-open"), std::string::npos) << r.err;
   EXPECT_EQ(read_text(out), "an earlier file that must survive");
 
   // a corrupted .ist

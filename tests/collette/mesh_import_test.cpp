@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <fstream>
+#include <set>
 
 #include "mesh_test_support.hpp"
 #include "uh/collette/mesh_import.hpp"
@@ -88,10 +91,14 @@ TEST(MeshImport, CubeMissingAFaceIsNotClosed) {
   test::write_obj(dir / "open_cube.obj", cube.vertices, cube.triangles);
   const auto r = load_mesh(dir / "open_cube.obj");
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("open_cube.obj: mesh is not closed: 4 boundary edges, 0 non-manifold edges, 0 degenerate faces"),
+  EXPECT_NE(r.error().message.find(
+                "open_cube.obj: mesh is not closed: 4 boundary edges, 0 non-manifold edges (a closed "
+                "2-manifold mesh is required)"),
             std::string::npos)
       << r.error().message;
-  EXPECT_NE(r.error().message.find("allow_open"), std::string::npos);
+  // programs show the message as it is: it names no C++ type or option
+  for (const char* cpp : {"MeshLoadOptions", "allow_open", "{.", "::", "repair ="})
+    EXPECT_EQ(r.error().message.find(cpp), std::string::npos) << cpp << " in " << r.error().message;
 }
 
 TEST(MeshImport, AllowOpenAcceptsSmallHolesAndSaysSo) {
@@ -116,26 +123,108 @@ TEST(MeshImport, FinIsNonManifold) {
   test::write_off(dir / "fin.off", cube.vertices, cube.triangles);
   const auto r = load_mesh(dir / "fin.off");
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("fin.off: mesh is not 2-manifold: 2 boundary edges, 1 non-manifold edges"), std::string::npos)
+  EXPECT_NE(r.error().message.find("fin.off: mesh is not 2-manifold: 2 boundary edges, 1 non-manifold edges"),
+            std::string::npos)
       << r.error().message;
 }
 
-TEST(MeshImport, DegenerateFaceIsReportedOrDropped) {
+TEST(MeshImport, DegenerateFaceIsDroppedOrWithoutRepairRefused) {
   TempDir dir("degenerate");
   TriangleMesh cube = unit_cube();
-  cube.vertices.push_back({0.5, 0.0, 0.0});      // on edge 0-1
-  cube.triangles.push_back({0, 1, 8});           // zero area, distinct vertices
+  cube.vertices.push_back({0.5, 0.0, 0.0});  // on edge 0-1
+  cube.triangles.push_back({0, 1, 8});       // zero area, distinct vertices
   test::write_obj(dir / "degenerate.obj", cube.vertices, cube.triangles);
-  const auto r = load_mesh(dir / "degenerate.obj");
+  const auto r = load_mesh(dir / "degenerate.obj", {.repair = false});
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("degenerate.obj: mesh has degenerate faces: 0 boundary edges, 0 non-manifold edges, 1 degenerate faces"),
+  EXPECT_NE(r.error().message.find(
+                "degenerate.obj: mesh has degenerate or duplicate faces: 0 boundary edges, 0 non-manifold "
+                "edges, 1 degenerate faces, 0 duplicate faces"),
             std::string::npos)
       << r.error().message;
-  const auto dropped = load_mesh(dir / "degenerate.obj", {.drop_degenerate = true});
+  const auto dropped = load_mesh(dir / "degenerate.obj");
   ASSERT_TRUE(dropped) << dropped.error().message;
   EXPECT_EQ(dropped->report.degenerate_faces, 1);
+  EXPECT_TRUE(dropped->report.repaired);
   EXPECT_EQ(dropped->report.triangle_count, 12);
   EXPECT_EQ(dropped->vertices.size(), 8u);
+}
+
+// Sorted corner positions of each triangle: what a mesh is, independent of numbering.
+std::multiset<std::array<double, 9>> triangle_set(const TriangleMesh& m) {
+  std::multiset<std::array<double, 9>> out;
+  for (const auto& t : m.triangles) {
+    std::array<std::array<double, 3>, 3> corners{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec3& v = m.vertices[static_cast<std::size_t>(t[k])];
+      corners[k] = {v.x, v.y, v.z};
+    }
+    std::sort(corners.begin(), corners.end());
+    std::array<double, 9> flat{};
+    for (std::size_t k = 0; k < 9; ++k) flat[k] = corners[k / 3][k % 3];
+    out.insert(flat);
+  }
+  return out;
+}
+
+TEST(MeshImport, RepairDropsDegenerateAndDuplicateFacesOfAClosedMesh) {
+  const TriangleMesh sphere = test::icosphere(1.0, 2);
+  ASSERT_TRUE(validate_mesh(sphere));
+  TriangleMesh broken = sphere;
+  const auto n = static_cast<std::int32_t>(broken.vertices.size());
+  // degenerate: repeated indices (3), a needle through an edge's midpoint (1), a face whose two
+  // corners are distinct vertices at the same position, merged by welding (1)
+  broken.triangles.push_back({0, 0, 1});
+  broken.triangles.push_back({2, 3, 3});
+  broken.triangles.push_back({4, 5, 4});
+  const auto& e = sphere.triangles[10];
+  broken.vertices.push_back(0.5 * (sphere.vertices[static_cast<std::size_t>(e[0])] +
+                                   sphere.vertices[static_cast<std::size_t>(e[1])]));
+  broken.triangles.push_back({e[0], e[1], n});
+  broken.vertices.push_back(sphere.vertices[7]);
+  broken.triangles.push_back({7, n + 1, 8});
+  // duplicates: a copy, a reversed copy, and two more copies of one face (4)
+  broken.triangles.push_back(sphere.triangles[5]);
+  broken.triangles.push_back({sphere.triangles[9][0], sphere.triangles[9][2], sphere.triangles[9][1]});
+  broken.triangles.push_back(sphere.triangles[20]);
+  broken.triangles.push_back(sphere.triangles[20]);
+  std::swap(broken.triangles[3], broken.triangles[broken.triangles.size() - 1]);  // the order does not matter
+  const auto strict = validate_mesh(broken, {.repair = false});
+  ASSERT_FALSE(strict);
+  EXPECT_NE(strict.error().message.find("5 degenerate faces, 4 duplicate faces"), std::string::npos)
+      << strict.error().message;
+  const auto repaired = validate_mesh(broken);
+  ASSERT_TRUE(repaired) << repaired.error().message;
+  const MeshReport& r = repaired->report;
+  EXPECT_EQ(r.degenerate_faces, 5);
+  EXPECT_EQ(r.duplicate_faces, 4);
+  EXPECT_TRUE(r.repaired);
+  EXPECT_TRUE(r.closed_manifold());
+  EXPECT_EQ(r.inconsistent_edges, 0);
+  EXPECT_FALSE(r.winding_flipped);
+  // exactly the original surface survives (compared as sets of corner positions)
+  EXPECT_EQ(triangle_set(*repaired), triangle_set(sphere));
+  EXPECT_EQ(repaired->vertices.size(), sphere.vertices.size());
+  EXPECT_NEAR(r.volume, mesh_volume(sphere), 1e-12);
+}
+
+TEST(MeshImport, MeshStillOpenAfterRepairIsRefusedSayingWhatWasDropped) {
+  TriangleMesh cube = unit_cube();
+  cube.triangles.resize(10);                    // the +x face is missing
+  cube.triangles.push_back({0, 0, 1});          // and a degenerate face
+  cube.triangles.push_back(cube.triangles[2]);  // and a duplicate
+  cube.source_name = "holey.obj";
+  const auto r = validate_mesh(cube);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find(
+                "holey.obj: mesh is not closed after dropping 1 degenerate and 1 duplicate faces: 4 "
+                "boundary edges, 0 non-manifold edges"),
+            std::string::npos)
+      << r.error().message;
+  const auto open = validate_mesh(cube, {.allow_open = true});
+  ASSERT_TRUE(open) << open.error().message;
+  EXPECT_TRUE(open->report.assumed_open);
+  EXPECT_EQ(open->report.degenerate_faces, 1);
+  EXPECT_EQ(open->report.duplicate_faces, 1);
 }
 
 TEST(MeshImport, InvertedCubeIsFlipped) {
@@ -163,7 +252,8 @@ TEST(MeshImport, InconsistentOrientationIsReported) {
   cube.source_name = "patchy.obj";
   const auto r = validate_mesh(cube);
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("patchy.obj: mesh orientation is inconsistent: 3 edges"), std::string::npos)
+  EXPECT_NE(r.error().message.find("patchy.obj: mesh orientation is inconsistent: 3 edges"),
+            std::string::npos)
       << r.error().message;
 }
 

@@ -114,7 +114,7 @@ TEST(SphereTree, BuildRejectsBadInput) {
   const std::vector<Sphere> bad_radius{{0.f, 0.f, 0.f, 1.f}, {2.f, 0.f, 0.f, 0.f}};
   const auto r = build_sphere_tree(bad_radius);
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("leaf 1"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("leaf sphere 1"), std::string::npos) << r.error().message;
   const std::vector<Sphere> nan_centre{{std::nanf(""), 0.f, 0.f, 1.f}};
   EXPECT_FALSE(build_sphere_tree(nan_centre));
   const std::vector<Sphere> one{{0.f, 0.f, 0.f, 1.f}};

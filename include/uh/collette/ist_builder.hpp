@@ -19,11 +19,11 @@ namespace uh::collette {
 
 /// Settings of build_ist_asset() (aggregate; designated initialisers).
 struct IstBuildOptions {
-  std::int64_t sphere_count = 10000;  ///< target number of leaf spheres
-  double voxel_size = 0.0;            ///< distance-field voxel [mesh units]; 0 = automatic
-  double meters_per_unit = 1.0;       ///< stored in the asset: length of one mesh unit [m]
-  MeshLoadOptions mesh{};             ///< import and validation settings
-  SphereTreeBuildOptions tree{};      ///< hierarchy settings
+  std::int64_t sphere_count = 10000;                ///< target number of leaf spheres
+  double voxel_size = 0.0;                          ///< distance-field voxel [mesh units]; 0 = automatic
+  double meters_per_unit = 1.0;                     ///< stored in the asset: length of one mesh unit [m]
+  MeshLoadOptions mesh{};                           ///< import and validation settings
+  SphereTreeBuildOptions tree{};                    ///< hierarchy settings
   std::function<void(double fraction)> progress{};  ///< packing progress in [0, 1], calling thread
 };
 
@@ -35,9 +35,17 @@ struct IstBuildResult {
   double tree_seconds = 0.0;  ///< time to build the hierarchy [s]
 };
 
-/// Loads `mesh_path`, packs it and builds the tree. Errors name the file and say what is wrong.
-/// Nothing is written to disk. Not real-time safe; any thread.
-Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path, const IstBuildOptions& options = {});
+/// Loads `mesh_path` (with options.mesh), packs it and builds the tree. Errors name the file and
+/// say what is wrong. Nothing is written to disk. Not real-time safe; any thread.
+Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path,
+                                       const IstBuildOptions& options = {});
+
+/// Packs an already loaded and validated mesh (load_mesh() / validate_mesh(); options.mesh is
+/// not used) and builds the tree, for callers that look at the MeshReport before packing.
+/// `source_mesh_hash` goes into the metadata (hash_file() of the mesh file, 0 if unknown);
+/// messages name mesh.source_name. Not real-time safe; any thread.
+Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t source_mesh_hash,
+                                       const IstBuildOptions& options = {});
 
 /// A copy of `tree` with every length multiplied by `factor` (> 0) and every volume by factor^3,
 /// e.g. to bring a tree in mesh units into metres. Not real-time safe.

@@ -19,21 +19,27 @@ struct MeshLoadOptions {
   /// (MeshInside does). Non-manifold edges and inconsistent orientation are still errors.
   bool allow_open = false;
   std::int64_t max_open_boundary_edges = 1000;
-  /// Drop degenerate (zero-area or repeated-vertex) triangles instead of rejecting the mesh.
-  bool drop_degenerate = false;
+  /// Repair what can be repaired without guessing at the shape: drop degenerate triangles
+  /// (repeated vertices after welding, or (near) zero area) and duplicate triangles (the same
+  /// three vertices as an earlier one, in either winding: the first is kept), then number the
+  /// remaining vertices and count the edges again. MeshReport says how many were dropped.
+  /// false: such a mesh is refused.
+  bool repair = true;
   /// A triangle is degenerate when twice its area is below this times the squared bbox diagonal.
   double degenerate_area_tolerance = 1e-14;
 };
 
-/// Reads a mesh file, welds vertices, validates it and fixes an inverted winding.
+/// Reads a mesh file, welds vertices, repairs it (MeshLoadOptions::repair), validates it and fixes
+/// an inverted winding.
 ///
 /// Errors name the file and say what is wrong, e.g. "teapot.obj: mesh is not closed: 64 boundary
-/// edges, 0 non-manifold edges, 0 degenerate faces (a closed 2-manifold mesh is required; ...)".
+/// edges, 0 non-manifold edges (a closed 2-manifold mesh is required)"; they name no C++ option,
+/// so that programs can show them as they are.
 /// Missing, unreadable and empty files are errors too. All meshes in the file are merged. Setup
 /// code only (allocates, reads files); any thread; not real-time safe.
 Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options = {});
 
-/// Welds, validates and orients an in-memory mesh the same way load_mesh() does (used by
+/// Welds, repairs, validates and orients an in-memory mesh the same way load_mesh() does (used by
 /// load_mesh() and by code that builds meshes itself). `mesh.source_name` names it in messages.
 /// On success mesh.report holds the counts. Not real-time safe.
 Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& options = {});
