@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, three builds in separate directories:
-#   1. Release: every test (unit, integration, the installed-package consumer);
+#   1. Release: every test (unit, integration, the C API, the installed-package consumer), then
+#      the Python module's pytest suite with Debian's /usr/bin/python3;
 #   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test;
 #   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions);
 #   4. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds), the scene
@@ -33,9 +34,28 @@ run_ctest() {
   [ "$fail" -eq 0 ] || status=1
 }
 
+# pytest's summary line, e.g. "2 failed, 11 passed, 1 error in 9.38s"
+run_pytest() {
+  echo "== pytest (Python module, /usr/bin/python3) =="
+  local log="$uh_root/build/release/pytest.log"
+  (cd "$uh_root" && PYTHONPATH="$uh_root/build/release/python" /usr/bin/python3 -m pytest -q -p no:cacheprovider \
+     python/tests) 2>&1 | tee "$log"
+  local line
+  line=$(grep -E "^(=+ )?[0-9]+ (passed|failed|errors?)" "$log" | tail -n 1)
+  if [ -z "$line" ]; then echo "test: no pytest summary"; status=1; failed=$((failed + 1)); return; fi
+  local p f e
+  p=$(grep -oE "[0-9]+ passed" <<<"$line" | grep -oE "[0-9]+" || true)
+  f=$(grep -oE "[0-9]+ failed" <<<"$line" | grep -oE "[0-9]+" || true)
+  e=$(grep -oE "[0-9]+ errors?" <<<"$line" | grep -oE "[0-9]+" || true)
+  passed=$((passed + ${p:-0}))
+  failed=$((failed + ${f:-0} + ${e:-0}))
+  [ $((${f:-0} + ${e:-0})) -eq 0 ] || status=1
+}
+
 echo "== build (Release) =="
 if uh_build build/release -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=ON -DUH_BUILD_BENCHMARKS=ON; then
   run_ctest release build/release
+  run_pytest
 else
   echo "test: Release build failed"; status=1; failed=$((failed + 1))
 fi

@@ -170,6 +170,30 @@ Status read_shape(const FieldReader& r, const json& j, const std::string& path, 
 }
 
 // Device settings are text in haptico::DeviceConfig; JSON numbers and [x, y, z] arrays are converted.
+Status read_device_config(const FieldReader& r, const json& config, const std::string& path,
+                          const std::filesystem::path& base_dir, haptico::DeviceConfig& out) {
+  UH_CHECK(r.require_object(config, path));
+  for (const auto& [key, value] : config.items()) {
+    if (value.is_number()) {
+      out.set(key, value.get<double>());
+    } else if (value.is_boolean()) {
+      out.set(key, value.get<bool>() ? 1.0 : 0.0);
+    } else if (value.is_string()) {
+      std::string text = value.get<std::string>();
+      // a trajectory file is relative to the scene, like meshes
+      if (key == "file" && !std::filesystem::path(text).is_absolute()) text = (base_dir / text).lexically_normal().string();
+      out.set(key, text);
+    } else if (value.is_array() && value.size() == 3 && value[0].is_number() && value[1].is_number() &&
+               value[2].is_number()) {
+      out.set(key, Vec3{value[0].get<double>(), value[1].get<double>(), value[2].get<double>()});
+    } else {
+      return r.error(FieldReader::join(path, key),
+                     fmt::format("expected a number, a string, a boolean or [x, y, z], got {}", value.dump()));
+    }
+  }
+  return Ok{};
+}
+
 Status read_device(const FieldReader& r, const json& j, const std::string& path, const std::filesystem::path& base_dir,
                    SceneDevice& device) {
   UH_CHECK(r.require_object(j, path));
@@ -177,27 +201,7 @@ Status read_device(const FieldReader& r, const json& j, const std::string& path,
   UH_CHECK(r.string(j, path, "driver", device.driver, true));
   const auto it = j.find("config");
   if (it == j.end()) return Ok{};
-  const std::string cpath = FieldReader::join(path, "config");
-  UH_CHECK(r.require_object(*it, cpath));
-  for (const auto& [key, value] : it->items()) {
-    if (value.is_number()) {
-      device.config.set(key, value.get<double>());
-    } else if (value.is_boolean()) {
-      device.config.set(key, value.get<bool>() ? 1.0 : 0.0);
-    } else if (value.is_string()) {
-      std::string text = value.get<std::string>();
-      // a trajectory file is relative to the scene, like meshes
-      if (key == "file" && !std::filesystem::path(text).is_absolute()) text = (base_dir / text).lexically_normal().string();
-      device.config.set(key, text);
-    } else if (value.is_array() && value.size() == 3 && value[0].is_number() && value[1].is_number() &&
-               value[2].is_number()) {
-      device.config.set(key, Vec3{value[0].get<double>(), value[1].get<double>(), value[2].get<double>()});
-    } else {
-      return r.error(FieldReader::join(cpath, key),
-                     fmt::format("expected a number, a string, a boolean or [x, y, z], got {}", value.dump()));
-    }
-  }
-  return Ok{};
+  return read_device_config(r, *it, FieldReader::join(path, "config"), base_dir, device.config);
 }
 
 Status read_force_params(const FieldReader& r, const json& j, const std::string& path, SceneTool& tool) {
@@ -273,17 +277,22 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
   return Ok{};
 }
 
+Result<json> parse_json(std::string_view json_text, const std::string& source) {
+  try {
+    return json::parse(json_text);
+  } catch (const json::exception& e) {
+    // parse_error for bad syntax, out_of_range for a number too large for a double (found by the
+    // scene fuzzer): both are the text's fault
+    return Error{fmt::format("{}: not valid JSON: {}", source, e.what())};
+  }
+}
+
 }  // namespace
 
 Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir) {
-  json root;
-  try {
-    root = json::parse(json_text);
-  } catch (const json::exception& e) {
-    // parse_error for bad syntax, out_of_range for a number too large for a double (found by the
-    // scene fuzzer): both are the file's fault
-    return Error{fmt::format("{}: not valid JSON: {}", source, e.what())};
-  }
+  auto parsed = parse_json(json_text, source);
+  if (!parsed) return parsed.error();
+  const json& root = *parsed;
   const FieldReader r(source);
   if (!root.is_object()) return Error{fmt::format("{}: expected a JSON object at the top level", source)};
   UH_CHECK(r.check_keys(root, "", {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force",
@@ -358,6 +367,16 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
   return scene;
 }
 
+Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, const std::string& source,
+                                                  const std::filesystem::path& base_dir) {
+  auto root = parse_json(json_text, source);
+  if (!root) return root.error();
+  const FieldReader r(source);
+  haptico::DeviceConfig config;
+  UH_CHECK(read_device_config(r, *root, "", base_dir, config));
+  return config;
+}
+
 Result<Scene> load_scene(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) return Error{fmt::format("{}: cannot open the scene file", path.string())};
@@ -415,6 +434,7 @@ Result<Scene> default_scene(const std::filesystem::path& cache_dir) {
 Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(
     const SceneShape& shape, const std::filesystem::path& cache_dir,
     const std::function<void(const std::string& what, double fraction)>& progress) {
+  if (shape.tree) return shape.tree;
   collette::IstAsset asset;
   if (!shape.ist.empty()) {
     auto loaded = collette::load_ist(shape.ist);

@@ -22,10 +22,12 @@
 
 namespace uh::controllers {
 
-/// Where an object's Inner Sphere Tree comes from: a mesh (packed on first use, cached) or a .ist file.
+/// Where an object's Inner Sphere Tree comes from: a mesh (packed on first use, cached), a .ist
+/// file, or a tree already in memory (built by the program, e.g. through the C API).
 struct SceneShape {
-  std::filesystem::path mesh{};      ///< mesh file (absolute after loading), or empty when `ist` is set
+  std::filesystem::path mesh{};      ///< mesh file (absolute after loading), or empty when `ist` or `tree` is set
   std::filesystem::path ist{};       ///< prebuilt .ist file, or empty
+  std::shared_ptr<const collette::SphereTree> tree{};  ///< a tree in metres, shared; used as it is when set
   std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
   double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
 };
@@ -81,6 +83,12 @@ Result<Scene> load_scene(const std::filesystem::path& path);
 
 /// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
 Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);
+
+/// Reads a device's settings from a JSON object (numbers, strings, booleans, [x, y, z]) as a
+/// scene's `tool.device.config` is read; a relative `file` resolves against `base_dir`. Errors
+/// name `source` and the key.
+Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, const std::string& source,
+                                                  const std::filesystem::path& base_dir);
 
 /// The embedded default scene: the bunny explored by a stylus on a raster sweep into deep contact.
 /// Its meshes are written into `cache_dir` on first use.

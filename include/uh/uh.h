@@ -1,0 +1,345 @@
+/*
+ * uh.h: the UnrealHaptics C API (plain C99, library libuh, CMake target uh::capi).
+ *
+ * One header for engines (Unreal, Unity's P/Invoke, Godot), other languages and plain C programs:
+ * open a haptic session (a scene: objects, a tool bound to a device, watched pairs), start its
+ * haptic and collision threads, poll its newest state and its contact events, stop it; and query
+ * Inner Sphere Trees directly.
+ *
+ * Rules that hold for every function:
+ *  - Every call returns a uh_status; UH_OK (0) is success. After a failure, uh_last_error()
+ *    returns a message for the calling thread that names what was wrong (a file, a field, a
+ *    handle). No C++ exception ever leaves the library.
+ *  - Objects are handles (uh_scene*, uh_session*, uh_tree*). A handle is never dereferenced by the
+ *    caller; it carries a generation, so a handle that was closed or freed is refused with
+ *    UH_ERROR_STALE_HANDLE, not a crash. Closing or freeing NULL or a stale handle does nothing.
+ *  - Structs that cross the boundary start with `struct_size`: set it to sizeof(the struct) (the
+ *    uh_default_*() functions do). A struct_size smaller than this version's struct is refused.
+ *  - There is no global state a call depends on: any number of sessions, scenes and trees may
+ *    exist in one process; each call names the one it works on.
+ *  - Units are SI: metres, seconds, newtons; quaternions are (w, x, y, z), unit length.
+ *  - Threads: see each section. In short: a session's calls may come from any thread and are
+ *    serialised per session; only uh_session_poll() runs alongside them. Callbacks marked
+ *    "haptic thread" are real-time: no allocation, no locks, no blocking, no calls into this API.
+ */
+#ifndef UH_UH_H
+#define UH_UH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* The API version this header describes. Raised on every incompatible change; a program built
+ * against one version is refused at open by a library of another (UH_ERROR_VERSION). */
+#define UH_API_VERSION 1
+
+#if defined(_WIN32) || defined(__CYGWIN__)
+#if defined(UH_CAPI_BUILDING)
+#define UH_API __declspec(dllexport)
+#else
+#define UH_API __declspec(dllimport)
+#endif
+#elif defined(__GNUC__)
+#define UH_API __attribute__((visibility("default")))
+#else
+#define UH_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------------------------------------
+ * Status, errors, version
+ * ------------------------------------------------------------------------------------------- */
+
+/* What a call did (a fixed-size integer; the values below). */
+typedef int32_t uh_status;
+enum {
+  UH_OK = 0,                      /* success */
+  UH_ERROR_INVALID_ARGUMENT = 1,  /* NULL where a value is needed, a number out of range, a bad struct_size */
+  UH_ERROR_STALE_HANDLE = 2,      /* the handle was closed or freed, or is not a handle of that kind */
+  UH_ERROR_WRONG_STATE = 3,       /* not possible now: start twice, start after stop, a callback set while running */
+  UH_ERROR_VERSION = 4,           /* the program was compiled against another UH_API_VERSION */
+  UH_ERROR_FAILED = 5,            /* the work failed: a file, a mesh, a device, a thread; see uh_last_error() */
+  UH_ERROR_INTERNAL = 6           /* an unexpected failure inside the library (out of memory, a bug) */
+};
+
+/* The library's version, e.g. "0.1.0". Static storage; any thread. */
+UH_API const char* uh_version_string(void);
+
+/* The UH_API_VERSION the library was built with. Any thread. */
+UH_API int32_t uh_api_version(void);
+
+/* The message of the calling thread's last failed call ("" if none). Valid until the next failing
+ * call on this thread. Any thread. */
+UH_API const char* uh_last_error(void);
+
+/* A short name of a status ("UH_OK", "UH_ERROR_STALE_HANDLE", ...). Static storage. */
+UH_API const char* uh_status_name(uh_status status);
+
+/* ---------------------------------------------------------------------------------------------
+ * Inner Sphere Trees: load, build, query
+ *
+ * A tree is immutable once made; it may be queried from several threads at once and shared with
+ * scenes (a scene keeps its own reference, so the tree may be freed after adding it). Lengths are
+ * metres: a .ist's meters_per_unit is applied on load, the build settings' on build.
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct uh_tree uh_tree;
+
+/* How to pack a mesh with spheres. */
+typedef struct uh_tree_build_def {
+  uint32_t struct_size;    /* sizeof(uh_tree_build_def) */
+  int64_t spheres;         /* target number of leaf spheres, > 0 (default 10000) */
+  double meters_per_unit;  /* length of one mesh unit [m], > 0 (default 1) */
+} uh_tree_build_def;
+
+UH_API uh_tree_build_def uh_default_tree_build_def(void);
+
+/* Loads a .ist file (checksummed; a damaged file is refused with the reason). */
+UH_API uh_status uh_tree_load(const char* ist_path, uh_tree** out);
+
+/* Loads a closed mesh (OBJ, STL, PLY, OFF, ...), validates it (an open or non-manifold mesh is
+ * refused with the counts of bad edges), packs it and builds the tree. Takes about a second per
+ * 10,000 spheres. `def` may be NULL (defaults). */
+UH_API uh_status uh_tree_build(const char* mesh_path, const uh_tree_build_def* def, uh_tree** out);
+
+/* Same from arrays: `vertices` holds vertex_count * 3 coordinates (x, y, z, in mesh units),
+ * `indices` triangle_count * 3 vertex indices, counter-clockwise seen from outside. The arrays
+ * are copied; the mesh must be closed and manifold. */
+UH_API uh_status uh_tree_build_from_arrays(const double* vertices, int32_t vertex_count, const int32_t* indices,
+                                           int32_t triangle_count, const uh_tree_build_def* def, uh_tree** out);
+
+/* Writes the tree as a .ist file (lengths in metres, meters_per_unit 1). */
+UH_API uh_status uh_tree_save(const uh_tree* tree, const char* ist_path);
+
+/* What a tree holds. */
+typedef struct uh_tree_info {
+  uint32_t struct_size;   /* sizeof(uh_tree_info) */
+  int32_t leaf_count;     /* leaf spheres */
+  double coverage;        /* sphere volume / mesh volume, 0..1 (0 if unknown) */
+  double mesh_volume;     /* volume of the mesh [m^3] (0 if unknown) */
+  double center[3];       /* bounding sphere of the root [m, tree frame] */
+  double radius;          /* [m] */
+} uh_tree_info;
+
+UH_API uh_status uh_tree_get_info(const uh_tree* tree, uh_tree_info* out);
+
+/* Frees the tree (scenes that hold it keep their reference). NULL or a stale handle: nothing. */
+UH_API void uh_tree_free(uh_tree* tree);
+
+/* The overlap of two trees at one pose. */
+typedef struct uh_query_result {
+  uint32_t struct_size;     /* sizeof(uh_query_result) */
+  double volume;            /* intersection volume of the two packings [m^3], >= 0 */
+  double volume_estimate;   /* volume / (coverage_a * coverage_b): an estimate of the meshes' overlap [m^3] */
+  double direction[3];      /* unit, A's frame: the direction that pushes B out of A; zero when apart */
+  int32_t pair_count;       /* overlapping leaf sphere pairs */
+  double distance;          /* separation when apart (an upper bound) [m]; 0 when they overlap */
+} uh_query_result;
+
+/* Queries B placed at (position, orientation) in A's frame against A. Any thread; a thread's
+ * first query allocates its scratch (about 2 MB), later ones do not. */
+UH_API uh_status uh_tree_query(const uh_tree* a, const uh_tree* b, const double position[3],
+                               const double orientation[4], uh_query_result* out);
+
+/* ---------------------------------------------------------------------------------------------
+ * Scenes: what a session runs, from a file or built through calls
+ *
+ * A scene is a description (objects, the tool and its device, watched pairs, rates); sessions
+ * copy it when they open, so it may be changed or freed afterwards. One thread at a time.
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct uh_scene uh_scene;
+
+/* Where a shape's tree comes from: exactly one of mesh_path, ist_path, tree or the arrays. */
+typedef struct uh_shape_def {
+  uint32_t struct_size;      /* sizeof(uh_shape_def) */
+  const char* mesh_path;     /* a closed mesh, packed on first use and cached (see uh_session_def.cache_dir) */
+  const char* ist_path;      /* a .ist file */
+  const uh_tree* tree;       /* a tree made by uh_tree_load/uh_tree_build (shared, not copied) */
+  const double* vertices;    /* or a closed mesh as arrays (see uh_tree_build_from_arrays) */
+  int32_t vertex_count;
+  const int32_t* indices;
+  int32_t triangle_count;
+  int64_t spheres;           /* leaf spheres when packing a mesh (default 10000) */
+  double meters_per_unit;    /* length of one mesh unit [m] (default 1) */
+} uh_shape_def;
+
+/* A static object of the scene. */
+typedef struct uh_object_def {
+  uint32_t struct_size;      /* sizeof(uh_object_def) */
+  const char* name;          /* unique in the scene; copied */
+  uh_shape_def shape;
+  double position[3];        /* world_from_object [m] */
+  double orientation[4];     /* (w, x, y, z) */
+  int32_t watch;             /* nonzero (default): the tool is watched against this object */
+} uh_object_def;
+
+/* How forces are rendered on the tool. */
+typedef int32_t uh_force_mode;
+enum { UH_FORCE_6DOF = 0, UH_FORCE_3DOF = 1 };
+
+/* The tool: a shape moved by a device, with its force law and limits. */
+typedef struct uh_tool_def {
+  uint32_t struct_size;        /* sizeof(uh_tool_def) */
+  const char* name;            /* default "tool" */
+  uh_shape_def shape;
+  uh_force_mode mode;          /* default UH_FORCE_6DOF */
+  double force_scale;          /* penalty stiffness eps_c [N/m^3] */
+  double damping;              /* eps_d [N s/m] */
+  double damping_full_volume;  /* overlap volume from which the full damping acts [m^3] (0: from the first touch) */
+  double mass_kg;              /* tool mass [kg] */
+  double center_of_mass[3];    /* [m, tool frame] */
+  double max_force_n;          /* limit of the tool's force [N] */
+  double max_torque_nm;        /* limit of its torque [N m] */
+  const char* device_driver;   /* a registered driver: "sim-line", "sim-circle", "sim-raster", "sim-replay", "sim-hand" */
+  const char* device_config_json; /* the driver's settings as a JSON object (numbers, strings, booleans, [x,y,z]); NULL = {} */
+  double workspace_scale;      /* world metres per device metre (default 1) */
+  double workspace_offset[3];  /* the device base in the world [m] */
+  double workspace_rotation[4];/* (w, x, y, z) */
+} uh_tool_def;
+
+UH_API uh_shape_def uh_default_shape_def(void);
+UH_API uh_object_def uh_default_object_def(void);
+UH_API uh_tool_def uh_default_tool_def(void);
+
+/* An empty scene (no objects, no tool yet; rates 1 kHz haptic and collision). */
+UH_API uh_status uh_scene_create(const char* name, uh_scene** out);
+/* A scene file (docs/pipeline.md); NULL: the embedded default scene. */
+UH_API uh_status uh_scene_load(const char* scene_path, uh_scene** out);
+/* Scene JSON text; relative paths resolve against base_dir (NULL: the current folder). */
+UH_API uh_status uh_scene_parse(const char* json_text, const char* base_dir, uh_scene** out);
+/* Frees the scene. NULL or a stale handle: nothing. */
+UH_API void uh_scene_free(uh_scene* scene);
+
+/* Adds an object; `out_index` (may be NULL) gets its index, which sessions use for it. The
+ * shape's files must exist now (the tree is loaded or built when a session opens). */
+UH_API uh_status uh_scene_add_object(uh_scene* scene, const uh_object_def* def, int32_t* out_index);
+/* Removes the object named `name`; later objects move down one index. */
+UH_API uh_status uh_scene_remove_object(uh_scene* scene, const char* name);
+/* Sets the pose of the object named `name`. */
+UH_API uh_status uh_scene_set_object_pose(uh_scene* scene, const char* name, const double position[3],
+                                          const double orientation[4]);
+/* Watches the pair (object, tool) or stops watching it. */
+UH_API uh_status uh_scene_watch(uh_scene* scene, const char* name, int32_t watch);
+/* Sets the tool and its device. The device config is checked when a session opens. */
+UH_API uh_status uh_scene_set_tool(uh_scene* scene, const uh_tool_def* def);
+/* Haptic rate in [1, 10000] Hz; collision rate in [0, 10000] Hz (0 = free-running). */
+UH_API uh_status uh_scene_set_rates(uh_scene* scene, double haptic_hz, double collision_hz);
+UH_API uh_status uh_scene_object_count(const uh_scene* scene, int32_t* out);
+
+/* ---------------------------------------------------------------------------------------------
+ * Sessions: a scene running
+ *
+ * open -> start -> poll ... -> stop -> close, or open -> run_stepped -> close. A session runs
+ * once. stop() is idempotent; close() stops first and works from any state.
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct uh_session uh_session;
+
+/* Settings of one session (0 / NULL fields keep the scene's value). */
+typedef struct uh_session_def {
+  uint32_t struct_size;    /* sizeof(uh_session_def) */
+  double haptic_hz;        /* override the haptic rate [Hz] (0: the scene's) */
+  double collision_hz;     /* override the collision rate [Hz] (< 0: the scene's; 0 = free-running) */
+  int32_t raise_priority;  /* nonzero: ask for SCHED_FIFO for the haptic and collision threads */
+  const char* cache_dir;   /* where packed meshes are cached (NULL: $UH_CACHE_DIR or ~/.cache/unrealhaptics) */
+} uh_session_def;
+
+UH_API uh_session_def uh_default_session_def(void);
+
+/* The newest state, as the haptic thread sent it in its last tick. */
+typedef struct uh_state {
+  uint32_t struct_size;        /* sizeof(uh_state), set by the caller */
+  double time_s;               /* that tick's time since start [s] (stepped: simulated time) */
+  double tool_position[3];     /* the tool's mesh frame origin in the world [m] */
+  double tool_orientation[4];  /* the tool's orientation in the world (w, x, y, z) */
+  double force[3];             /* force sent to the device, world frame [N] */
+  double torque[3];            /* torque sent to the device, world frame [N m] */
+  int32_t contact_pairs;       /* sphere pairs the force of that tick used */
+  uint64_t haptic_ticks;       /* haptic ticks since start */
+  uint64_t missed_deadlines;   /* ticks that started more than a period late */
+  double haptic_rate_hz;       /* haptic ticks per second over the last ~100 ms [Hz] */
+  double collision_rate_hz;    /* collision steps per second over the last ~100 ms [Hz] */
+} uh_state;
+
+/* A contact between the tool and a watched object began or ended. */
+typedef int32_t uh_contact_kind;
+enum { UH_CONTACT_BEGIN = 0, UH_CONTACT_END = 1 };
+
+typedef struct uh_contact_event {
+  uint32_t struct_size;  /* sizeof(uh_contact_event), set by the caller */
+  uh_contact_kind kind;
+  int32_t object;        /* index of the object in the scene */
+  double time_s;         /* time of the collision step that saw it, since start [s] */
+  double volume;         /* overlap volume then [m^3] (0 for UH_CONTACT_END) */
+  int32_t pairs;         /* overlapping sphere pairs then (0 for UH_CONTACT_END) */
+} uh_contact_event;
+
+/* Called on the haptic thread after every tick (on the calling thread in stepped runs) with that
+ * tick's state. Real-time: return within microseconds; no allocation, no locks, no blocking, no
+ * calls into this API. `user` is the pointer given to uh_session_set_tick_callback. */
+typedef void (*uh_tick_fn)(void* user, const uh_state* state);
+
+/* Opens a session of the scene file `scene_path` (NULL: the embedded default scene): loads or
+ * builds the trees, creates and opens the device; starts no thread. Called through a macro that
+ * passes this header's UH_API_VERSION; the function itself is exported for bindings, which
+ * should compare uh_api_version() first. */
+UH_API uh_status uh_session_open(const char* scene_path, uh_session** out);
+UH_API uh_status uh_session_open_checked(int32_t api_version, const char* scene_path, uh_session** out);
+#define uh_session_open(scene_path, out) uh_session_open_checked(UH_API_VERSION, (scene_path), (out))
+
+/* Opens a session of a scene built through calls; `def` may be NULL (defaults). Same version
+ * check as uh_session_open. */
+UH_API uh_status uh_session_create(const uh_scene* scene, const uh_session_def* def, uh_session** out);
+UH_API uh_status uh_session_create_checked(int32_t api_version, const uh_scene* scene, const uh_session_def* def,
+                                           uh_session** out);
+#define uh_session_create(scene, def, out) uh_session_create_checked(UH_API_VERSION, (scene), (def), (out))
+
+/* Starts the haptic, collision and monitor threads and returns at once. */
+UH_API uh_status uh_session_start(uh_session* s);
+
+/* Instead of start: runs `seconds` of the session on the calling thread in simulated time, one
+ * collision step every `ticks_per_collision_step` haptic ticks (deterministic; for tests and
+ * offline work). Returns when done; the session is then stopped. */
+UH_API uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_per_collision_step);
+
+/* Copies the newest state into `out` (out->struct_size set by the caller). Any thread; never
+ * waits for the haptic thread. Before the first tick: zeros. After stop: the last state, with
+ * the zero force the device got. */
+UH_API uh_status uh_session_poll(uh_session* s, uh_state* out);
+
+/* Takes the oldest contact event not yet taken: *has_event is 1 and `out` filled, or 0 when none
+ * is waiting. Events queue up (1024; more are dropped) from start on. */
+UH_API uh_status uh_session_poll_event(uh_session* s, uh_contact_event* out, int32_t* has_event);
+
+/* Moves object `object` (its scene index) while the session runs; the collision thread uses the
+ * pose from its next step. Call it for one object from one thread only. */
+UH_API uh_status uh_session_set_object_pose(uh_session* s, int32_t object, const double position[3],
+                                            const double orientation[4]);
+
+/* Sets (or with fn NULL removes) the haptic-thread tick callback. Only before start. */
+UH_API uh_status uh_session_set_tick_callback(uh_session* s, uh_tick_fn fn, void* user);
+
+/* Sends zero force at once, stops and joins every thread, completes the report. Idempotent: later
+ * calls return what the first returned. UH_ERROR_FAILED if a thread had ended on its own (the
+ * report is still complete). Before start: UH_OK, nothing to do. */
+UH_API uh_status uh_session_stop(uh_session* s);
+
+/* The report of the run as the JSON object `uh run --json` prints. Only after stop (or a stepped
+ * run); `*out` stays valid until the session is closed. */
+UH_API uh_status uh_session_report_json(uh_session* s, const char** out);
+
+/* Objects of the session's scene: their count and names (valid until close). */
+UH_API uh_status uh_session_object_count(uh_session* s, int32_t* out);
+UH_API uh_status uh_session_object_name(uh_session* s, int32_t object, const char** out);
+
+/* Stops the session if it runs and frees it. NULL, a stale handle or a second close: nothing. */
+UH_API void uh_session_close(uh_session* s);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* UH_UH_H */

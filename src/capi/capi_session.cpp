@@ -1,0 +1,297 @@
+// The C API's sessions: open, start or run stepped, poll state and events, stop, report, close.
+
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "capi_support.hpp"
+#include "uh/controllers/haptic_session.hpp"
+
+namespace uh::capi {
+
+/// A session and what the C side hands out from it. `mutex` serialises the owner's calls
+/// (everything but uh_session_poll, which HapticSession::state() makes safe on its own).
+struct SessionBox {
+  std::mutex mutex;
+  std::unique_ptr<controllers::HapticSession> session;
+  std::vector<std::string> object_names;
+  std::string report_json;
+  bool stopped = false;
+  uh_tick_fn tick_fn = nullptr;
+  void* tick_user = nullptr;
+  ScopedConnection tick_connection;
+};
+
+namespace {
+
+HandleTable<SessionBox>& session_table() {
+  static HandleTable<SessionBox> table(3);
+  return table;
+}
+
+void fill_state(const controllers::SessionState& s, uh_state& out) {
+  out.time_s = s.time_s;
+  out.tool_position[0] = s.tool_position_world.x;
+  out.tool_position[1] = s.tool_position_world.y;
+  out.tool_position[2] = s.tool_position_world.z;
+  out.tool_orientation[0] = s.tool_orientation_world.w;
+  out.tool_orientation[1] = s.tool_orientation_world.x;
+  out.tool_orientation[2] = s.tool_orientation_world.y;
+  out.tool_orientation[3] = s.tool_orientation_world.z;
+  out.force[0] = s.force_world.x;
+  out.force[1] = s.force_world.y;
+  out.force[2] = s.force_world.z;
+  out.torque[0] = s.torque_world.x;
+  out.torque[1] = s.torque_world.y;
+  out.torque[2] = s.torque_world.z;
+  out.contact_pairs = s.contact_pairs;
+  out.haptic_ticks = s.haptic_ticks;
+  out.missed_deadlines = s.missed_deadlines;
+  out.haptic_rate_hz = s.haptic_rate_hz;
+  out.collision_rate_hz = s.collision_rate_hz;
+}
+
+// haptic thread: hands each tick's state to the program's callback (real-time; no allocation)
+void call_tick_callback(SessionBox& box, const controllers::SessionState& s) {
+  uh_state state{};
+  state.struct_size = sizeof(uh_state);
+  fill_state(s, state);
+  box.tick_fn(box.tick_user, &state);
+}
+
+uh_status check_version(const char* function, int32_t api_version) {
+  if (api_version != UH_API_VERSION)
+    return fail(UH_ERROR_VERSION,
+                fmt::format("{}: the program was compiled against UH_API_VERSION {}, this library "
+                            "is version {} ({}); rebuild the program against this library's uh.h",
+                            function, api_version, UH_API_VERSION, UH_VERSION_STRING));
+  return UH_OK;
+}
+
+uh_status open_session(const char* function, const controllers::Scene& scene, const uh_session_def& def,
+                       uh_session** out) {
+  if (scene.tool.shape.mesh.empty() && scene.tool.shape.ist.empty() && !scene.tool.shape.tree)
+    return fail(UH_ERROR_INVALID_ARGUMENT,
+                fmt::format("{}: {} has no tool (uh_scene_set_tool)", function, scene.source));
+  controllers::SessionOptions options;
+  if (def.haptic_hz != 0.0) options.haptic_hz = def.haptic_hz;
+  if (def.collision_hz >= 0.0) options.collision_hz = def.collision_hz;
+  options.raise_priority = def.raise_priority != 0;
+  options.cache_dir =
+      def.cache_dir != nullptr ? std::filesystem::path(def.cache_dir) : controllers::default_cache_dir();
+  auto session = controllers::HapticSession::create(scene, options);
+  if (!session) return fail(UH_ERROR_FAILED, session.error().message);
+  auto box = std::make_shared<SessionBox>();
+  box->session = std::move(session).value();
+  for (const auto& o : scene.objects) box->object_names.push_back(o.name);
+  const std::uintptr_t handle = session_table().insert(std::move(box));
+  if (handle == 0) return fail(UH_ERROR_FAILED, "too many sessions are open at once");
+  *out = as_handle<uh_session>(handle);
+  return UH_OK;
+}
+
+// Runs `body(box)` with the session's owner lock held, or fails for a stale handle.
+template <typename Body>
+uh_status with_session(const char* function, uh_session* s, Body&& body) {
+  return guarded(function, [&]() -> uh_status {
+    const auto box = session_table().find(handle_value(s));
+    if (!box) return stale(function, "session");
+    const std::lock_guard lock(box->mutex);
+    return body(*box);
+  });
+}
+
+uh_status finish(SessionBox& box, const Status& result) {
+  box.stopped = true;
+  box.report_json = controllers::session_report_json(box.session->report());
+  if (!result) return fail(UH_ERROR_FAILED, result.error().message);
+  return UH_OK;
+}
+
+}  // namespace
+}  // namespace uh::capi
+
+using namespace uh;
+using namespace uh::capi;
+
+extern "C" {
+
+uh_session_def uh_default_session_def(void) {
+  return uh_session_def{.struct_size = sizeof(uh_session_def),
+                        .haptic_hz = 0.0,
+                        .collision_hz = -1.0,
+                        .raise_priority = 0,
+                        .cache_dir = nullptr};
+}
+
+uh_status(uh_session_open)(const char* scene_path, uh_session** out) {
+  return uh_session_open_checked(UH_API_VERSION, scene_path, out);
+}
+
+uh_status uh_session_open_checked(int32_t api_version, const char* scene_path, uh_session** out) {
+  return guarded("uh_session_open", [&]() -> uh_status {
+    if (out == nullptr) return null_argument("uh_session_open", "out");
+    *out = nullptr;
+    if (auto v = check_version("uh_session_open", api_version); v != UH_OK) return v;
+    const uh_session_def def = uh_default_session_def();
+    auto scene = scene_path != nullptr ? controllers::load_scene(scene_path)
+                                       : controllers::default_scene(controllers::default_cache_dir());
+    if (!scene) return fail(UH_ERROR_FAILED, scene.error().message);
+    return open_session("uh_session_open", *scene, def, out);
+  });
+}
+
+uh_status(uh_session_create)(const uh_scene* scene, const uh_session_def* def, uh_session** out) {
+  return uh_session_create_checked(UH_API_VERSION, scene, def, out);
+}
+
+uh_status uh_session_create_checked(int32_t api_version, const uh_scene* scene, const uh_session_def* def,
+                                    uh_session** out) {
+  return guarded("uh_session_create", [&]() -> uh_status {
+    if (out == nullptr) return null_argument("uh_session_create", "out");
+    *out = nullptr;
+    if (auto v = check_version("uh_session_create", api_version); v != UH_OK) return v;
+    if (def != nullptr)
+      if (auto s = check_struct("uh_session_create", "def", def); s != UH_OK) return s;
+    const auto box = scene_table().find(handle_value(scene));
+    if (!box) return stale("uh_session_create", "scene");
+    return open_session("uh_session_create", box->scene, def != nullptr ? *def : uh_default_session_def(),
+                        out);
+  });
+}
+
+uh_status uh_session_start(uh_session* s) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (box.stopped || box.session->running())
+      return fail(UH_ERROR_WRONG_STATE,
+                  fmt::format("{}: the session has run already (a session runs once)", fn));
+    if (auto started = box.session->start(); !started) return fail(UH_ERROR_FAILED, started.error().message);
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_per_collision_step) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (!(seconds > 0.0 && seconds <= 86400.0) || ticks_per_collision_step < 1)
+      return fail(
+          UH_ERROR_INVALID_ARGUMENT,
+          fmt::format("{}: seconds must be in (0, 86400] and ticks_per_collision_step >= 1 (got {} and {})",
+                      fn, seconds, ticks_per_collision_step));
+    if (box.stopped || box.session->running())
+      return fail(UH_ERROR_WRONG_STATE,
+                  fmt::format("{}: the session has run already (a session runs once)", fn));
+    return finish(box, box.session->run_stepped(seconds, ticks_per_collision_step));
+  });
+}
+
+uh_status uh_session_poll(uh_session* s, uh_state* out) {
+  const char* const fn = __func__;
+  return guarded(fn, [&]() -> uh_status {
+    if (auto c = check_struct(fn, "out", out); c != UH_OK) return c;
+    const auto box = session_table().find(handle_value(s));
+    if (!box) return stale(fn, "session");
+    fill_state(box->session->state(), *out);
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_poll_event(uh_session* s, uh_contact_event* out, int32_t* has_event) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (auto c = check_struct(fn, "out", out); c != UH_OK) return c;
+    if (has_event == nullptr) return null_argument(fn, "has_event");
+    controllers::ContactEvent e;
+    *has_event = box.session->poll_event(e) ? 1 : 0;
+    if (*has_event != 0) {
+      out->kind = e.kind == controllers::ContactEventKind::kBegin ? UH_CONTACT_BEGIN : UH_CONTACT_END;
+      out->object = e.object;
+      out->time_s = e.time_s;
+      out->volume = e.volume;
+      out->pairs = e.pairs;
+    }
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_set_object_pose(uh_session* s, int32_t object, const double position[3],
+                                     const double orientation[4]) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    auto pose = pose_from_arrays(position, orientation);
+    if (!pose) return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", fn, pose.error().message));
+    if (auto set = box.session->set_object_pose(object, *pose); !set)
+      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", fn, set.error().message));
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_set_tick_callback(uh_session* s, uh_tick_fn callback, void* user) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (box.stopped || box.session->running())
+      return fail(UH_ERROR_WRONG_STATE, fmt::format("{}: only before the session starts", fn));
+    box.tick_connection.disconnect();
+    box.tick_fn = callback;
+    box.tick_user = user;
+    if (callback != nullptr)
+      box.tick_connection = box.session->on_haptic_tick().connect<&call_tick_callback>(box);
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_stop(uh_session* s) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (!box.session->running() && !box.stopped) return UH_OK;  // never started: nothing to stop
+    return finish(box, box.session->stop());
+  });
+}
+
+uh_status uh_session_report_json(uh_session* s, const char** out) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    if (!box.stopped)
+      return fail(UH_ERROR_WRONG_STATE, fmt::format("{}: the report exists once the session stopped", fn));
+    *out = box.report_json.c_str();
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_object_count(uh_session* s, int32_t* out) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    *out = static_cast<int32_t>(box.object_names.size());
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_object_name(uh_session* s, int32_t object, const char** out) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    if (object < 0 || static_cast<std::size_t>(object) >= box.object_names.size())
+      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: there is no object {} (the scene has {})", fn,
+                                                         object, box.object_names.size()));
+    *out = box.object_names[static_cast<std::size_t>(object)].c_str();
+    return UH_OK;
+  });
+}
+
+void uh_session_close(uh_session* s) {
+  const char* const fn = __func__;
+  const uh_status ignored = guarded(fn, [&]() -> uh_status {
+    const auto box = session_table().remove(handle_value(s));
+    if (!box) return UH_OK;
+    const std::lock_guard lock(box->mutex);
+    const Status stopped = box->session->stop();
+    (void)stopped;  // closing: nobody is left to tell
+    return UH_OK;
+  });
+  (void)ignored;
+}
+
+}  // extern "C"

@@ -1,0 +1,479 @@
+/* Tests of the C API, written in C99 as a user of uh.h would. One program; argv[1] names the
+ * test (each is its own ctest). Paths: UH_TEST_DATA_DIR (the committed meshes). */
+#define _POSIX_C_SOURCE 199309L /* nanosleep */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "uh/uh.h"
+
+static int failures = 0;
+
+#define CHECK(cond)                                                                              \
+  do {                                                                                           \
+    if (!(cond)) {                                                                               \
+      fprintf(stderr, "%s:%d: CHECK failed: %s (last error: %s)\n", __FILE__, __LINE__, #cond, \
+              uh_last_error());                                                                  \
+      ++failures;                                                                                \
+    }                                                                                            \
+  } while (0)
+
+#define CHECK_STATUS(call, expected)                                                               \
+  do {                                                                                             \
+    const uh_status status_ = (call);                                                              \
+    if (status_ != (expected)) {                                                                   \
+      fprintf(stderr, "%s:%d: %s returned %s, expected %s (last error: %s)\n", __FILE__, __LINE__, \
+              #call, uh_status_name(status_), uh_status_name(expected), uh_last_error());          \
+      ++failures;                                                                                  \
+    }                                                                                              \
+  } while (0)
+
+#define REQUIRE_OK(call)                                                                          \
+  do {                                                                                            \
+    const uh_status status_ = (call);                                                             \
+    if (status_ != UH_OK) {                                                                       \
+      fprintf(stderr, "%s:%d: %s returned %s: %s\n", __FILE__, __LINE__, #call,                   \
+              uh_status_name(status_), uh_last_error());                                          \
+      exit(1);                                                                                    \
+    }                                                                                             \
+  } while (0)
+
+static void sleep_ms(long ms) {
+  struct timespec t;
+  t.tv_sec = ms / 1000;
+  t.tv_nsec = (ms % 1000) * 1000000L;
+  nanosleep(&t, NULL);
+}
+
+static double norm3(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+/* The number after "key": in the report JSON, after `section` (enough for this report's layout). */
+static double json_number(const char* json, const char* section, const char* key) {
+  const char* at = strstr(json, section);
+  char pattern[64];
+  if (at == NULL) return NAN;
+  snprintf(pattern, sizeof pattern, "\"%s\":", key);
+  at = strstr(at, pattern);
+  return at != NULL ? strtod(at + strlen(pattern), NULL) : NAN;
+}
+
+static uh_shape_def mesh_shape(const char* file, int64_t spheres) {
+  static char paths[4][512];
+  static int next = 0;
+  uh_shape_def shape = uh_default_shape_def();
+  char* path = paths[next++ % 4];
+  snprintf(path, 512, "%s/meshes/%s", UH_TEST_DATA_DIR, file);
+  shape.mesh_path = path;
+  shape.spheres = spheres;
+  shape.meters_per_unit = 0.01;
+  return shape;
+}
+
+/* The small scene of the C++ session tests, built through calls: a 10 cm bunny (600 spheres) and
+ * a stylus (150) that goes down into it and back every second (sim-line). */
+static uh_scene* small_scene(void) {
+  uh_scene* scene = NULL;
+  uh_object_def bunny = uh_default_object_def();
+  uh_tool_def tool = uh_default_tool_def();
+  REQUIRE_OK(uh_scene_create("small-c", &scene));
+  bunny.name = "bunny";
+  bunny.shape = mesh_shape("bunny_npm_3674.obj", 600);
+  bunny.orientation[0] = 0.70710678;
+  bunny.orientation[1] = 0.70710678;
+  REQUIRE_OK(uh_scene_add_object(scene, &bunny, NULL));
+  tool.name = "stylus";
+  tool.shape = mesh_shape("stylus.obj", 150);
+  tool.force_scale = 8.0e6;
+  tool.damping = 1.0;
+  tool.center_of_mass[2] = 0.025;
+  tool.max_force_n = 6.0;
+  tool.max_torque_nm = 0.3;
+  tool.device_driver = "sim-line";
+  tool.device_config_json =
+      "{\"start\": [0, 0, 0.10], \"end\": [0, 0, 0.045], \"duration_s\": 0.5, \"bounce\": true,"
+      " \"dof_actuated\": 6, \"max_force_n\": 6}";
+  REQUIRE_OK(uh_scene_set_tool(scene, &tool));
+  return scene;
+}
+
+static uh_session* open_small_session(void) {
+  uh_scene* scene = small_scene();
+  uh_session* s = NULL;
+  REQUIRE_OK(uh_session_create(scene, NULL, &s));
+  uh_scene_free(scene); /* the session copied it */
+  return s;
+}
+
+/* what the tick callback saw (stepped: on this thread) */
+typedef struct {
+  uint64_t ticks;
+  double max_force;
+  int32_t max_pairs;
+} tick_record;
+
+static void record_tick(void* user, const uh_state* state) {
+  tick_record* r = (tick_record*)user;
+  const double f = norm3(state->force);
+  ++r->ticks;
+  if (f > r->max_force) r->max_force = f;
+  if (state->contact_pairs > r->max_pairs) r->max_pairs = state->contact_pairs;
+}
+
+static void test_version(void) {
+  uh_session* s = (uh_session*)1;
+  CHECK(strlen(uh_version_string()) > 0);
+  CHECK(uh_api_version() == UH_API_VERSION);
+  CHECK_STATUS(uh_session_open_checked(UH_API_VERSION + 1, NULL, &s), UH_ERROR_VERSION);
+  CHECK(s == NULL);
+  CHECK(strstr(uh_last_error(), "UH_API_VERSION") != NULL);
+  CHECK(strcmp(uh_status_name(UH_ERROR_STALE_HANDLE), "UH_ERROR_STALE_HANDLE") == 0);
+}
+
+/* The default scene (the bunny sweep) run deterministically: contact and force read back. */
+static void test_default_session_stepped(void) {
+  uh_session* s = NULL;
+  uh_state st;
+  uh_contact_event e;
+  tick_record rec = {0, 0.0, 0};
+  int32_t has_event = 0, begins = 0;
+  const char* report = NULL;
+  REQUIRE_OK(uh_session_open(NULL, &s));
+  REQUIRE_OK(uh_session_set_tick_callback(s, record_tick, &rec));
+  REQUIRE_OK(uh_session_run_stepped(s, 3.0, 4));
+  memset(&st, 0, sizeof st);
+  st.struct_size = sizeof st;
+  REQUIRE_OK(uh_session_poll(s, &st));
+  CHECK(st.haptic_ticks == 3000);
+  CHECK(fabs(st.time_s - 2.999) < 1e-9);
+  CHECK(rec.ticks == 3000);
+  CHECK(rec.max_force > 0.5); /* the sweep goes into deep contact */
+  CHECK(rec.max_force <= 8.0 + 1e-9);
+  CHECK(rec.max_pairs > 0);
+  e.struct_size = sizeof e;
+  while (uh_session_poll_event(s, &e, &has_event) == UH_OK && has_event) {
+    CHECK(e.object == 0);
+    if (e.kind == UH_CONTACT_BEGIN) {
+      ++begins;
+      CHECK(e.volume > 0.0 && e.pairs > 0);
+    }
+  }
+  CHECK(begins >= 1);
+  REQUIRE_OK(uh_session_report_json(s, &report));
+  /* two paths to the same figure: the states the callback saw, the controller's own maximum */
+  CHECK(fabs(json_number(report, "\"force\"", "max_n") - rec.max_force) < 1e-9);
+  CHECK(json_number(report, "\"haptic\"", "ticks") == 3000.0);
+  CHECK(strstr(report, "\"mode\": \"stepped\"") != NULL);
+  REQUIRE_OK(uh_session_stop(s)); /* stopped already: idempotent */
+  uh_session_close(s);
+}
+
+/* A short threaded run of a scene built through calls: poll state and events while it runs. */
+static void test_threaded_session(void) {
+  uh_session* s = open_small_session();
+  uh_state st;
+  uh_contact_event e;
+  int32_t has_event = 0, begins = 0, i;
+  double max_force = 0.0;
+  int32_t max_pairs = 0;
+  uint64_t last_ticks = 0;
+  const char* report = NULL;
+  st.struct_size = sizeof st;
+  e.struct_size = sizeof e;
+  REQUIRE_OK(uh_session_start(s));
+  CHECK_STATUS(uh_session_start(s), UH_ERROR_WRONG_STATE);
+  CHECK_STATUS(uh_session_set_tick_callback(s, record_tick, NULL), UH_ERROR_WRONG_STATE);
+  for (i = 0; i < 600; ++i) { /* about 1.2 s */
+    REQUIRE_OK(uh_session_poll(s, &st));
+    CHECK(st.haptic_ticks >= last_ticks);
+    last_ticks = st.haptic_ticks;
+    if (norm3(st.force) > max_force) max_force = norm3(st.force);
+    if (st.contact_pairs > max_pairs) max_pairs = st.contact_pairs;
+    while (uh_session_poll_event(s, &e, &has_event) == UH_OK && has_event) begins += e.kind == UH_CONTACT_BEGIN;
+    sleep_ms(2);
+  }
+  REQUIRE_OK(uh_session_stop(s));
+  REQUIRE_OK(uh_session_poll(s, &st));
+  CHECK(norm3(st.force) == 0.0); /* the device got zero at stop */
+  CHECK(last_ticks > 300);       /* ~1200 at 1 kHz; loose for sanitizer builds */
+  CHECK(max_force > 0.1);
+  CHECK(max_force <= 6.0 + 1e-9);
+  CHECK(max_pairs > 0);
+  CHECK(begins >= 1);
+  REQUIRE_OK(uh_session_report_json(s, &report));
+  CHECK(strstr(report, "\"mode\": \"threaded\"") != NULL);
+  CHECK(json_number(report, "\"force\"", "max_n") >= max_force - 1e-9);
+  uh_session_close(s);
+}
+
+/* Two sessions at once, each with its own threads and device. */
+static void test_several_sessions(void) {
+  uh_session* a = open_small_session();
+  uh_session* b = open_small_session();
+  uh_state sa, sb;
+  int i;
+  double max_a = 0.0, max_b = 0.0;
+  sa.struct_size = sizeof sa;
+  sb.struct_size = sizeof sb;
+  REQUIRE_OK(uh_session_start(a));
+  REQUIRE_OK(uh_session_start(b));
+  for (i = 0; i < 400; ++i) {
+    REQUIRE_OK(uh_session_poll(a, &sa));
+    REQUIRE_OK(uh_session_poll(b, &sb));
+    if (norm3(sa.force) > max_a) max_a = norm3(sa.force);
+    if (norm3(sb.force) > max_b) max_b = norm3(sb.force);
+    sleep_ms(2);
+  }
+  REQUIRE_OK(uh_session_stop(a));
+  CHECK(uh_session_poll(b, &sb) == UH_OK && sb.haptic_ticks > 0); /* b runs on after a stopped */
+  uh_session_close(b);                                             /* close stops b */
+  uh_session_close(a);
+  CHECK(max_a > 0.1);
+  CHECK(max_b > 0.1);
+
+  /* stepped sessions of the same scene are bit-for-bit equal */
+  a = open_small_session();
+  b = open_small_session();
+  REQUIRE_OK(uh_session_run_stepped(a, 0.5, 4));
+  REQUIRE_OK(uh_session_run_stepped(b, 0.5, 4));
+  REQUIRE_OK(uh_session_poll(a, &sa));
+  REQUIRE_OK(uh_session_poll(b, &sb));
+  CHECK(memcmp(sa.force, sb.force, sizeof sa.force) == 0);
+  CHECK(memcmp(sa.tool_position, sb.tool_position, sizeof sa.tool_position) == 0);
+  CHECK(norm3(sa.force) > 0.1); /* 0.5 s: the stylus is at its deepest */
+  uh_session_close(a);
+  uh_session_close(b);
+}
+
+/* Misuse gives statuses, never crashes. */
+static void test_handle_misuse(void) {
+  uh_session* s = open_small_session();
+  uh_session* stale_handle = s;
+  uh_state st;
+  uh_contact_event e;
+  int32_t has_event = 0, count = 0;
+  const char* text = NULL;
+  uh_tree* tree = NULL;
+  st.struct_size = sizeof st;
+  e.struct_size = sizeof e;
+
+  CHECK_STATUS(uh_session_report_json(s, &text), UH_ERROR_WRONG_STATE); /* before it ran */
+  CHECK_STATUS(uh_session_stop(s), UH_OK);                              /* before start: nothing to do */
+  CHECK_STATUS(uh_session_poll(s, &st), UH_OK);
+  CHECK(st.haptic_ticks == 0);
+  st.struct_size = 8;
+  CHECK_STATUS(uh_session_poll(s, &st), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "uh_session_poll: out->struct_size is 8") != NULL); /* names the call */
+  st.struct_size = sizeof st;
+  CHECK_STATUS(uh_session_poll(s, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(uh_session_poll_event(s, &e, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(uh_session_object_name(s, 7, &text), UH_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(uh_session_object_name(s, 0, &text), UH_OK);
+  CHECK(text != NULL && strcmp(text, "bunny") == 0);
+  {
+    const double p[3] = {0, 0, 0}, zero_q[4] = {0, 0, 0, 0}, nan_p[3] = {NAN, 0, 0}, q[4] = {1, 0, 0, 0};
+    CHECK_STATUS(uh_session_set_object_pose(s, 0, p, zero_q), UH_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(uh_session_set_object_pose(s, 0, nan_p, q), UH_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(uh_session_set_object_pose(s, 3, p, q), UH_ERROR_INVALID_ARGUMENT);
+  }
+
+  REQUIRE_OK(uh_session_start(s));
+  REQUIRE_OK(uh_session_stop(s));
+  CHECK_STATUS(uh_session_stop(s), UH_OK); /* twice */
+  CHECK_STATUS(uh_session_start(s), UH_ERROR_WRONG_STATE);
+  CHECK_STATUS(uh_session_run_stepped(s, 0.1, 4), UH_ERROR_WRONG_STATE);
+  CHECK_STATUS(uh_session_report_json(s, &text), UH_OK);
+  uh_session_close(s);
+  uh_session_close(s); /* twice: nothing */
+  uh_session_close(NULL);
+
+  CHECK_STATUS(uh_session_poll(stale_handle, &st), UH_ERROR_STALE_HANDLE);
+  CHECK(strstr(uh_last_error(), "uh_session_poll: the session handle") != NULL);
+  CHECK_STATUS(uh_session_start(stale_handle), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_stop(stale_handle), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_poll_event(stale_handle, &e, &has_event), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_object_count(stale_handle, &count), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_start(NULL), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_poll((uh_session*)(uintptr_t)0xdeadbeef0ull, &st), UH_ERROR_STALE_HANDLE);
+
+  /* a new session may reuse the slot: the old handle still refers to nothing */
+  s = open_small_session();
+  CHECK(s != stale_handle);
+  CHECK_STATUS(uh_session_poll(stale_handle, &st), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_poll(s, &st), UH_OK);
+  /* a handle of another kind is refused */
+  CHECK_STATUS(uh_tree_load("/nonexistent.ist", &tree), UH_ERROR_FAILED);
+  CHECK(tree == NULL);
+  CHECK(strstr(uh_last_error(), "/nonexistent.ist") != NULL);
+  CHECK_STATUS(uh_tree_get_info((const uh_tree*)s, NULL), UH_ERROR_INVALID_ARGUMENT);
+  {
+    uh_tree_info info;
+    info.struct_size = sizeof info;
+    CHECK_STATUS(uh_tree_get_info((const uh_tree*)s, &info), UH_ERROR_STALE_HANDLE);
+  }
+  uh_session_close(s);
+  CHECK_STATUS(uh_session_open(NULL, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(uh_session_open("/nonexistent/scene.json", &s), UH_ERROR_FAILED);
+  CHECK(s == NULL);
+  CHECK(strstr(uh_last_error(), "/nonexistent/scene.json") != NULL);
+}
+
+/* A closed cube of side 2 cm centred on the origin, as arrays (outward, counter-clockwise). */
+static const double cube_vertices[8 * 3] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,
+                                            -1, -1, 1,  1, -1, 1,  1, 1, 1,  -1, 1, 1};
+static const int32_t cube_indices[12 * 3] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                             1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+
+/* Trees from arrays, queried: against itself at the identity every leaf meets itself and no other
+ * (the packing does not overlap), so the volume is the packing's own, known from the build. */
+static void test_trees(void) {
+  uh_tree_build_def def = uh_default_tree_build_def();
+  uh_tree *a = NULL, *b = NULL;
+  uh_tree_info info;
+  uh_query_result r;
+  const double origin[3] = {0, 0, 0}, identity[4] = {1, 0, 0, 0}, far[3] = {0.1, 0, 0};
+  const double shifted[3] = {0.005, 0, 0}, scaled_identity[4] = {3, 0, 0, 0};
+  char path[512];
+  def.spheres = 400;
+  def.meters_per_unit = 0.01;
+  REQUIRE_OK(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 12, &def, &a));
+  info.struct_size = sizeof info;
+  REQUIRE_OK(uh_tree_get_info(a, &info));
+  CHECK(info.leaf_count > 100);
+  CHECK(fabs(info.mesh_volume - 8e-6) < 1e-12); /* (2 cm)^3 */
+  CHECK(info.coverage > 0.3 && info.coverage < 1.0);
+  CHECK(info.radius > 0.005 && info.radius < 0.02);
+
+  snprintf(path, sizeof path, "%s/capi_cube_test.ist", UH_TEST_TMP_DIR);
+  REQUIRE_OK(uh_tree_save(a, path));
+  REQUIRE_OK(uh_tree_load(path, &b));
+  remove(path);
+
+  r.struct_size = sizeof r;
+  REQUIRE_OK(uh_tree_query(a, b, origin, identity, &r));
+  CHECK(fabs(r.volume - info.coverage * info.mesh_volume) < 1e-4 * r.volume);
+  CHECK(fabs(r.volume_estimate - info.mesh_volume / info.coverage) < 1e-4 * r.volume_estimate);
+  CHECK(r.pair_count >= info.leaf_count);
+  CHECK(r.distance == 0.0);
+  /* B moved 5 mm along +x: it is pushed out along +x */
+  REQUIRE_OK(uh_tree_query(a, b, shifted, scaled_identity, &r));
+  CHECK(r.volume > 0.0 && r.direction[0] > 0.9);
+  /* apart: no volume, a separation */
+  REQUIRE_OK(uh_tree_query(a, b, far, identity, &r));
+  CHECK(r.volume == 0.0 && r.pair_count == 0);
+  CHECK(r.distance > 0.07 && r.distance < 0.1);
+
+  /* bad input */
+  CHECK_STATUS(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 10, &def, &b), UH_ERROR_FAILED);
+  CHECK(strstr(uh_last_error(), "not closed") != NULL);
+  def.spheres = 0;
+  CHECK_STATUS(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 12, &def, &b), UH_ERROR_FAILED);
+  CHECK_STATUS(uh_tree_query(a, NULL, origin, identity, &r), UH_ERROR_STALE_HANDLE);
+  {
+    const double zero_q[4] = {0, 0, 0, 0};
+    CHECK_STATUS(uh_tree_query(a, a, origin, zero_q, &r), UH_ERROR_INVALID_ARGUMENT);
+  }
+  uh_tree_free(b);
+  CHECK_STATUS(uh_tree_query(a, b, origin, identity, &r), UH_ERROR_STALE_HANDLE);
+  uh_tree_free(b); /* twice: nothing */
+  uh_tree_free(a);
+}
+
+/* Scenes through calls: objects from a tree, removal, watch, device config errors. */
+static void test_scene_building(void) {
+  uh_scene* scene = small_scene();
+  uh_object_def cube = uh_default_object_def();
+  uh_tool_def tool = uh_default_tool_def();
+  uh_tree_build_def def = uh_default_tree_build_def();
+  uh_tree* tree = NULL;
+  uh_session* s = NULL;
+  int32_t count = 0, index = -1;
+  const char* name = NULL;
+  def.spheres = 200;
+  def.meters_per_unit = 0.01;
+  REQUIRE_OK(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 12, &def, &tree));
+  cube.name = "cube";
+  cube.shape.tree = tree;
+  cube.position[0] = 0.2; /* beside the bunny, never touched */
+  REQUIRE_OK(uh_scene_add_object(scene, &cube, &index));
+  CHECK(index == 1);
+  uh_tree_free(tree); /* the scene keeps its own reference */
+  CHECK_STATUS(uh_scene_add_object(scene, &cube, NULL), UH_ERROR_INVALID_ARGUMENT); /* duplicate name */
+  cube.name = "two sources";
+  cube.shape = mesh_shape("stylus.obj", 100);
+  cube.shape.ist_path = "x.ist";
+  CHECK_STATUS(uh_scene_add_object(scene, &cube, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "exactly one") != NULL);
+  cube.shape = mesh_shape("missing.obj", 100);
+  CHECK_STATUS(uh_scene_add_object(scene, &cube, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "missing.obj") != NULL);
+  REQUIRE_OK(uh_scene_object_count(scene, &count));
+  CHECK(count == 2);
+
+  REQUIRE_OK(uh_session_create(scene, NULL, &s));
+  REQUIRE_OK(uh_session_object_count(s, &count));
+  CHECK(count == 2);
+  REQUIRE_OK(uh_session_object_name(s, 1, &name));
+  CHECK(strcmp(name, "cube") == 0);
+  REQUIRE_OK(uh_session_run_stepped(s, 0.5, 4));
+  uh_session_close(s);
+
+  CHECK_STATUS(uh_scene_remove_object(scene, "nothing"), UH_ERROR_INVALID_ARGUMENT);
+  REQUIRE_OK(uh_scene_remove_object(scene, "cube"));
+  REQUIRE_OK(uh_scene_object_count(scene, &count));
+  CHECK(count == 1);
+  REQUIRE_OK(uh_scene_watch(scene, "bunny", 0));
+  REQUIRE_OK(uh_session_create(scene, NULL, &s));
+  CHECK_STATUS(uh_session_start(s), UH_ERROR_FAILED); /* nothing watched */
+  uh_session_close(s);
+  REQUIRE_OK(uh_scene_watch(scene, "bunny", 1));
+
+  tool.shape = mesh_shape("stylus.obj", 150);
+  tool.device_config_json = "{\"start\": {\"x\": 1}}";
+  CHECK_STATUS(uh_scene_set_tool(scene, &tool), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "start") != NULL);
+  tool.device_config_json = "{not json";
+  CHECK_STATUS(uh_scene_set_tool(scene, &tool), UH_ERROR_INVALID_ARGUMENT);
+  tool.device_config_json = NULL;
+  tool.device_driver = "phantom-omni";
+  REQUIRE_OK(uh_scene_set_tool(scene, &tool));
+  CHECK_STATUS(uh_session_create(scene, NULL, &s), UH_ERROR_FAILED);
+  CHECK(strstr(uh_last_error(), "phantom-omni") != NULL);
+  CHECK_STATUS(uh_scene_set_rates(scene, 0.5, 100), UH_ERROR_INVALID_ARGUMENT);
+  uh_scene_free(scene);
+  uh_scene_free(scene);
+  CHECK_STATUS(uh_scene_object_count(scene, &count), UH_ERROR_STALE_HANDLE);
+
+  REQUIRE_OK(uh_scene_create("empty", &scene));
+  CHECK_STATUS(uh_session_create(scene, NULL, &s), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "no tool") != NULL);
+  uh_scene_free(scene);
+}
+
+int main(int argc, char** argv) {
+  static const struct {
+    const char* name;
+    void (*run)(void);
+  } tests[] = {{"version", test_version},
+               {"default_session_stepped", test_default_session_stepped},
+               {"threaded_session", test_threaded_session},
+               {"several_sessions", test_several_sessions},
+               {"handle_misuse", test_handle_misuse},
+               {"trees", test_trees},
+               {"scene_building", test_scene_building}};
+  size_t i;
+  if (argc != 2) {
+    fprintf(stderr, "usage: %s TEST\n", argv[0]);
+    return 2;
+  }
+  for (i = 0; i < sizeof tests / sizeof tests[0]; ++i) {
+    if (strcmp(argv[1], tests[i].name) == 0) {
+      tests[i].run();
+      printf("%s: %s (%d failed checks)\n", tests[i].name, failures == 0 ? "passed" : "FAILED", failures);
+      return failures == 0 ? 0 : 1;
+    }
+  }
+  fprintf(stderr, "unknown test '%s'\n", argv[1]);
+  return 2;
+}
