@@ -1,0 +1,131 @@
+"""Sessions from Python: the default scene, a scene built through calls, threads, the context manager."""
+import json
+import pathlib
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import unrealhaptics as uh
+from conftest import CUBE_TRIANGLES, CUBE_VERTICES, small_scene
+
+
+def test_version_and_api():
+    assert isinstance(uh.__version__, str) and uh.__version__.count(".") == 2
+    assert uh.api_version == 1
+
+
+def test_default_session_stepped_reads_contact_and_force():
+    with uh.Session.open() as s:  # the default scene (bunny sweep)
+        assert s.object_names == ["bunny"]
+        report = s.run_stepped(3.0, 4)
+        st = s.state()
+        events = s.events()
+    assert report["mode"] == "stepped" and report["haptic"]["ticks"] == 3000
+    assert report["contact"]["ticks"] > 0
+    assert st.haptic_ticks == 3000
+    for name, shape in (("tool_position", (3,)), ("tool_orientation", (4,)), ("force", (3,)), ("torque", (3,))):
+        value = getattr(st, name)
+        assert isinstance(value, np.ndarray) and value.shape == shape and value.dtype == np.float64
+    assert abs(np.linalg.norm(st.tool_orientation) - 1.0) < 1e-9
+    assert np.linalg.norm(st.force) <= report["force"]["max_n"] + 1e-12
+    begins = [e for e in events if e.kind == "begin"]
+    assert begins and all(e.object == 0 and e.volume > 0 and e.pairs > 0 for e in begins)
+
+
+def test_threaded_session_polls_state_and_stop_returns_the_report(scene):
+    with uh.Session.open(scene) as s:
+        s.start()
+        max_force, max_pairs, ticks, begins = 0.0, 0, [], 0
+        end = time.monotonic() + 1.2
+        while time.monotonic() < end:
+            st = s.state()
+            max_force = max(max_force, float(np.linalg.norm(st.force)))
+            max_pairs = max(max_pairs, st.contact_pairs)
+            ticks.append(st.haptic_ticks)
+            begins += sum(e.kind == "begin" for e in s.events())
+            time.sleep(0.002)
+        report = s.stop()
+        assert s.stop() == report  # idempotent: the same report
+        after = s.state()
+    assert ticks == sorted(ticks) and ticks[-1] > 300
+    assert 0.1 < max_force <= 6.0 + 1e-9
+    assert max_pairs > 0 and begins >= 1
+    assert np.linalg.norm(after.force) == 0.0  # the device got zero at stop
+    assert report["mode"] == "threaded"
+    assert report["force"]["max_n"] >= max_force - 1e-9
+    assert set(report) == {"scene", "mode", "seconds", "haptic", "collision", "force", "contact", "energy"}
+
+
+def test_report_is_the_uh_run_json_object(scene):
+    """stop() gives the same object, key for key, that `uh run --json` prints."""
+    with uh.Session.open(scene) as s:
+        report = s.run_stepped(0.2, 4)
+    uh_program = pathlib.Path(uh.__file__).resolve().parents[1] / "apps" / "uh" / "uh"  # the same build
+    assert uh_program.exists(), "build the uh program with the module"
+    printed = json.loads(subprocess.run([str(uh_program), "run", "--stepped", "--seconds", "0.2", "--json"],
+                                        check=True, capture_output=True, text=True).stdout)
+
+    def keys(d, prefix=""):
+        return {prefix + k for k in d} | {x for k, v in d.items() if isinstance(v, dict) for x in keys(v, prefix + k + ".")}
+    assert keys(report) == keys(printed)
+
+
+def test_leaving_the_block_stops_and_closes_even_on_error(scene):
+    with pytest.raises(ZeroDivisionError):
+        with uh.Session.open(scene) as s:
+            s.start()
+            1 / 0
+    with pytest.raises(uh.UhError) as error:
+        s.state()
+    assert error.value.status == "UH_ERROR_STALE_HANDLE"
+    s.close()  # twice: nothing
+
+
+def test_several_sessions_at_once():
+    a, b = uh.Session.open(small_scene()), uh.Session.open(small_scene())
+    a.start()
+    b.start()
+    time.sleep(0.8)
+    ra, rb = a.stop(), b.stop()
+    a.close()
+    b.close()
+    assert ra["contact"]["ticks"] > 0 and rb["contact"]["ticks"] > 0
+
+
+def test_long_calls_release_the_gil():
+    """A stepped run holds no GIL: this thread keeps running Python while it works."""
+    s = uh.Session.open()  # the default scene: 10,000 spheres each, about a second of work
+    worker = threading.Thread(target=s.run_stepped, args=(3.0, 1))
+    worker.start()
+    time.sleep(0.05)
+    still_inside = worker.is_alive()  # this thread woke up while the worker was in the C call
+    worker.join()
+    s.close()
+    assert still_inside
+
+
+def test_moving_an_object_moves_the_contact(scene):
+    """The bunny moved 20 cm away while the session runs: no more contact."""
+    with uh.Session.open(scene) as s:
+        s.set_object_pose(0, (0.2, 0, 0), (1, 0, 0, 0))
+        report = s.run_stepped(1.0, 4)
+    assert report["contact"]["ticks"] == 0
+    with pytest.raises(uh.UhError, match="no object 5"):
+        uh.Session.open(small_scene()).set_object_pose(5, (0, 0, 0), (1, 0, 0, 0))
+
+
+def test_bad_input_raises_with_a_message(scene):
+    with pytest.raises(uh.UhError, match="missing.json"):
+        uh.Session.open("missing.json")
+    with pytest.raises(uh.UhError, match="exactly one"):
+        scene.add_object("x", mesh="a.obj", ist="b.ist")
+    with pytest.raises(uh.UhError, match="start"):
+        scene.set_tool(vertices=CUBE_VERTICES, triangles=CUBE_TRIANGLES, spheres=50, device="sim-line",
+                       config={"start": {"x": 1}})
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        scene.set_tool(meshh="x")
+    with pytest.raises(ValueError):
+        uh.Session.open(scene).set_object_pose(0, (0, 0), (1, 0, 0, 0))
