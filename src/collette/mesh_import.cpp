@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <numeric>
 #include <system_error>
-#include <unordered_map>
 
 namespace uh::collette {
 namespace {
@@ -31,9 +30,13 @@ struct CellKey {
 };
 struct CellHash {
   std::size_t operator()(const CellKey& k) const {
-    const auto h = static_cast<std::uint64_t>(k.x) * 73856093ULL ^
-                   static_cast<std::uint64_t>(k.y) * 19349663ULL ^
-                   static_cast<std::uint64_t>(k.z) * 83492791ULL;
+    // spread every input bit over the word (splitmix64 finaliser): the table is indexed by the low bits
+    std::uint64_t h = static_cast<std::uint64_t>(k.x) * 0x9E3779B97F4A7C15ULL ^
+                      static_cast<std::uint64_t>(k.y) * 0xC2B2AE3D27D4EB4FULL ^
+                      static_cast<std::uint64_t>(k.z) * 0x165667B19E3779F9ULL;
+    h ^= h >> 31;
+    h *= 0xBF58476D1CE4E5B9ULL;
+    h ^= h >> 29;
     return static_cast<std::size_t>(h);
   }
 };
@@ -64,8 +67,19 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
     }
     return map;
   }
-  std::unordered_map<CellKey, std::vector<std::int32_t>, CellHash> cells;
-  cells.reserve(v.size());
+  // cells of edge `tol` in an open-addressing table (one allocation, no node per cell); each cell
+  // heads a list of the kept vertices in it, linked through `next`
+  std::size_t capacity = 16;
+  while (capacity < 2 * v.size()) capacity *= 2;
+  const std::size_t mask = capacity - 1;
+  std::vector<CellKey> keys(capacity);
+  std::vector<std::int32_t> heads(capacity, -1);
+  std::vector<std::int32_t> next(v.size(), -1);
+  auto slot_of = [&](const CellKey& k) {
+    std::size_t s = CellHash{}(k)&mask;
+    while (heads[s] >= 0 && !(keys[s] == k)) s = (s + 1) & mask;
+    return s;
+  };
   const double tol2 = tol * tol;
   for (std::size_t i = 0; i < v.size(); ++i) {
     const CellKey k{static_cast<std::int64_t>(std::floor(v[i].x / tol)),
@@ -75,9 +89,8 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
     for (std::int64_t dx = -1; dx <= 1; ++dx) {
       for (std::int64_t dy = -1; dy <= 1; ++dy) {
         for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find({k.x + dx, k.y + dy, k.z + dz});
-          if (it == cells.end()) continue;
-          for (const std::int32_t j : it->second) {
+          for (std::int32_t j = heads[slot_of({k.x + dx, k.y + dy, k.z + dz})]; j >= 0;
+               j = next[static_cast<std::size_t>(j)]) {
             if (squared_norm(v[static_cast<std::size_t>(j)] - v[i]) <= tol2 && (found < 0 || j < found))
               found = j;
           }
@@ -88,7 +101,10 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
       map[i] = found;
     } else {
       map[i] = static_cast<std::int32_t>(i);
-      cells[k].push_back(static_cast<std::int32_t>(i));
+      const std::size_t s = slot_of(k);
+      keys[s] = k;
+      next[i] = heads[s];
+      heads[s] = static_cast<std::int32_t>(i);
     }
   }
   return map;

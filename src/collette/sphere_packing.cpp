@@ -289,6 +289,13 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
           const std::int32_t id = interior_of[static_cast<std::size_t>(i + nx * (j + ny * k))];
           if (id < 0) continue;
           const Vec3 p = centre(i, j, k);
+          // the triangle is no nearer than its box: most visits after the first few triangles
+          // around a voxel end here, with the same result as the exact test below
+          const double bx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
+          const double by = std::max({lo.y - p.y, 0.0, p.y - hi.y});
+          const double bz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+          const auto known = static_cast<double>(dsurf[static_cast<std::size_t>(id)]);
+          if (bx * bx + by * by + bz * bz >= known * known) continue;
           const Vec3 q = detail::closest_point_on_triangle(p, t);
           const auto d = static_cast<float>(norm(q - p));
           if (d < dsurf[static_cast<std::size_t>(id)]) {

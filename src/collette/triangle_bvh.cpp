@@ -72,21 +72,29 @@ TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices,
   for (std::size_t i = 0; i < tris_.size(); ++i) centroids[i] = (tris_[i].a + tris_[i].b + tris_[i].c) / 3.0;
   nodes_.reserve(2 * tris_.size() / kLeafSize + 2);
   nodes_.push_back({});
-  build(0, 0, static_cast<std::int32_t>(tris_.size()), centroids);
+  // the build permutes triangle ids only; the triangles are put in leaf order once at the end
+  std::vector<std::int32_t> order(tris_.size());
+  std::iota(order.begin(), order.end(), 0);
+  build(0, 0, static_cast<std::int32_t>(tris_.size()), order, centroids);
+  std::vector<Triangle> in_leaf_order(tris_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) in_leaf_order[i] = tris_[static_cast<std::size_t>(order[i])];
+  tris_.swap(in_leaf_order);
 }
 
-void TriangleBvh::build(std::int32_t node, std::int32_t first, std::int32_t count, std::vector<Vec3>& centroids) {
+void TriangleBvh::build(std::int32_t node, std::int32_t first, std::int32_t count,
+                        std::vector<std::int32_t>& order, const std::vector<Vec3>& centroids) {
   Vec3 lo{1e300, 1e300, 1e300};
   Vec3 hi{-1e300, -1e300, -1e300};
   Vec3 clo = lo;
   Vec3 chi = hi;
   for (std::int32_t i = first; i < first + count; ++i) {
-    const Triangle& t = tris_[static_cast<std::size_t>(i)];
+    const auto id = static_cast<std::size_t>(order[static_cast<std::size_t>(i)]);
+    const Triangle& t = tris_[id];
     for (const Vec3& v : {t.a, t.b, t.c}) {
       lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
       hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
     }
-    const Vec3& c = centroids[static_cast<std::size_t>(i)];
+    const Vec3& c = centroids[id];
     clo = {std::min(clo.x, c.x), std::min(clo.y, c.y), std::min(clo.z, c.z)};
     chi = {std::max(chi.x, c.x), std::max(chi.y, c.y), std::max(chi.z, c.z)};
   }
@@ -99,30 +107,21 @@ void TriangleBvh::build(std::int32_t node, std::int32_t first, std::int32_t coun
   }
   const Vec3 ext = chi - clo;
   const int axis = (ext.x >= ext.y && ext.x >= ext.z) ? 0 : (ext.y >= ext.z ? 1 : 2);
-  // median split on the longest centroid axis: balanced depth, deterministic (ties by index)
-  std::vector<std::int32_t> order(static_cast<std::size_t>(count));
-  std::iota(order.begin(), order.end(), first);
+  // median split on the longest centroid axis: balanced depth, deterministic (ties by id)
   const std::int32_t half = count / 2;
-  std::nth_element(order.begin(), order.begin() + half, order.end(), [&](std::int32_t a, std::int32_t b) {
+  const auto begin = order.begin() + first;
+  std::nth_element(begin, begin + half, begin + count, [&](std::int32_t a, std::int32_t b) {
     const double ca = component(centroids[static_cast<std::size_t>(a)], axis);
     const double cb = component(centroids[static_cast<std::size_t>(b)], axis);
     return ca < cb || (ca == cb && a < b);
   });
-  std::vector<Triangle> tmp_t(static_cast<std::size_t>(count));
-  std::vector<Vec3> tmp_c(static_cast<std::size_t>(count));
-  for (std::int32_t i = 0; i < count; ++i) {
-    tmp_t[static_cast<std::size_t>(i)] = tris_[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
-    tmp_c[static_cast<std::size_t>(i)] = centroids[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
-  }
-  std::copy(tmp_t.begin(), tmp_t.end(), tris_.begin() + first);
-  std::copy(tmp_c.begin(), tmp_c.end(), centroids.begin() + first);
   const auto left = static_cast<std::int32_t>(nodes_.size());
   nodes_.push_back({});
   nodes_.push_back({});
   nodes_[static_cast<std::size_t>(node)].first = left;
   nodes_[static_cast<std::size_t>(node)].count = 0;
-  build(left, first, half, centroids);
-  build(left + 1, first + half, count - half, centroids);
+  build(left, first, half, order, centroids);
+  build(left + 1, first + half, count - half, order, centroids);
 }
 
 double TriangleBvh::closest(const Vec3& p, Vec3* nearest, double max_d2) const {
@@ -215,7 +214,8 @@ void TriangleBvh::ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& 
   }
 }
 
-void TriangleBvh::ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<std::pair<double, int>>& hits) const {
+void TriangleBvh::ray_hits(const Vec3& o, const Vec3& d, double t_max,
+                           std::vector<std::pair<double, int>>& hits) const {
   ray_visit(o, d, t_max, [&](double t, int w) { hits.emplace_back(t, w); });
 }
 

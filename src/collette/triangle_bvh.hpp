@@ -51,7 +51,8 @@ class TriangleBvh {
   const std::vector<Triangle>& triangles() const { return tris_; }
 
  private:
-  void build(std::int32_t node, std::int32_t first, std::int32_t count, std::vector<Vec3>& centroids);
+  void build(std::int32_t node, std::int32_t first, std::int32_t count, std::vector<std::int32_t>& order,
+             const std::vector<Vec3>& centroids);
   template <typename Visit>
   void ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& visit) const;
 
