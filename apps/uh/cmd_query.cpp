@@ -16,6 +16,7 @@
 #include "uh/collette/ist_file.hpp"
 #include "uh/collette/time_critical_query.hpp"
 #include "uh/collette/volume_query.hpp"
+#include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::cli {
 namespace {
@@ -41,27 +42,16 @@ struct QueryRow {
   double time_us = 0.0;
 };
 
-// Writes next to the target, then renames, so an existing results file is never left half-written.
+// An existing results file is replaced only by a complete new one.
 Status write_results_csv(const std::filesystem::path& path, const std::vector<QueryRow>& rows) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) return Error{fmt::format("{}: cannot write (is the directory there and writable?)", path.string())};
-    out << "id,volume,nx,ny,nz,pairs,distance,time_us\n";
-    for (const QueryRow& r : rows)
-      out << fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.3f}\n", r.id, r.volume, r.normal.x, r.normal.y,
-                         r.normal.z, r.pairs, r.distance, r.time_us);
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      return Error{fmt::format("{}: write failed", path.string())};
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return Error{fmt::format("{}: cannot replace the file: {}", path.string(), ec.message())};
-  return Ok{};
+  auto file = AtomicFileWriter::create(path);
+  if (!file) return file.error();
+  std::ostream& out = file->stream();
+  out << "id,volume,nx,ny,nz,pairs,distance,time_us\n";
+  for (const QueryRow& r : rows)
+    out << fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.3f}\n", r.id, r.volume, r.normal.x, r.normal.y,
+                       r.normal.z, r.pairs, r.distance, r.time_us);
+  return file->commit();
 }
 
 double percentile(std::vector<double> values, double q) {

@@ -3,7 +3,6 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <optional>
 #include <string>
 
@@ -14,6 +13,7 @@
 #include "session_plot.hpp"
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::cli {
 namespace {
@@ -76,14 +76,14 @@ int run_session(const RunArgs& args) {
   bar.reset();
   if (!session) return fail(session.error().message);
 
-  std::ofstream trace_file;
-  std::string trace_tmp;
+  // the trace replaces an earlier file only once it is complete
+  std::optional<AtomicFileWriter> trace_file;
   if (!args.trace.empty()) {
-    trace_tmp = args.trace + ".tmp";
-    trace_file.open(trace_tmp);
-    if (!trace_file) return fail(fmt::format("{}: cannot write the trace", args.trace));
+    auto created = AtomicFileWriter::create(args.trace);
+    if (!created) return fail(created.error().message);
+    trace_file.emplace(std::move(*created));
   }
-  std::ostream* trace = args.trace.empty() ? nullptr : &trace_file;
+  std::ostream* trace = trace_file ? &trace_file->stream() : nullptr;
   const double seconds = args.seconds > 0.0 ? args.seconds : scene->seconds;
   const char* ci = std::getenv("CI");
   const bool live = !args.json && isatty(STDERR_FILENO) == 1 && (ci == nullptr || *ci == '\0');
@@ -97,13 +97,10 @@ int run_session(const RunArgs& args) {
                                               },
                                               trace);
   if (live) std::fputc('\n', stderr);
+  // a session that ended in an error keeps its trace too: it shows what happened up to the end
+  const Status traced = trace_file ? trace_file->commit() : Status{Ok{}};
   if (!ran) return fail(ran.error().message);
-  if (trace != nullptr) {
-    trace_file.close();
-    std::error_code ec;
-    std::filesystem::rename(trace_tmp, args.trace, ec);
-    if (ec) return fail(fmt::format("{}: cannot write the trace: {}", args.trace, ec.message()));
-  }
+  if (!traced) return fail(traced.error().message);
   const auto& report = (*session)->report();
   if (!args.plot.empty())
     if (auto plotted = write_session_plot(report, args.plot); !plotted) return fail(plotted.error().message);

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/atomic_file_writer.hpp"
 #include "uh/core/math.hpp"
 
 namespace uh::cli {
@@ -124,6 +125,16 @@ Series decimate(const std::vector<double>& t, const std::vector<double>& v) {
   return out;
 }
 
+// cairo's PNG output callback: append to the std::string behind `closure`
+cairo_status_t append_png_bytes(void* closure, const unsigned char* data, unsigned int length) {
+  try {
+    static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+  } catch (...) {
+    return CAIRO_STATUS_NO_MEMORY;  // an exception must not cross cairo's C frames
+  }
+  return CAIRO_STATUS_SUCCESS;
+}
+
 }  // namespace
 
 Status write_session_plot(const controllers::SessionReport& report, const std::filesystem::path& png) {
@@ -160,18 +171,13 @@ Status write_session_plot(const controllers::SessionReport& report, const std::f
   draw_panel(cr, torque, 0, kPanelHeight, kWidth, kPanelHeight, t_max);
   draw_panel(cr, collision, 0, 2 * kPanelHeight, kWidth, kPanelHeight, t_max);
   cairo_destroy(cr);
-  const std::filesystem::path tmp = png.string() + ".tmp";
-  const cairo_status_t status = cairo_surface_write_to_png(surface, tmp.c_str());
+  std::string bytes;
+  const cairo_status_t status = cairo_surface_write_to_png_stream(surface, append_png_bytes, &bytes);
   cairo_surface_destroy(surface);
   if (status != CAIRO_STATUS_SUCCESS) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
     return Error{fmt::format("{}: cannot write the plot: {}", png.string(), cairo_status_to_string(status))};
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, png, ec);
-  if (ec) return Error{fmt::format("{}: cannot write the plot: {}", png.string(), ec.message())};
-  return Ok{};
+  return write_file_atomically(png, bytes);
 }
 
 }  // namespace uh::cli

@@ -1,20 +1,19 @@
 #include "uh/collette/ist_file.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <tuple>
+
+#include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::collette {
 namespace {
@@ -357,36 +356,8 @@ Status save_ist(const std::filesystem::path& path, const IstAsset& asset) {
   const std::string name = path.string();
   if (const Status ok = validate(asset); !ok) return Error{name + ": not saved: " + ok.error().message};
   const std::vector<std::byte> bytes = encode_ist(asset);
-  const std::string tmp = name + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return Error{name + ": cannot create temporary file " + tmp + ": " + std::strerror(errno)};
-  auto fail = [&](const char* what) {
-    const std::string msg = name + ": " + what + ": " + std::strerror(errno);
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    return Error{msg};
-  };
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (w < 0) {
-      if (errno == EINTR) continue;
-      return fail("write failed");
-    }
-    done += static_cast<std::size_t>(w);
-  }
-  if (::fsync(fd) != 0) return fail("fsync failed");
-  if (::close(fd) != 0) {
-    const std::string msg = name + ": close failed: " + std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return Error{msg};
-  }
-  if (::rename(tmp.c_str(), name.c_str()) != 0) {
-    const std::string msg = name + ": cannot rename the temporary file into place: " + std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return Error{msg};
-  }
-  return Ok{};
+  return write_file_atomically(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace uh::collette

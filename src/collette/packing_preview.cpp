@@ -1,15 +1,15 @@
 #include "uh/collette/packing_preview.hpp"
 
 #include <png.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
 #include <limits>
-#include <system_error>
+#include <string>
+
+#include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::collette {
 namespace {
@@ -29,23 +29,32 @@ Rgb ramp(double t) {
   return {a.r + (b.r - a.r) * f, a.g + (b.g - a.g) * f, a.b + (b.b - a.b) * f};
 }
 
-Status write_png(const std::filesystem::path& path, int w, int h, const std::vector<unsigned char>& rgb) {
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) return Error{fmt::format("{}: cannot open for writing", path.string())};
+// libpng's output callback: append to the std::string behind png_get_io_ptr
+void append_png_bytes(png_structp png, png_bytep data, png_size_t size) {
+  auto* out = static_cast<std::string*>(png_get_io_ptr(png));
+  try {
+    out->append(reinterpret_cast<const char*>(data), size);
+  } catch (...) {
+    png_error(png, "out of memory");  // longjmps; an exception must not cross libpng's C frames
+  }
+}
+
+// the PNG bytes of an RGB picture; an empty string if libpng fails
+std::string encode_png(int w, int h, const std::vector<unsigned char>& rgb) {
+  std::string out;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
     png_destroy_write_struct(&png, nullptr);
-    std::fclose(file);
-    return Error{fmt::format("{}: libpng could not start", path.string())};
+    return {};
   }
-  // libpng reports errors by longjmp; nothing with a destructor lives between here and the end
+  // libpng reports errors by longjmp; nothing with a destructor starts living between here and the end
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    return Error{fmt::format("{}: libpng failed while writing", path.string())};
+    out.clear();
+    return out;
   }
-  png_init_io(png, file);
+  png_set_write_fn(png, &out, append_png_bytes, nullptr);
   png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
@@ -54,8 +63,7 @@ Status write_png(const std::filesystem::path& path, int w, int h, const std::vec
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0) return Error{fmt::format("{}: write failed (disk full?)", path.string())};
-  return Ok{};
+  return out;
 }
 
 }  // namespace
@@ -147,24 +155,9 @@ Status write_packing_preview(const std::vector<Sphere>& spheres, const std::file
     }
   }
 
-  // write next to the target and rename, so a failure never leaves a half-written file there
-  const std::filesystem::path dir = png.has_parent_path() ? png.parent_path() : std::filesystem::path(".");
-  // process id plus a per-process counter: concurrent writers never share a temporary file
-  static std::atomic<unsigned> counter{0};
-  const std::filesystem::path tmp =
-      dir / fmt::format(".{}.tmp{}-{}", png.filename().string(), static_cast<long>(::getpid()), counter.fetch_add(1));
-  Status st = write_png(tmp, w, h, rgb);
-  std::error_code ec;
-  if (!st) {
-    std::filesystem::remove(tmp, ec);
-    return st;
-  }
-  std::filesystem::rename(tmp, png, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    return Error{fmt::format("{}: cannot move the finished picture into place: {}", png.string(), ec.message())};
-  }
-  return Ok{};
+  const std::string bytes = encode_png(w, h, rgb);
+  if (bytes.empty()) return Error{fmt::format("{}: libpng could not encode the picture", png.string())};
+  return write_file_atomically(png, bytes);
 }
 
 }  // namespace uh::collette

@@ -12,6 +12,7 @@
 #include "embedded_assets.hpp"
 #include "uh/collette/ist_builder.hpp"
 #include "uh/collette/ist_file.hpp"
+#include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::controllers {
 namespace {
@@ -406,16 +407,7 @@ Status write_if_changed(const std::filesystem::path& path, std::string_view text
       if (existing.str() == text) return Ok{};
     }
   }
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!out) return Error{fmt::format("{}: cannot write", tmp.string())};
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return Error{fmt::format("{}: cannot write: {}", path.string(), ec.message())};
-  return Ok{};
+  return write_file_atomically(path, text);
 }
 
 }  // namespace

@@ -14,26 +14,30 @@ Result<std::unique_ptr<TraceCsvWriter>> TraceCsvWriter::start(HapticManager& man
     return Error{"trace writer: the haptic manager records no trace (set HapticManagerOptions::trace_capacity)"};
   }
   if (!(options.drain_period_s > 0.0)) return Error{"trace writer: drain_period_s must be positive"};
-  std::ofstream file(path);
-  if (!file) return Error{fmt::format("{}: cannot create the trace file", path)};
-  write_trace_header(file);
-  return std::unique_ptr<TraceCsvWriter>(new TraceCsvWriter(manager, std::move(file), options));
+  auto file = AtomicFileWriter::create(path);
+  if (!file) return file.error();
+  write_trace_header(file->stream());
+  return std::unique_ptr<TraceCsvWriter>(new TraceCsvWriter(manager, std::move(*file), options));
 }
 
-TraceCsvWriter::TraceCsvWriter(HapticManager& manager, std::ofstream file, const TraceCsvWriterOptions& options)
+TraceCsvWriter::TraceCsvWriter(HapticManager& manager, AtomicFileWriter file, const TraceCsvWriterOptions& options)
     : manager_(manager), file_(std::move(file)), options_(options) {
   thread_ = std::thread([this] { run(); });
 }
 
-TraceCsvWriter::~TraceCsvWriter() { stop(); }
+TraceCsvWriter::~TraceCsvWriter() { (void)stop(); }
 
-void TraceCsvWriter::stop() {
+Status TraceCsvWriter::stop() {
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     stop_requested_ = true;
   }
   wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  if (thread_.joinable()) {
+    thread_.join();
+    written_ = file_.commit();
+  }
+  return written_;
 }
 
 void TraceCsvWriter::run() {
@@ -42,11 +46,8 @@ void TraceCsvWriter::run() {
   while (true) {
     const bool stopping = wake_.wait_for(lock, period, [this] { return stop_requested_; });
     lock.unlock();
-    rows_.fetch_add(manager_.drain_trace(file_), std::memory_order_relaxed);
-    if (stopping) {
-      file_.flush();
-      return;
-    }
+    rows_.fetch_add(manager_.drain_trace(file_.stream()), std::memory_order_relaxed);
+    if (stopping) return;
     lock.lock();
   }
 }

@@ -54,10 +54,11 @@ class CliTest : public ::testing::Test {
 
   static fs::path bunny() { return fs::path(UH_TEST_DATA_DIR) / "meshes" / "bunny_npm_3674.obj"; }
 
-  static CommandRun uh(const std::string& arguments) {
+  // `shell_prefix` runs before the program in the same shell (e.g. a ulimit)
+  static CommandRun uh(const std::string& arguments, const std::string& shell_prefix = "") {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command =
-        fmt::format("'{}' {} > '{}' 2> '{}'", UH_CLI_PATH, arguments, out.string(), err.string());
+    const std::string command = fmt::format("{}'{}' {} > '{}' 2> '{}'", shell_prefix, UH_CLI_PATH, arguments,
+                                            out.string(), err.string());
     const int status = std::system(command.c_str());
     CommandRun r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -386,6 +387,42 @@ TEST_F(CliTest, BadInputGetsAnErrorNamingTheFileAndWritesNothing) {
   EXPECT_NE(n.err.find("bad_number.csv:4: column 'ty' (field 3) is 'oops', expected a finite number"), std::string::npos)
       << n.err;
   EXPECT_FALSE(fs::exists(results));
+}
+
+// A write that fails half-way (here at a file size limit, as on a full disk) leaves the earlier
+// output whole and no temporary file behind.
+TEST_F(CliTest, FailedWritesLeaveEarlierOutputsWhole) {
+  const fs::path out_dir = dir_ / "limited";
+  fs::create_directories(out_dir);
+  const fs::path results = out_dir / "results.csv", ist = out_dir / "bunny.ist";
+  std::ofstream(results) << "earlier results";
+  std::ofstream(ist) << "earlier tree";
+  const fs::path poses = write_poses(dir_ / "many_poses.csv", 400, -4.0, 2.0);
+  // files of at most 16 blocks (8 KiB); SIGXFSZ ignored so that the write fails with EFBIG
+  const std::string limit = "trap '' XFSZ; ulimit -f 16; ";
+
+  const CommandRun q = uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", (dir_ / "bunny.ist").string(),
+                                      poses.string(), results.string()),
+                          limit);
+  EXPECT_NE(q.exit_code, 0);
+  EXPECT_NE(q.err.find(results.string() + ": write failed: File too large"), std::string::npos) << q.err;
+  EXPECT_EQ(read_text(results), "earlier results");
+
+  const CommandRun b = uh(fmt::format("ist build '{}' -o '{}' --spheres 600", bunny().string(), ist.string()), limit);
+  EXPECT_NE(b.exit_code, 0);
+  EXPECT_NE(b.err.find(ist.string() + ": write failed: File too large"), std::string::npos) << b.err;
+  EXPECT_EQ(read_text(ist), "earlier tree");
+
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(out_dir)) files += e.is_regular_file() ? 1 : 0;
+  EXPECT_EQ(files, 2) << "no temporary file may be left behind";
+
+  // without the limit both succeed and replace the files
+  ASSERT_EQ(uh(fmt::format("query '{0}' '{0}' --poses '{1}' --out '{2}'", (dir_ / "bunny.ist").string(),
+                           poses.string(), results.string()))
+                .exit_code,
+            0);
+  EXPECT_EQ(read_text(results).rfind("id,volume,", 0), 0u);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@ TEST(TraceCsvWriter, WritesEveryTickOfAThreadedRun) {
   const std::string path = testing::TempDir() + "uh_trace_writer_test.csv";
   HapticManager manager(std::make_unique<SimLineDevice>(SimLineOptions{}), {.trace_capacity = 4096});
   manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {0, 0, 1}; });
+  std::ofstream(path) << "an earlier trace\n";
   auto writer = TraceCsvWriter::start(manager, path, {.drain_period_s = 0.01});
   ASSERT_TRUE(writer) << writer.error().message;
   ASSERT_TRUE(manager.start());
@@ -26,7 +27,14 @@ TEST(TraceCsvWriter, WritesEveryTickOfAThreadedRun) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   manager.stop();
-  (*writer)->stop();
+  {
+    // the earlier file stays whole until the new trace is complete
+    std::ifstream before(path);
+    std::string first;
+    std::getline(before, first);
+    EXPECT_EQ(first, "an earlier trace");
+  }
+  ASSERT_TRUE((*writer)->stop());
   const HapticStats stats = manager.stats();
   EXPECT_EQ(stats.trace_dropped, 0u);
   EXPECT_EQ((*writer)->rows_written(), stats.ticks);
@@ -48,7 +56,7 @@ TEST(TraceCsvWriter, RefusesManagerWithoutTraceAndUnwritablePath) {
             "trace writer: the haptic manager records no trace (set HapticManagerOptions::trace_capacity)");
   HapticManager manager(std::make_unique<SimLineDevice>(SimLineOptions{}), {.trace_capacity = 16});
   EXPECT_EQ(TraceCsvWriter::start(manager, "/nonexistent/dir/t.csv").error().message,
-            "/nonexistent/dir/t.csv: cannot create the trace file");
+            "/nonexistent/dir/t.csv: cannot create a file in /nonexistent/dir: No such file or directory");
 }
 
 }  // namespace

@@ -5,12 +5,12 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <fstream>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 
+#include "uh/core/atomic_file_writer.hpp"
 #include "uh/core/result.hpp"
 
 namespace uh::haptico {
@@ -30,27 +30,30 @@ struct TraceCsvWriterOptions {
 /// Not real-time: it writes files and may block. The manager must outlive the writer.
 class TraceCsvWriter {
  public:
-  /// Creates `path`, writes the header and starts draining. An Error if the manager records no
-  /// trace (trace_capacity 0) or the file cannot be created.
+  /// Starts a new trace for `path` (written beside it and moved into place by stop(), so an
+  /// earlier file at `path` stays whole until then), writes the header and starts draining. An
+  /// Error if the manager records no trace (trace_capacity 0) or the file cannot be created.
   static Result<std::unique_ptr<TraceCsvWriter>> start(HapticManager& manager, const std::string& path,
                                                        const TraceCsvWriterOptions& options = {});
-  /// stop().
+  /// stop(), ignoring its result.
   ~TraceCsvWriter();
   TraceCsvWriter(const TraceCsvWriter&) = delete;
   TraceCsvWriter& operator=(const TraceCsvWriter&) = delete;
 
-  /// Drains what is left (call after HapticManager::stop() to get every tick), flushes and joins
-  /// the thread. Idempotent.
-  void stop();
+  /// Drains what is left (call after HapticManager::stop() to get every tick), joins the thread
+  /// and puts the file in place (AtomicFileWriter::commit()); an Error names the file and why it
+  /// could not be written. Idempotent: later calls return the first one's result.
+  Status stop();
   /// Rows written so far.
   std::uint64_t rows_written() const { return rows_.load(std::memory_order_relaxed); }
 
  private:
-  TraceCsvWriter(HapticManager& manager, std::ofstream file, const TraceCsvWriterOptions& options);
+  TraceCsvWriter(HapticManager& manager, AtomicFileWriter file, const TraceCsvWriterOptions& options);
   void run();
 
   HapticManager& manager_;
-  std::ofstream file_;
+  AtomicFileWriter file_;
+  Status written_ = Ok{};  // the commit's result (controlling thread only)
   TraceCsvWriterOptions options_;
   std::mutex mutex_;
   std::condition_variable wake_;
