@@ -29,6 +29,14 @@ run sdescent4k_multi "$uh_root/scenes/bunny_descent.json" --stepped --haptic-hz 
 run sdescent4k_held "$uh_root/scenes/bunny_descent.json" --stepped --haptic-hz 4000 --ticks-per-collision 16 --held-forces
 run circle_stepped "$uh_root/scenes/bunny_coupling_circle.json" --stepped --ticks-per-collision 1
 run circle_threaded "$uh_root/scenes/bunny_coupling_circle.json"
+press="$uh_root/scenes/bunny_hand_press.json"
+stiff="$uh_root/scenes/bunny_hand_press_too_stiff.json"
+run press1k_stepped "$press" --stepped --ticks-per-collision 1
+run press4k_stepped "$press" --stepped --haptic-hz 4000 --ticks-per-collision 4
+run press1k_threaded "$press"
+run press4k_threaded "$press" --haptic-hz 4000
+run stiff1k_stepped "$stiff" --stepped --ticks-per-collision 1
+run stiff4k_stepped "$stiff" --stepped --haptic-hz 4000 --ticks-per-collision 4
 
 python3 - "$out" <<'PY'
 import json, sys, os
@@ -58,4 +66,13 @@ print("|---|---|---|")
 for name, label in [("circle_stepped", "stepped (simulated time, collision every tick)"), ("circle_threaded", "threaded")]:
     r = j[name]
     print(f"| {label} | {r['energy']['work_on_hand_j']:.5f} | {r['force']['max_n']:.2f} |")
+print()
+print("| passivity with a hand that reacts (sim-hand presses 5 cm into the bunny and back, twice) | 1 kHz: energy into the hand [J] | max force [N] | 4 kHz: energy into the hand [J] | max force [N] |")
+print("|---|---|---|---|---|")
+for (a, b), label in [(("press1k_stepped", "press4k_stepped"), "bunny_hand_press, stepped"),
+                      (("press1k_threaded", "press4k_threaded"), "bunny_hand_press, threaded"),
+                      (("stiff1k_stepped", "stiff4k_stepped"), "bunny_hand_press_too_stiff (coupling 9x the real bound), stepped")]:
+    ra, rb = j[a], j[b]
+    print(f"| {label} | {ra['energy']['work_on_hand_j']:.5f} | {ra['force']['max_n']:.2f} | "
+          f"{rb['energy']['work_on_hand_j']:.5f} | {rb['force']['max_n']:.2f} |")
 PY

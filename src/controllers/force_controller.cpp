@@ -127,10 +127,6 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   raise_max(max_torque_nm_, norm(torque_device));
   last_force_n_.store(force_n, std::memory_order_relaxed);
   last_pairs_.store(pairs, std::memory_order_relaxed);
-  // energy the device puts into the hand: force on the hand times the hand's velocity
-  const double work = dot(force_device, state.linear_velocity) * elapsed;
-  if (std::isfinite(work))
-    work_on_hand_j_.store(work_on_hand_j_.load(std::memory_order_relaxed) + work, std::memory_order_relaxed);
 }
 
 ForceControllerStats ForceController::stats() const {
@@ -143,7 +139,6 @@ ForceControllerStats ForceController::stats() const {
   s.max_force_step_n = max_force_step_n_.load(std::memory_order_relaxed);
   s.last_force_n = last_force_n_.load(std::memory_order_relaxed);
   s.last_pairs = last_pairs_.load(std::memory_order_relaxed);
-  s.work_on_hand_j = work_on_hand_j_.load(std::memory_order_relaxed);
   s.safety = safety_.counters();
   return s;
 }

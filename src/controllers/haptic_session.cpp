@@ -119,6 +119,7 @@ Status HapticSession::begin_run() {
   report_.force_max_step_n = 0.0;
   report_.force_max_n = 0.0;
   report_.torque_max_nm = 0.0;
+  report_.work_on_hand_j = 0.0;
   have_last_sent_ = false;
   ticks_at_start_ = manager_->ticks();
   return Ok{};
@@ -182,9 +183,17 @@ void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::o
     // the ticks after stop() asked for zero force are in the trace, not in the report: the
     // report describes the run, not its end
     if (s.tick_time_s >= halted_at_s) continue;
-    if (have_last_sent_)
+    if (have_last_sent_) {
       report_.force_max_step_n = std::max(report_.force_max_step_n, norm(s.sent.force - last_sent_.force));
+      // energy the device put into the hand over the last period: the force it held then (as
+      // sent, after every limit) times the handle's displacement since. Exact for a zero-order
+      // hold; F . v dt at the sample instant would miss the sampled-data energy gain that makes a
+      // too stiff coupling active
+      const double work = dot(last_sent_.force, s.state.position - last_sent_position_);
+      if (std::isfinite(work)) report_.work_on_hand_j += work;
+    }
     last_sent_ = s.sent;
+    last_sent_position_ = s.state.position;
     have_last_sent_ = true;
     report_.force_max_n = std::max(report_.force_max_n, norm(s.sent.force));
     report_.torque_max_nm = std::max(report_.torque_max_nm, norm(s.sent.torque));
@@ -363,7 +372,6 @@ void HapticSession::collect_report(double seconds, bool stepped) {
   r.limits = hs.limits;
   r.stale_ticks = fc.safety.stale_ticks;
   r.contact_ticks = fc.contact_ticks;
-  r.work_on_hand_j = fc.work_on_hand_j;
   r.multi_rate = force_controller_->options().multi_rate;
   r.coupling = force_controller_->options().use_coupling;
 }

@@ -155,7 +155,7 @@ Result<std::unique_ptr<HapticDevice>> make_replay(const DeviceConfig& c) {
 Result<std::unique_ptr<HapticDevice>> make_hand(const DeviceConfig& c) {
   constexpr std::string_view kName = "sim-hand";
   if (Status s = c.check_keys({UH_SIM_COMMON_KEYS, "handle_mass_kg", "hand_stiffness", "hand_damping", "device_damping",
-                               "target_start", "target_end", "duration_s", "substeps"},
+                               "target_start", "target_end", "duration_s", "bounce", "substeps"},
                               kName);
       !s) {
     return s.error();
@@ -169,6 +169,9 @@ Result<std::unique_ptr<HapticDevice>> make_hand(const DeviceConfig& c) {
   UH_TRY_ASSIGN(o.target_start, field(c.vec3("target_start", o.target_start), kName));
   UH_TRY_ASSIGN(o.target_end, field(c.vec3("target_end", o.target_end), kName));
   UH_TRY_ASSIGN(o.duration_s, field(c.number("duration_s", o.duration_s), kName));
+  double bounce = 0.0;
+  UH_TRY_ASSIGN(bounce, field(c.number("bounce", bounce), kName));
+  o.bounce = bounce != 0.0;
   double substeps = o.substeps;
   UH_TRY_ASSIGN(substeps, field(c.number("substeps", substeps), kName));
   if (!(substeps >= 1.0 && substeps <= 1000.0) || substeps != std::floor(substeps)) {

@@ -6,6 +6,7 @@
 
 #include "scene_test_support.hpp"
 #include "uh/core/sphere_overlap.hpp"
+#include "uh/forcecomp/virtual_coupling.hpp"
 
 namespace uh::controllers {
 namespace {
@@ -281,6 +282,58 @@ TEST_F(SessionFixture, ReportJsonHasTheDocumentedFields) {
                           "\"max_torque_nm\"", "\"nonfinite\"", "\"clamped\"",  "\"limited\"",
                           "\"device\"",        "\"tool\"",      "\"safety\"",   "\"contact\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
+}
+
+// A simulated hand (sim-hand: the force acts back on its motion) presses the stylus deep into the
+// bunny and pulls it out, twice: closed paths through deep contact, rendered through the virtual
+// coupling. The coupling's stiffness is clamped to 90 % of the passive bound for the damping it is
+// told the device has; `declared_device_damping` above the hand device's real 1 N s/m lets it
+// exceed the real bound. The force-rate limit is off: it is a separate safety net that throttles
+// what an active coupling can pump in, and this examines the coupling alone.
+std::string hand_press_scene_json(double haptic_hz, double declared_device_damping) {
+  return fmt::format(R"({{
+  "name": "hand-press-test",
+  "rates": {{ "haptic_hz": {haptic_hz}, "collision_hz": 1000 }},
+  "seconds": 4.0,
+  "objects": [{{ "name": "bunny", "mesh": "meshes/bunny_npm_3674.obj", "meters_per_unit": 0.01, "spheres": 600,
+                "pose": {{ "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
+  "tool": {{
+    "name": "stylus", "mesh": "meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
+    "force": {{ "mode": "3dof", "force_scale": 1.0e7, "damping": 2.0, "mass_kg": 0.05,
+               "center_of_mass": [0, 0, 0.025], "max_force_n": 8.0 }},
+    "device": {{ "driver": "sim-hand",
+                "config": {{ "target_start": [0.0, -0.01, 0.09], "target_end": [0.0, -0.01, 0.04], "duration_s": 1.0,
+                            "bounce": true, "handle_mass_kg": 0.1, "hand_stiffness": 300, "hand_damping": 3.0,
+                            "device_damping": 1.0, "substeps": 20, "max_force_n": 8 }} }}
+  }},
+  "force": {{ "safety": {{ "max_force_n": 8.0, "max_force_rate_n_per_s": 1.0e9 }},
+             "coupling": {{ "enabled": true, "stiffness": 1.0e6, "device_damping": {declared},
+                           "passivity_margin": 0.9, "proxy_mass_kg": 0.05 }} }}
+}})",
+                     fmt::arg("haptic_hz", haptic_hz), fmt::arg("declared", declared_device_damping));
+}
+
+TEST_F(SessionFixture, CouplingWithinThePassiveBoundPutsNoEnergyIntoAReactingHand) {
+  for (const double hz : {1000.0, 4000.0}) {
+    const int ticks_per_collision = static_cast<int>(hz / 1000.0);
+    // within the bound for the device's real damping (1 N s/m): 0.9 * 2 b / T
+    auto passive = make(hand_press_scene_json(hz, 1.0));
+    ASSERT_TRUE(passive);
+    ASSERT_TRUE(passive->run_stepped(4.0, ticks_per_collision).has_value());
+    const SessionReport& p = passive->report();
+    EXPECT_GT(p.contact_ticks, static_cast<std::uint64_t>(hz * 0.8)) << "the hand must press into the bunny";
+    EXPECT_GT(p.force_max_n, 0.5) << hz << " Hz";
+    EXPECT_LE(p.work_on_hand_j, 0.0) << hz << " Hz: a passive coupling put energy into the hand";
+
+    // told the device has 10x its real damping, the coupling is 10x stiffer than the real bound
+    // allows: the same motion now pumps energy into the hand, so the check above can fail
+    auto active = make(hand_press_scene_json(hz, 10.0));
+    ASSERT_TRUE(active);
+    ASSERT_TRUE(active->run_stepped(4.0, ticks_per_collision).has_value());
+    const double real_bound = forcecomp::max_passive_stiffness(1.0, 1.0 / hz, 0.0);
+    EXPECT_GT(0.9 * forcecomp::max_passive_stiffness(10.0, 1.0 / hz, 0.0), 5.0 * real_bound);
+    EXPECT_GT(active->report().work_on_hand_j, 0.01) << hz << " Hz: a coupling above the bound must show";
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/csv_reader.hpp"
 #include "uh/core/math.hpp"
 
 namespace uh::controllers::testing {
@@ -103,23 +104,26 @@ struct TraceTable {
   }
 };
 
+// read with the project's CSV reader; a malformed trace fails the test
 inline TraceTable parse_trace(const std::string& csv) {
   TraceTable t;
   std::istringstream in(csv);
-  std::string line;
-  std::getline(in, line);
-  {
-    std::istringstream h(line);
-    for (std::string name; std::getline(h, name, ',');) t.names.push_back(name);
+  CsvReader reader(in, "trace.csv");
+  const Status header = reader.read_header();
+  EXPECT_TRUE(header) << header.error().message;
+  if (!header) return t;
+  t.names = reader.columns();
+  while (true) {
+    auto more = reader.next_row();
+    EXPECT_TRUE(more) << more.error().message;
+    if (!more || !*more) return t;
+    std::vector<double>& row = t.rows.emplace_back();
+    for (std::size_t c = 0; c < t.names.size(); ++c) {
+      auto number = reader.number(c);
+      EXPECT_TRUE(number) << number.error().message;
+      row.push_back(number ? *number : 0.0);
+    }
   }
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream l(line);
-    for (std::string cell; std::getline(l, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
-    EXPECT_EQ(row.size(), t.names.size()) << line;
-    t.rows.push_back(std::move(row));
-  }
-  return t;
 }
 
 }  // namespace uh::controllers::testing

@@ -170,6 +170,29 @@ TEST(SimHandDevice, ForceActsBackOnMotion) {
   EXPECT_LT(stable.late_peak_speed, 1e-4);
 }
 
+TEST(SimHandDevice, BounceMakesAClosedPath) {
+  const SimHandOptions o{.target_start = {0, 0, 0.1}, .target_end = {0, 0, 0.05}, .duration_s = 0.5, .bounce = true};
+  const SimHandDevice hand(o);
+  for (const double cycle : {0.0, 1.0, 7.0}) {
+    const double t0 = cycle * 2.0 * o.duration_s;
+    expect_near(hand.target_at(t0), o.target_start, 1e-12);
+    expect_near(hand.target_at(t0 + 0.25), {0, 0, 0.075}, 1e-12);
+    expect_near(hand.target_at(t0 + 0.5), o.target_end, 1e-12);
+    expect_near(hand.target_at(t0 + 0.75), {0, 0, 0.075}, 1e-12);
+    expect_near(hand.target_velocity_at(t0 + 0.1), {0, 0, -0.1}, 1e-12);
+    expect_near(hand.target_velocity_at(t0 + 0.6), {0, 0, 0.1}, 1e-12);
+  }
+  // a free hand following the closed path comes back to where it started
+  SimHandDevice free_hand(SimHandOptions{.target_start = o.target_start, .target_end = o.target_end,
+                                         .duration_s = 0.5, .bounce = true});
+  ASSERT_TRUE(free_hand.open());
+  expect_near(run(free_hand, 4000).position, o.target_start, 2e-3);
+  // without bounce the target stays at the end
+  const SimHandDevice one_way({.target_start = {0, 0, 0.1}, .target_end = {0, 0, 0.05}, .duration_s = 0.5});
+  expect_near(one_way.target_at(3.0), {0, 0, 0.05}, 1e-12);
+  expect_near(one_way.target_velocity_at(3.0), {}, 1e-12);
+}
+
 TEST(SimHandDevice, InstabilityOfTooStiffWallIsObservable) {
   // far above the passive bound and with no hand damping the sampled wall pumps energy in: the
   // oscillation grows instead of dying out

@@ -44,7 +44,6 @@ struct ForceControllerStats {
   double max_force_step_n = 0.0;        ///< largest tick-to-tick change of the contact force before limits [N]
   double last_force_n = 0.0;            ///< |force| of the last tick [N]
   std::int32_t last_pairs = 0;          ///< pairs used in the last tick
-  double work_on_hand_j = 0.0;          ///< sum of F_sent . v_handle dt: energy the device put into the hand [J]
   forcecomp::ForceSafetyCounters safety{};
 };
 
@@ -128,7 +127,6 @@ class ForceController {
   std::atomic<double> max_force_step_n_{0.0};
   std::atomic<double> last_force_n_{0.0};
   std::atomic<std::int32_t> last_pairs_{0};
-  std::atomic<double> work_on_hand_j_{0.0};
 };
 
 }  // namespace uh::controllers

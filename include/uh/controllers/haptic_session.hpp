@@ -86,7 +86,10 @@ struct SessionReport {
   std::uint64_t force_nonfinite = 0, force_clamped = 0, torque_clamped = 0, stale_ticks = 0;
   haptico::LimitCounters limits{};     ///< ticks in which each limit of the chain engaged
   std::uint64_t contact_ticks = 0;
-  double work_on_hand_j = 0.0;         ///< energy the device put into the hand [J]
+  /// Energy the device put into the hand [J]: per tick, the force sent (held over the period)
+  /// times the handle's displacement until the next tick; exact for a zero-order hold. Over a
+  /// closed path it is <= 0 when the rendering is passive.
+  double work_on_hand_j = 0.0;
   bool multi_rate = true;
   bool coupling = false;
   std::vector<TimelineSample> timeline;
@@ -195,6 +198,7 @@ class HapticSession {
 
   Scene scene_;
   haptico::DeviceCommand last_sent_{};
+  Vec3 last_sent_position_{};  // the handle when last_sent_ was sent [m, device frame]
   bool have_last_sent_ = false;
   double haptic_hz_ = 1000.0;
   double collision_hz_ = 1000.0;
