@@ -39,9 +39,10 @@ std::vector<SpherePairContact> make_pairs(int count, const Pose& world_from_a, c
     const Vec3 cb_local = transform_point(b_from_world, cb);
     p.sphere_b_local = {static_cast<float>(cb_local.x), static_cast<float>(cb_local.y), static_cast<float>(cb_local.z), rb};
     const double ra = static_cast<double>(p.sphere_a_local.radius);
-    const double v = lens_volume(dist, ra, static_cast<double>(rb));
-    const Vec3 c = ca + lens_centroid_offset(dist, ra, static_cast<double>(rb)) * dir;
-    p.volume = static_cast<float>(v);
+    const SphereOverlap<double> o = sphere_overlap(dist, ra, static_cast<double>(rb));
+    const Vec3 c = ca + o.centroid_offset * dir;
+    p.volume = static_cast<float>(o.volume);
+    p.area = static_cast<float>(o.area);
     p.normal_world[0] = static_cast<float>(dir.x);
     p.normal_world[1] = static_cast<float>(dir.y);
     p.normal_world[2] = static_cast<float>(dir.z);

@@ -25,7 +25,7 @@ struct Sums {
     const float dx = bx - a.x, dy = by - a.y, dz = bz - a.z;
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float inv = d > 0.f ? 1.f / d : 0.f;
-    const float off = lens_centroid_offset(d, a.radius, rb);
+    const float off = sphere_overlap(d, a.radius, rb).centroid_offset;
     const double w = static_cast<double>(vol);
     v += w;
     nx += w * static_cast<double>(dx * inv);

@@ -20,7 +20,7 @@ namespace {
 struct Totals {
   double volume = 0.0;
   double nx = 0.0, ny = 0.0, nz = 0.0;
-  double gx = 0.0, gy = 0.0, gz = 0.0;  // sum of a^2 * normal
+  double gx = 0.0, gy = 0.0, gz = 0.0;  // sum of pi a^2 * normal
   double cx = 0.0, cy = 0.0, cz = 0.0;
 };
 
@@ -68,28 +68,16 @@ struct Traversal {
                 std::int32_t lb) {
     const float dx = bx - ax, dy = by - ay, dz = bz - az;
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    const float v = lens_volume(d, ar, br);
+    const SphereOverlap<float> o = sphere_overlap(d, ar, br);
+    const float v = o.volume;
     if (!(v > 0.f)) {
       if (margin > 0.f && d < ar + br + margin) add_near_pair(dx, dy, dz, d, ax, ay, az, ar, la, lb);
       return;
     }
     const float inv = d > 0.f ? 1.f / d : 0.f;
-    // lens_centroid_offset with its cap terms simplified: v_i z_i = 3/4 h_i^2 (2 r_i - h_i)^2,
-    // so one division instead of three (same formula, checked against it by the tests)
-    float off;
-    float a2 = 0.f;  // squared radius of the intersection circle (0 in containment)
-    if (d <= std::abs(ar - br)) {
-      off = ar <= br ? 0.f : d;
-    } else {
-      const float x = (d * d + ar * ar - br * br) * 0.5f * inv;
-      a2 = std::max(0.f, ar * ar - x * x);
-      const float h1 = ar - x, h2 = br - (d - x);
-      const float v1 = h1 * h1 * (3.f * ar - h1), v2 = h2 * h2 * (3.f * br - h2);
-      const float q1 = h1 * (2.f * ar - h1), q2 = h2 * (2.f * br - h2);
-      off = (0.75f * (q1 * q1 - q2 * q2) + v2 * d) / (v1 + v2);
-    }
     const float nx = dx * inv, ny = dy * inv, nz = dz * inv;
-    const float cx = ax + nx * off, cy = ay + ny * off, cz = az + nz * off;
+    const float cx = ax + nx * o.centroid_offset, cy = ay + ny * o.centroid_offset,
+                cz = az + nz * o.centroid_offset;
     const double vd = static_cast<double>(v);
     sum.volume += vd;
     sum.nx += vd * static_cast<double>(nx);
@@ -98,7 +86,7 @@ struct Traversal {
     sum.cx += vd * static_cast<double>(cx);
     sum.cy += vd * static_cast<double>(cy);
     sum.cz += vd * static_cast<double>(cz);
-    const double ad = static_cast<double>(a2);
+    const double ad = static_cast<double>(o.area);
     sum.gx += ad * static_cast<double>(nx);
     sum.gy += ad * static_cast<double>(ny);
     sum.gz += ad * static_cast<double>(nz);
@@ -108,6 +96,7 @@ struct Traversal {
       p.leaf_a = la;
       p.leaf_b = lb;
       p.volume = v;
+      p.area = o.area;
       p.normal[0] = nx;
       p.normal[1] = ny;
       p.normal[2] = nz;
@@ -128,6 +117,7 @@ struct Traversal {
     p.leaf_a = la;
     p.leaf_b = lb;
     p.volume = 0.f;
+    p.area = 0.f;
     p.normal[0] = dx * inv;
     p.normal[1] = dy * inv;
     p.normal[2] = dz * inv;
@@ -283,7 +273,7 @@ void finish(const Traversal& t, bool collect_pairs, VolumeQueryResult& result) {
   result.weighted_normal_sum = {t.sum.nx, t.sum.ny, t.sum.nz};
   result.restoring_direction = normalized(result.weighted_normal_sum);
   if (t.sum.volume > 0.0) result.volume_centroid = Vec3{t.sum.cx, t.sum.cy, t.sum.cz} / t.sum.volume;
-  result.volume_gradient = Vec3{t.sum.gx, t.sum.gy, t.sum.gz} * -kPi;
+  result.volume_gradient = -Vec3{t.sum.gx, t.sum.gy, t.sum.gz};
   result.pair_count = t.stored;
   result.truncated = t.overlapping + t.near > t.stored && collect_pairs;
   result.near_pairs = t.near;
@@ -439,6 +429,7 @@ void VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& worl
     const PairOverlap& p = pairs_[static_cast<std::size_t>(i)];
     SpherePairContact& c = out.pairs[static_cast<std::size_t>(i)];
     c.volume = p.volume;
+    c.area = p.area;
     for (int k = 0; k < 3; ++k) {
       c.normal_world[k] = static_cast<float>(m.m[k][0] * static_cast<double>(p.normal[0]) +
                                              m.m[k][1] * static_cast<double>(p.normal[1]) +

@@ -81,12 +81,13 @@ std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_
     const double rb = static_cast<double>(in.sphere_b_local.radius);
     const Vec3 delta = cb - ca;
     const double d = norm(delta);
-    const double volume = lens_volume(d, ra, rb);
+    const SphereOverlap<double> o = sphere_overlap(d, ra, rb);
     // coincident centres (within float storage precision) leave the centre line undefined: keep
     // the held normal, turned with A
     const Vec3 u = d > 1e-6 * (ra + rb) ? delta / d : rotate(world_from_a.rotation, normal_a_local_[i]);
-    const Vec3 centroid = ca + lens_centroid_offset(d, ra, rb) * u;
-    out.volume = static_cast<float>(volume);
+    const Vec3 centroid = ca + o.centroid_offset * u;
+    out.volume = static_cast<float>(o.volume);
+    out.area = static_cast<float>(o.area);
     store(out.normal_world, u);
     store(out.centroid_world, centroid);
   }
@@ -97,16 +98,15 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   // everything in A's frame: A's spheres need no transform, B's one; the sums turn back at the end
   const Pose a_from_world = inverse(world_from_a);
   const Pose a_from_b = a_from_world * world_from_b;
-  // Per pair in float, as the collision query does (the lens formulas agree with the double ones to
-  // ~1e-6 relative), sums in double; one division per overlapping pair: this loop runs every
-  // haptic tick over up to tens of thousands of pairs.
+  // Per pair in float with the one lens kernel, as the collision query does (it is backward stable
+  // in float: a few ulps), sums in double: this loop runs every haptic tick over up to tens of
+  // thousands of pairs.
   const Mat3 rot = rotation_matrix(a_from_b.rotation);
   float r[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) r[i][j] = static_cast<float>(rot.m[i][j]);
   const float tx = static_cast<float>(a_from_b.position.x), ty = static_cast<float>(a_from_b.position.y),
               tz = static_cast<float>(a_from_b.position.z);
-  constexpr float kPiF = static_cast<float>(kPi);
   double total = 0.0;
   std::int32_t count = 0;
   for (std::int32_t k = 0; k < size_; ++k) {
@@ -121,24 +121,10 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
     const float d = std::sqrt(d2);
     const float inv = d > 0.f ? 1.f / d : 0.f;
     LocalPair& out = local_[static_cast<std::size_t>(count)];
-    float off;
-    if (d <= std::abs(p.ar - p.br)) {
-      // containment: the smaller sphere's volume, its centre as centroid
-      const float rmin = std::min(p.ar, p.br);
-      out.volume = 4.f / 3.f * kPiF * rmin * rmin * rmin;
-      off = p.ar <= p.br ? 0.f : d;
-    } else {
-      const float s_ = rs - d;
-      out.volume = kPiF * s_ * s_ *
-                   (d2 + 2.f * d * p.ar - 3.f * p.ar * p.ar + 2.f * d * p.br + 6.f * p.ar * p.br - 3.f * p.br * p.br) *
-                   (inv / 12.f);
-      // lens_centroid_offset with its cap terms simplified: v_i z_i = 3/4 h_i^2 (2 r_i - h_i)^2
-      const float x = (d2 + p.ar * p.ar - p.br * p.br) * 0.5f * inv;
-      const float h1 = p.ar - x, h2 = p.br - (d - x);
-      const float v1 = h1 * h1 * (3.f * p.ar - h1), v2 = h2 * h2 * (3.f * p.br - h2);
-      const float q1 = h1 * (2.f * p.ar - h1), q2 = h2 * (2.f * p.br - h2);
-      off = (0.75f * (q1 * q1 - q2 * q2) + v2 * d) / (v1 + v2);
-    }
+    const SphereOverlap<float> o = sphere_overlap(d, p.ar, p.br);
+    out.volume = o.volume;
+    out.area = o.area;
+    const float off = o.centroid_offset;
     if (!(out.volume > 0.f)) continue;
     if (d > 1e-6f * rs) {
       out.nx = dx * inv;

@@ -18,8 +18,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "lens_reference.hpp"
 #include "uh/collette/ist_file.hpp"
-#include "uh/core/sphere_overlap.hpp"
 
 namespace uh {
 namespace {
@@ -105,8 +105,9 @@ double brute_volume(const collette::SphereTree& a, const collette::SphereTree& b
   for (const Sphere& sb : b.leaves()) {
     const Vec3 cb = transform_point(b_in_a, centre(sb));
     for (const Sphere& sa : a.leaves())
-      v += lens_volume<double>(norm(cb - centre(sa)), static_cast<double>(sa.radius),
-                               static_cast<double>(sb.radius));
+      v += uh::test::lens_reference(norm(cb - centre(sa)), static_cast<double>(sa.radius),
+                                    static_cast<double>(sb.radius))
+               .volume;
   }
   return v;
 }

@@ -9,8 +9,8 @@
 #include <thread>
 #include <vector>
 
+#include "lens_reference.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
-#include "uh/core/sphere_overlap.hpp"
 
 namespace uh::collette {
 namespace {
@@ -41,7 +41,7 @@ double brute_force_volume(const std::vector<Sphere>& a, const Pose& world_from_a
     const Vec3 ca = transform_point(world_from_a, {sa.x, sa.y, sa.z});
     for (const Sphere& sb : b) {
       const Vec3 cb = transform_point(world_from_b, {sb.x, sb.y, sb.z});
-      total += lens_volume<double>(norm(cb - ca), sa.radius, sb.radius);
+      total += uh::test::lens_reference(norm(cb - ca), sa.radius, sb.radius).volume;
     }
   }
   return total;

@@ -96,5 +96,50 @@ TEST(VolumeQuery, MatchesTrueMeshIntersectionOnBunny) {
   }
 }
 
+// A packing queried against itself, B shifted by 0 to 1e-3 of the object's size: every sphere
+// overlaps its own copy almost completely. The overlap can never exceed the spheres' volume and
+// must fall off continuously (|dV/dt| <= sum of pi r^2 of the spheres). The textbook lens formula
+// cancelled here in float: at a shift of 1e-6 of the size it returned more volume than the
+// packing holds, at 1e-7 about half.
+TEST(VolumeQuery, PackingAgainstItselfNeverExceedsItsSphereVolumeAndIsContinuous) {
+  auto mesh = load_mesh(std::string(UH_TEST_DATA_DIR) + "/meshes/bunny_npm_3674.obj");
+  ASSERT_TRUE(mesh) << mesh.error().message;
+  PackingOptions packing_options;
+  packing_options.target_sphere_count = 2000;
+  const auto packing = pack_spheres(*mesh, packing_options);
+  ASSERT_TRUE(packing) << packing.error().message;
+  const auto tree = build_sphere_tree(packing->spheres);
+  ASSERT_TRUE(tree);
+  double sphere_volume = 0.0, disk_areas = 0.0;
+  for (const Sphere& s : tree->leaves()) {
+    const double r = static_cast<double>(s.radius);
+    sphere_volume += 4.0 / 3.0 * kPi * r * r * r;
+    disk_areas += kPi * r * r;
+  }
+  const Aabb box = mesh_bounds(*mesh);
+  const double size = norm(box.max - box.min);
+  const Vec3 direction = normalized(Vec3{1.0, 0.37, -0.21});
+  // rounding of float pair volumes summed in double: a few ulps of float of the total
+  const double rounding = 1e-6 * sphere_volume;
+  VolumeQuery query({.collect_pairs = false});
+  std::vector<double> shifts{0.0};
+  for (int i = 0; i <= 60; ++i) shifts.push_back(std::pow(10.0, -9.0 + i / 10.0) * size);
+  double previous = -1.0, previous_shift = 0.0;
+  for (const double t : shifts) {
+    const double v = query.run(*tree, *tree, Pose{{}, direction * t}).total_volume;
+    EXPECT_LE(v, sphere_volume + rounding) << "shift " << t / size << " of the size";
+    if (previous >= 0.0) {
+      // falls with the shift, at most at the rate of all the spheres' disks
+      EXPECT_LE(v, previous + rounding) << "shift " << t / size << " of the size";
+      EXPECT_GE(v, previous - disk_areas * (t - previous_shift) - rounding)
+          << "shift " << t / size << " of the size";
+    } else {
+      EXPECT_NEAR(v, sphere_volume, rounding) << "unshifted, every sphere overlaps its own copy exactly";
+    }
+    previous = v;
+    previous_shift = t;
+  }
+}
+
 }  // namespace
 }  // namespace uh::collette

@@ -98,7 +98,7 @@ TEST(VolumeQuery, DisjointAndSingleLeafTrees) {
   VolumeQuery q;
   EXPECT_EQ(q.run(*t, *t, Pose{{}, {2.5, 0, 0}}).total_volume, 0.0);
   const auto& r = q.run(*t, *t, Pose{{}, {1.0, 0, 0}});
-  EXPECT_NEAR(r.total_volume, lens_volume(1.0, 1.0, 1.0), 1e-6);
+  EXPECT_NEAR(r.total_volume, 5.0 * kPi / 12.0, 1e-6);  // two unit balls 1 apart: 2 caps of height 1/2
   EXPECT_NEAR(r.restoring_direction.x, 1.0, 1e-9);
   EXPECT_NEAR(r.volume_centroid.x, 0.5, 1e-6);
   ASSERT_EQ(r.pair_count, 1);
@@ -130,9 +130,10 @@ TEST(VolumeQuery, ContactFrameMatchesResultInWorldFrame) {
     const Vec3 ca = transform_point(world_from_a, testing::centre(c.sphere_a_local));
     const Vec3 cb = transform_point(world_from_b, testing::centre(c.sphere_b_local));
     const double d = norm(cb - ca);
-    EXPECT_NEAR(static_cast<double>(c.volume),
-                lens_volume(d, static_cast<double>(c.sphere_a_local.radius), static_cast<double>(c.sphere_b_local.radius)),
-                1e-4 * static_cast<double>(c.volume) + 1e-7);
+    const uh::test::LensReference lens = uh::test::lens_reference(
+        d, static_cast<double>(c.sphere_a_local.radius), static_cast<double>(c.sphere_b_local.radius));
+    EXPECT_NEAR(static_cast<double>(c.volume), lens.volume, 1e-4 * static_cast<double>(c.volume) + 1e-7);
+    EXPECT_NEAR(static_cast<double>(c.area), lens.area, 1e-4 * lens.area + 1e-6);
     EXPECT_LT(norm(v3(c.normal_world) - normalized(cb - ca)), 1e-3);
     EXPECT_EQ(c.sphere_a_local.x, la[static_cast<std::size_t>(c.leaf_a)].x);
   }

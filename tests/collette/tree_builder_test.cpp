@@ -8,55 +8,12 @@
 #include "tree_test_support.hpp"
 #include "uh/collette/sphere_tree.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
-#include "uh/core/sphere_overlap.hpp"
 
 namespace uh::collette {
 namespace {
 
 using testing::make_packing;
 using testing::Shape;
-
-// Monte Carlo over the bounding box of the smaller sphere: volume and centroid of the lens.
-struct Mc {
-  double volume;
-  double centroid_offset;  // along the centre line from c1
-};
-Mc monte_carlo_lens(double d, double r1, double r2, int samples, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  const double rs = std::min(r1, r2);
-  const double cx = r1 <= r2 ? 0.0 : d;  // centre of the smaller sphere on the x axis
-  std::uniform_real_distribution<double> u(-rs, rs);
-  int inside = 0;
-  double sum_x = 0.0;
-  for (int s = 0; s < samples; ++s) {
-    const double x = cx + u(rng), y = u(rng), z = u(rng);
-    if (x * x + y * y + z * z <= r1 * r1 && (x - d) * (x - d) + y * y + z * z <= r2 * r2) {
-      ++inside;
-      sum_x += x;
-    }
-  }
-  const double box = 8.0 * rs * rs * rs;
-  return {box * inside / samples, inside > 0 ? sum_x / inside : 0.0};
-}
-
-TEST(SphereOverlap, LensVolumeAndCentroidMatchMonteCarlo) {
-  struct Case {
-    double d, r1, r2;
-  };
-  const Case cases[] = {{1.5, 1.0, 1.0}, {0.4, 1.0, 1.0}, {1.2, 1.0, 0.5}, {0.8, 0.3, 1.0}, {0.2, 1.0, 0.5}, {1.9, 1.2, 0.9}};
-  int seed = 1;
-  for (const Case& c : cases) {
-    const Mc mc = monte_carlo_lens(c.d, c.r1, c.r2, 400000, static_cast<std::uint32_t>(seed++));
-    const double v = lens_volume(c.d, c.r1, c.r2);
-    const double scale = 4.0 / 3.0 * kPi * std::pow(std::min(c.r1, c.r2), 3);
-    EXPECT_NEAR(v, mc.volume, 0.01 * scale) << "d=" << c.d << " r1=" << c.r1 << " r2=" << c.r2;
-    EXPECT_NEAR(lens_centroid_offset(c.d, c.r1, c.r2), mc.centroid_offset, 0.01 * std::max(c.r1, c.r2))
-        << "d=" << c.d << " r1=" << c.r1 << " r2=" << c.r2;
-    // float evaluation (used by the queries) agrees with double
-    EXPECT_NEAR(static_cast<double>(lens_volume(static_cast<float>(c.d), static_cast<float>(c.r1), static_cast<float>(c.r2))), v,
-                1e-5 * scale);
-  }
-}
 
 TEST(SphereTree, BuildPassesValidateOnManyLeafSets) {
   std::vector<std::vector<Sphere>> sets;

@@ -6,9 +6,9 @@
 #include <random>
 #include <vector>
 
+#include "lens_reference.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
-#include "uh/core/sphere_overlap.hpp"
 
 namespace uh::collette::testing {
 
@@ -51,12 +51,13 @@ inline Vec3 centre(const Sphere& s) {
   return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
 }
 
-/// Brute force over all leaf pairs, in double, A frame.
+/// Brute force over all leaf pairs, in double, A frame, with the independent lens reference
+/// (tests/support/lens_reference.hpp), not the kernel the queries use.
 struct BruteVolume {
   double volume = 0.0;
   Vec3 normal_sum{};
   Vec3 centroid_sum{};  // sum of volume * centroid
-  Vec3 gradient{};      // sum of dV/dd * normal
+  Vec3 gradient{};      // sum of dV/dd * normal = -sum of disk area * normal
   std::vector<std::pair<int, int>> pairs;
   std::vector<double> pair_volumes;
 };
@@ -70,13 +71,14 @@ inline BruteVolume brute_volume(const std::vector<Sphere>& a, const std::vector<
       const Vec3 ca = centre(a[static_cast<std::size_t>(i)]);
       const double ra = static_cast<double>(a[static_cast<std::size_t>(i)].radius);
       const double d = norm(cb - ca);
-      const double v = lens_volume(d, ra, rb);
+      const uh::test::LensReference lens = uh::test::lens_reference(d, ra, rb);
+      const double v = lens.volume;
       if (!(v > 0.0)) continue;
       const Vec3 n = normalized(cb - ca);
       r.volume += v;
       r.normal_sum += v * n;
-      r.centroid_sum += v * (ca + n * lens_centroid_offset(d, ra, rb));
-      r.gradient += lens_volume_derivative(d, ra, rb) * n;
+      r.centroid_sum += v * (ca + n * lens.centroid_offset);
+      r.gradient += -lens.area * n;
       r.pairs.emplace_back(i, j);
       r.pair_volumes.push_back(v);
     }

@@ -5,7 +5,6 @@
 #include <sstream>
 
 #include "scene_test_support.hpp"
-#include "uh/core/sphere_overlap.hpp"
 #include "uh/forcecomp/virtual_coupling.hpp"
 
 namespace uh::controllers {

@@ -4,11 +4,11 @@
 
 #include <memory>
 
+#include "lens_reference.hpp"
 #include "scene_test_support.hpp"
 #include "uh/collette/collision_world.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/controllers/scene.hpp"
-#include "uh/core/sphere_overlap.hpp"
 #include "uh/forcecomp/force_component.hpp"
 
 namespace uh::controllers {
@@ -47,7 +47,7 @@ TEST(SphereBunnyForce, WorldAndForceComponentMatchTheSumOverAllLeaves) {
     for (const Sphere& leaf : (*bunny)->leaves()) {
       const Vec3 c = transform_point(bunny_pose, Vec3{leaf.x, leaf.y, leaf.z});
       const Vec3 d = probe_pose.position - c;
-      const double v = lens_volume<double>(norm(d), leaf.radius, probe.radius);
+      const double v = uh::test::lens_reference(norm(d), leaf.radius, probe.radius).volume;
       if (v > 0.0) expected += 1.0e6 * v * normalized(d);
     }
     if (norm(expected) > 0.0) ++poses_in_contact;

@@ -1,12 +1,13 @@
 #pragma once
 // Brute-force reference for the forcecomp tests: builds SpherePairContacts straight from the
-// overlap formulas, the way a collision query would, without any tree.
+// overlap geometry, the way a collision query would, without any tree, with the independent lens
+// reference (tests/support/lens_reference.hpp) rather than the kernel under test.
 
 #include <vector>
 
+#include "lens_reference.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
-#include "uh/core/sphere_overlap.hpp"
 
 namespace uh::forcecomp::test {
 
@@ -28,8 +29,10 @@ inline SpherePairContact make_pair(const Sphere& a, const Pose& world_from_a, co
   const double rb = static_cast<double>(b.radius);
   const double d = norm(cb - ca);
   const Vec3 u = normalized(cb - ca);
-  const Vec3 c = ca + lens_centroid_offset(d, ra, rb) * u;
-  p.volume = static_cast<float>(lens_volume(d, ra, rb));
+  const uh::test::LensReference lens = uh::test::lens_reference(d, ra, rb);
+  const Vec3 c = ca + lens.centroid_offset * u;
+  p.volume = static_cast<float>(lens.volume);
+  p.area = static_cast<float>(lens.area);
   p.normal_world[0] = static_cast<float>(u.x);
   p.normal_world[1] = static_cast<float>(u.y);
   p.normal_world[2] = static_cast<float>(u.z);

@@ -6,7 +6,7 @@
 /// Simultaneous traversal of two SphereTrees A and B that descends only into overlapping node
 /// pairs (both inner nodes of a pair are split: each child of B, moved into A's frame once, is
 /// tested against all children of A in one SIMD batch, on SphereTree::blocks()); at every
-/// overlapping leaf pair it adds the exact lens volume (uh::lens_volume), the unit
+/// overlapping leaf pair it adds the exact lens volume (uh::sphere_overlap), the unit
 /// normal along the centre line from A's sphere to B's (pushes B out of A) and the lens centroid.
 /// Since the leaves of one object never overlap, the total is exactly the intersection volume of
 /// the two packings.
@@ -30,11 +30,12 @@
 
 namespace uh::collette {
 
-/// One overlapping leaf pair as the query stores it, in A's mesh frame. 36 bytes.
+/// One overlapping leaf pair as the query stores it, in A's mesh frame. 40 bytes.
 struct PairOverlap {
   std::int32_t leaf_a = -1;  ///< index into A.leaves()
   std::int32_t leaf_b = -1;  ///< index into B.leaves()
-  float volume = 0.f;        ///< lens volume [length^3], > 0
+  float volume = 0.f;        ///< lens volume [length^3], > 0 (0 for a near pair of the contact margin)
+  float area = 0.f;          ///< pi a^2, area of the intersection disk [length^2] = -d(volume)/d(distance)
   float normal[3] = {};      ///< unit, A frame, from a's centre to b's centre (zero if the centres coincide)
   float centroid[3] = {};    ///< lens centroid, A frame [length]
 };

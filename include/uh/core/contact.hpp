@@ -27,8 +27,9 @@ struct Sphere {
 /// One overlapping pair of leaf spheres, sphere a of object A and sphere b of object B.
 struct SpherePairContact {
   float volume = 0.f;             ///< lens volume [length^3], >= 0
+  float area = 0.f;               ///< pi a^2 of the intersection disk [length^2] = -dV/d(distance)
   float normal_world[3] = {};     ///< unit, world frame, from a's centre towards b's centre: pushes B out of A
-  float centroid_world[3] = {};   ///< lens centroid, world frame [length]
+  float centroid_world[3] = {};   ///< lens centroid, world frame [length]; on the centre line
   Sphere sphere_a_local{};        ///< a in A's body (mesh) frame
   Sphere sphere_b_local{};        ///< b in B's body (mesh) frame
   std::int32_t leaf_a = -1;       ///< index of a among A's leaves
@@ -51,9 +52,10 @@ struct ContactFrame {
   double total_volume = 0.0;        ///< sum of all pair volumes [length^3], >= 0
   Vec3 restoring_direction_world{}; ///< unit direction of sum(volume * normal): pushes B out of A; zero if none
   Vec3 volume_centroid_world{};     ///< volume-weighted mean of the lens centroids [length]
-  /// d(total_volume)/d(position of B), world frame [length^2]: -sum(pi a^2 normal) over the pairs
-  /// (a = radius of a pair's intersection circle). Its negation is the exact restoring direction
-  /// of the packings, closer to the meshes' true one than restoring_direction_world.
+  /// d(total_volume)/d(position of B), world frame [length^2]: -sum(area * normal) over the pairs
+  /// (area = pi a^2 of a pair's intersection disk). Its negation is the exact restoring direction
+  /// of the packings, closer to the meshes' true one than restoring_direction_world, and the
+  /// direction of the gradient force law (forcecomp/penalty_force.hpp).
   Vec3 volume_gradient_world{};
   double distance = 0.0;            ///< separation when apart (upper bound), 0 when touching [length]
   double query_seconds = 0.0;       ///< time the query took [s]
@@ -63,7 +65,7 @@ struct ContactFrame {
 };
 static_assert(std::is_trivially_copyable_v<ContactFrame>);
 
-/// Copies `src` into `dst`, only the `pair_count` valid pairs (a full ContactFrame is ~2.5 MB;
+/// Copies `src` into `dst`, only the `pair_count` valid pairs (a full ContactFrame is ~2.4 MB;
 /// a frame usually holds a few thousand pairs). Real-time safe.
 inline void copy_contact_frame(const ContactFrame& src, ContactFrame& dst) {
   const auto count = static_cast<std::size_t>(src.pair_count < 0 ? 0 : src.pair_count);

@@ -78,6 +78,7 @@ class HeldContactSet {
   std::unique_ptr<PackedPair[]> packed_;
   struct LocalPair {
     float volume;
+    float area;        // pi a^2 of the intersection disk
     float nx, ny, nz;  // unit normal, A's frame, from a towards b
     float cx, cy, cz;  // lens centroid, A's frame
   };
