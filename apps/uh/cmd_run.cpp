@@ -1,6 +1,9 @@
 // uh run [SCENE] [--seconds S] [--json] [--trace OUT.csv] [--plot OUT.png]
+#include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -18,6 +21,42 @@
 namespace uh::cli {
 namespace {
 
+// SIGINT / SIGTERM during a run: the handler only records the signal and asks the session to stop
+// (a sig_atomic_t store and one lock-free atomic store, both async-signal-safe); the run then ends
+// as if its time were up: zero force, threads joined, summary printed, exit status 128 + signal.
+volatile std::sig_atomic_t g_stop_signal = 0;
+std::atomic<controllers::HapticSession*> g_running_session{nullptr};
+static_assert(std::atomic<controllers::HapticSession*>::is_always_lock_free);
+
+extern "C" void on_stop_signal(int signal_number) {
+  g_stop_signal = signal_number;
+  if (controllers::HapticSession* session = g_running_session.load()) session->request_stop();
+}
+
+// Routes SIGINT and SIGTERM to `session` while it lives; restores the previous handlers after.
+class StopOnSignals {
+ public:
+  explicit StopOnSignals(controllers::HapticSession& session) {
+    g_running_session.store(&session);
+    struct sigaction action {};
+    action.sa_handler = &on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_int_);
+    sigaction(SIGTERM, &action, &previous_term_);
+  }
+  ~StopOnSignals() {
+    sigaction(SIGINT, &previous_int_, nullptr);
+    sigaction(SIGTERM, &previous_term_, nullptr);
+    g_running_session.store(nullptr);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+ private:
+  struct sigaction previous_int_ {};
+  struct sigaction previous_term_ {};
+};
+
 struct RunArgs {
   std::string scene;
   double seconds = 0.0;
@@ -34,7 +73,8 @@ struct RunArgs {
 };
 
 void print_summary(const controllers::SessionReport& r) {
-  std::printf("scene %s: %.1f s %s\n", r.scene.c_str(), r.seconds, r.stepped ? "(stepped, simulated time)" : "");
+  std::printf("scene %s: %.1f s%s%s\n", r.scene.c_str(), r.seconds, r.stepped ? " (stepped, simulated time)" : "",
+              r.stopped_early ? " (stopped early)" : "");
   std::printf("  haptic    %.1f Hz (target %.0f), %llu ticks, %llu missed deadlines, jitter p50 %.1f us, p99 %.1f us, max %.1f us\n",
               r.haptic_rate_hz, r.haptic_target_hz, static_cast<unsigned long long>(r.haptic_ticks),
               static_cast<unsigned long long>(r.haptic_missed_deadlines), r.jitter_p50_us, r.jitter_p99_us, r.jitter_max_us);
@@ -88,14 +128,18 @@ int run_session(const RunArgs& args) {
   const char* ci = std::getenv("CI");
   const bool live = !args.json && isatty(STDERR_FILENO) == 1 && (ci == nullptr || *ci == '\0');
 
-  Status ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
-                            : (*session)->run(seconds,
-                                              [live](const controllers::SessionState& s) {
-                                                if (!live) return;
-                                                std::fprintf(stderr, "\r  t %5.1f s | haptic %6.0f Hz | collision %6.0f Hz | force %5.2f N | pairs %6d ",
-                                                             s.time_s, s.haptic_rate_hz, s.collision_rate_hz, norm(s.force_world), s.contact_pairs);
-                                              },
-                                              trace);
+  Status ran = Ok{};
+  {
+    const StopOnSignals stop_on_signals(**session);
+    ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
+                       : (*session)->run(seconds,
+                                         [live](const controllers::SessionState& s) {
+                                           if (!live) return;
+                                           std::fprintf(stderr, "\r  t %5.1f s | haptic %6.0f Hz | collision %6.0f Hz | force %5.2f N | pairs %6d ",
+                                                        s.time_s, s.haptic_rate_hz, s.collision_rate_hz, norm(s.force_world), s.contact_pairs);
+                                         },
+                                         trace);
+  }
   if (live) std::fputc('\n', stderr);
   // a session that ended in an error keeps its trace too: it shows what happened up to the end
   const Status traced = trace_file ? trace_file->commit() : Status{Ok{}};
@@ -110,6 +154,13 @@ int run_session(const RunArgs& args) {
     print_summary(report);
     if (!args.trace.empty()) std::printf("  trace -> %s\n", args.trace.c_str());
     if (!args.plot.empty()) std::printf("  plot  -> %s\n", args.plot.c_str());
+  }
+  if (g_stop_signal != 0) {
+    const int signal_number = g_stop_signal;
+    std::fflush(stdout);
+    std::fprintf(stderr, "uh: stopped by %s after %.2f s; the device was sent zero force\n",
+                 signal_number == SIGINT ? "SIGINT" : "SIGTERM", report.seconds);
+    return 128 + signal_number;
   }
   return 0;
 }

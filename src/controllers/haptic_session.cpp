@@ -180,9 +180,9 @@ void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::o
   const double halted_at_s = halted_at_s_.load(std::memory_order_relaxed);
   for (const auto& s : buffer) {
     if (trace != nullptr) haptico::write_trace_row(*trace, s);
-    // the ticks after stop() asked for zero force are in the trace, not in the report: the
-    // report describes the run, not its end
-    if (s.tick_time_s >= halted_at_s) continue;
+    // the ticks after stop() asked for zero force, and the zero sent as the haptic loop ended,
+    // are in the trace, not in the report: the report describes the run, not its end
+    if (s.tick_time_s >= halted_at_s || (s.flags & haptico::kTraceStopped) != 0) continue;
     if (have_last_sent_) {
       report_.force_max_step_n = std::max(report_.force_max_step_n, norm(s.sent.force - last_sent_.force));
       // energy the device put into the hand over the last period: the force it held then (as
@@ -272,7 +272,9 @@ Status HapticSession::stop() {
   std::vector<haptico::TraceSample> buffer;
   take_trace(buffer, trace_);
   phase_ = Phase::kStopped;
-  if (!haptic_alive)
+  if (Status haptic = manager_->thread_status(); !haptic)
+    stopped_ = Error{fmt::format("{}: {}", scene_.source, haptic.error().message)};
+  else if (!haptic_alive)
     stopped_ = Error{"the haptic thread ended before the session was stopped"};
   else if (!collision_alive)
     stopped_ = Error{"the collision thread ended before the session was stopped"};
@@ -285,18 +287,30 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
                           std::ostream* trace) {
   if (!(seconds > 0.0)) return Error{"HapticSession::run: the duration must be positive"};
   if (auto started = start(trace); !started) return started;
+  // an exception from on_status must not leave the threads running: stop() (idempotent) either way
+  struct StopOnExit {
+    HapticSession& session;
+    ~StopOnExit() { (void)session.stop(); }
+  } stop_on_exit{*this};
   const auto begin = std::chrono::steady_clock::now();
   const auto end = begin + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                std::chrono::duration<double>(seconds));
   auto next_status = begin + std::chrono::milliseconds(250);
-  while (std::chrono::steady_clock::now() < end) {
-    std::this_thread::sleep_until(std::min(end, next_status));
+  // a stop request is seen within 20 ms; a thread that ended by itself (the haptic one has sent
+  // zero already) ends the run as well
+  while (std::chrono::steady_clock::now() < end && !stop_requested_.load(std::memory_order_relaxed) &&
+         manager_->running() && world_->running()) {
+    const auto soon = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
+    std::this_thread::sleep_until(std::min({end, next_status, soon}));
     if (on_status && std::chrono::steady_clock::now() >= next_status) {
       next_status += std::chrono::milliseconds(250);
       on_status(state());
     }
   }
-  return stop();
+  const bool early = std::chrono::steady_clock::now() < end && stop_requested_.load(std::memory_order_relaxed);
+  Status stopped = stop();
+  report_.stopped_early = early;
+  return stopped;
 }
 
 Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, std::ostream* trace) {
@@ -309,16 +323,19 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
-  for (std::int64_t k = 0; k < ticks; ++k) {
+  std::int64_t k = 0;
+  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed); ++k) {
     const double t = static_cast<double>(k) / haptic_hz_;
     // the collision step sees the tool pose of the previous tick, as the threaded world would
     if (k % ticks_per_collision_step == 0) world_->step(t);
     manager_->step(t);
     if (k % 256 == 255) take_trace(buffer, trace);
   }
+  manager_->stop();  // a stepped run ends like a threaded one: zero to the device, traced
   take_trace(buffer, trace);
   collision_hz_ = haptic_hz_ / ticks_per_collision_step;
-  collect_report(seconds, true);
+  collect_report(static_cast<double>(k) / haptic_hz_, true);
+  report_.stopped_early = k < ticks;
   phase_ = Phase::kStopped;
   return Ok{};
 }
@@ -381,6 +398,7 @@ std::string session_report_json(const SessionReport& r) {
       {"scene", r.scene},
       {"mode", r.stepped ? "stepped" : "threaded"},
       {"seconds", r.seconds},
+      {"stopped_early", r.stopped_early},
       {"haptic",
        {{"target_hz", r.haptic_target_hz},
         {"rate_hz", r.haptic_rate_hz},

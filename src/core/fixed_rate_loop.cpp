@@ -54,7 +54,7 @@ FixedRateLoop::FixedRateLoop(FixedRateLoopOptions options) : options_(std::move(
 
 FixedRateLoop::~FixedRateLoop() { stop(); }
 
-Status FixedRateLoop::start(Callback callback) {
+Status FixedRateLoop::start(Callback callback, ExitCallback on_exit) {
   if (running_.load(std::memory_order_acquire)) {
     return Error{"FixedRateLoop::start(): loop '" + options_.name + "' is already running"};
   }
@@ -75,6 +75,7 @@ Status FixedRateLoop::start(Callback callback) {
   if (thread_.joinable()) thread_.join();
 
   stop_requested_.store(false, std::memory_order_relaxed);
+  failure_.clear();
   priority_raised_.store(false, std::memory_order_relaxed);
   ticks_.store(0, std::memory_order_relaxed);
   missed_deadlines_.store(0, std::memory_order_relaxed);
@@ -87,7 +88,9 @@ Status FixedRateLoop::start(Callback callback) {
 
   running_.store(true, std::memory_order_release);
   try {
-    thread_ = std::thread([this, cb = std::move(callback)]() mutable { run(std::move(cb)); });
+    thread_ = std::thread([this, cb = std::move(callback), exit_cb = std::move(on_exit)]() mutable {
+      run(std::move(cb), std::move(exit_cb));
+    });
   } catch (const std::exception& e) {
     running_.store(false, std::memory_order_release);
     return Error{std::string("FixedRateLoop::start(): cannot create the loop thread: ") + e.what()};
@@ -130,7 +133,7 @@ FixedRateLoopStats FixedRateLoop::stats() const {
   return s;
 }
 
-void FixedRateLoop::run(Callback callback) {
+void FixedRateLoop::run(Callback callback, ExitCallback on_exit) {
   {
     const std::string short_name = options_.name.substr(0, 15);
     pthread_setname_np(pthread_self(), short_name.c_str());
@@ -159,6 +162,8 @@ void FixedRateLoop::run(Callback callback) {
 
   TickInfo info;
   info.period_s = static_cast<double>(period.count()) * 1e-9;
+  LoopExit exit;
+  std::string thrown;  // the exception's message, kept past its catch block for on_exit
 
   try {
     while (!stop_requested_.load(std::memory_order_acquire)) {
@@ -210,10 +215,27 @@ void FixedRateLoop::run(Callback callback) {
       scheduled += period;
     }
   } catch (const std::exception& e) {
-    log::error("FixedRateLoop '{}': the tick callback threw ({}); the loop stopped", options_.name, e.what());
+    thrown = e.what();
+    exit.callback_threw = true;
   } catch (...) {
-    log::error("FixedRateLoop '{}': the tick callback threw; the loop stopped", options_.name);
+    thrown = "an exception of unknown type";
+    exit.callback_threw = true;
   }
+  if (exit.callback_threw) {
+    failure_ = "the tick callback threw: " + thrown;
+    exit.what = thrown.c_str();
+  }
+  // the exit callback first (it may have to zero a device at once), then the log
+  if (on_exit) {
+    try {
+      on_exit(exit);
+    } catch (const std::exception& e) {
+      log::error("FixedRateLoop '{}': the exit callback threw ({})", options_.name, e.what());
+    } catch (...) {
+      log::error("FixedRateLoop '{}': the exit callback threw", options_.name);
+    }
+  }
+  if (exit.callback_threw) log::error("FixedRateLoop '{}': {}; the loop stopped", options_.name, failure_);
   running_.store(false, std::memory_order_release);
 }
 

@@ -13,6 +13,20 @@ namespace {
 
 bool finite(const DeviceCommand& c) { return is_finite(c.force) && is_finite(c.torque); }
 
+constexpr const char* kMoveBindRefused =
+    "haptic manager: MoveOnHapticTick delegates cannot be bound while the haptic thread runs; bind before start() "
+    "or after stop()";
+constexpr const char* kForceBindRefused =
+    "haptic manager: ForceOnHapticTick delegates cannot be bound while the haptic thread runs; bind before "
+    "start() or after stop()";
+constexpr const char* kSentBindRefused =
+    "haptic manager: SentOnHapticTick delegates cannot be bound while the haptic thread runs; bind before "
+    "start() or after stop()";
+
+double steady_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 FixedRateLoopOptions loop_options(const HapticManagerOptions& o) {
   FixedRateLoopOptions l;
   l.rate_hz = o.rate_hz;
@@ -65,23 +79,88 @@ Status HapticManager::open() {
   return Ok{};
 }
 
+const char* HapticManager::phase_name(TickPhase phase) {
+  switch (phase) {
+    case TickPhase::kReadState:
+      return "reading the device state";
+    case TickPhase::kMove:
+      return "a MoveOnHapticTick delegate (moving the tool)";
+    case TickPhase::kForce:
+      return "a ForceOnHapticTick delegate (computing the force)";
+    case TickPhase::kCommand:
+      return "commanding the device";
+    case TickPhase::kSent:
+      return "a SentOnHapticTick delegate";
+    case TickPhase::kIdle:
+      break;
+  }
+  return "the haptic tick";
+}
+
 Status HapticManager::start() {
   if (!(options_.rate_hz > 0.0 && options_.rate_hz <= 10000.0)) {
     return Error{fmt::format("haptic manager: rate_hz {} is outside (0, 10000]", options_.rate_hz)};
   }
   if (loop_.running()) return Error{"haptic manager: already running"};
   if (Status s = open(); !s) return s;
+  // a thread that ended by itself is joined by the loop's start(); its failure is history now
+  failure_.clear();
   restart_fade_.store(true, std::memory_order_release);
-  return loop_.start([this](const TickInfo& t) {
-    const double now = std::chrono::duration<double>(t.start_time.time_since_epoch()).count();
-    tick(now);
-  });
+  // from here the haptic thread reads the delegators: binding would race with it
+  move_event_.refuse_binding(kMoveBindRefused);
+  force_event_.refuse_binding(kForceBindRefused);
+  sent_event_.refuse_binding(kSentBindRefused);
+  Status started = loop_.start(
+      [this](const TickInfo& t) {
+        const double now = std::chrono::duration<double>(t.start_time.time_since_epoch()).count();
+        tick(now);
+      },
+      [this](const LoopExit& exit) { on_loop_exit(exit); });
+  if (!started) allow_binding();
+  return started;
+}
+
+void HapticManager::on_loop_exit(const LoopExit& exit) {
+  // haptic thread, the loop is over: zero first, everything else after; a driver whose
+  // read_state() threw is not asked again
+  send_final_zero(steady_now_s(), !(exit.callback_threw && phase_ == TickPhase::kReadState));
+  if (exit.callback_threw)
+    failure_ = fmt::format("the haptic thread stopped: {} threw: {}; the device was sent zero force",
+                           phase_name(phase_), exit.what);
+}
+
+void HapticManager::send_final_zero(double now_s, bool read_device) {
+  const DeviceCommand zero{};
+  device_->command(zero);
+  limiter_.zero();
+  ended_with_zero_ = true;
+  TraceSample sample;
+  sample.tick_time_s = now_s;
+  // for the trace, the state after the zero, so that its device times keep increasing (it replays)
+  sample.state = read_device && trace_ ? device_->read_state() : last_state_;
+  sample.sent = zero;
+  sample.flags = kTraceStopped;
+  if (trace_ && !trace_->try_push(sample)) trace_dropped_.increment();
+  sent_event_.broadcast(sample);
 }
 
 void HapticManager::stop() {
   loop_.stop();
-  // the haptic thread is joined: this thread may talk to the device now
-  if (open_) device_->command(DeviceCommand{});
+  // the haptic thread is joined: this thread may talk to the device and bind delegates now
+  allow_binding();
+  // a threaded run ended with zero from the haptic thread itself; a stepped one ends here
+  if (open_ && !ended_with_zero_) send_final_zero(tick_time_s_ + 1.0 / options_.rate_hz, true);
+}
+
+void HapticManager::allow_binding() {
+  move_event_.allow_binding();
+  force_event_.allow_binding();
+  sent_event_.allow_binding();
+}
+
+Status HapticManager::thread_status() const {
+  if (loop_.running() || failure_.empty()) return Ok{};
+  return Error{failure_};
 }
 
 TraceSample HapticManager::step(double now_s) {
@@ -93,9 +172,12 @@ TraceSample HapticManager::step(double now_s) {
 TraceSample HapticManager::tick(double now_s) {
   ticks_.increment();
   tick_time_s_ = now_s;
+  ended_with_zero_ = false;
   TraceSample sample;
   sample.tick_time_s = now_s;
+  phase_ = TickPhase::kReadState;
   sample.state = device_->read_state();
+  last_state_ = sample.state;
   // a driver that keeps returning the same sample has stalled: its pose is no longer the hand's
   bool frozen = false;
   if (options_.max_frozen_ticks > 0 && sample.state.status == DeviceStatus::kOk) {
@@ -112,7 +194,9 @@ TraceSample HapticManager::tick(double now_s) {
     faulted_.store(true, std::memory_order_release);
     sample.flags |= kTraceDeviceError;
   } else {
+    phase_ = TickPhase::kMove;
     move_event_.broadcast(sample.state);
+    phase_ = TickPhase::kForce;
     force_event_.broadcast(sample.state, sample.requested);
   }
 
@@ -144,10 +228,13 @@ TraceSample HapticManager::tick(double now_s) {
   }
   count(sample.flags);
   sample.sent = out;
+  phase_ = TickPhase::kCommand;
   device_->command(out);
 
   if (trace_ && !trace_->try_push(sample)) trace_dropped_.increment();
+  phase_ = TickPhase::kSent;
   sent_event_.broadcast(sample);
+  phase_ = TickPhase::kIdle;
   return sample;
 }
 

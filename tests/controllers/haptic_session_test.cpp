@@ -122,29 +122,39 @@ TEST_F(SessionFixture, CouplingRendersThroughTheProxyAndStaysWithinLimits) {
   EXPECT_EQ(r.force_nonfinite, 0u);
 }
 
-TEST_F(SessionFixture, StateAfterASteppedRunIsTheLastTickOfTheTrace) {
+TEST_F(SessionFixture, StateAfterASteppedRunIsTheZeroItEndedWith) {
   auto session = make(small_scene_json());
   ASSERT_TRUE(session);
   const SessionState before = session->state();
   EXPECT_EQ(before.haptic_ticks, 0u);
   std::ostringstream trace;
+  std::vector<SessionState> published;
+  auto seen = session->on_haptic_tick().connect([&](const SessionState& s) { published.push_back(s); });
   ASSERT_TRUE(session->run_stepped(0.5, 4, &trace).has_value());
   const SessionState s = session->state();
   const auto table = parse_trace(trace.str());
-  ASSERT_EQ(table.rows.size(), 500u);
-  const std::vector<double>& last = table.rows.back();
-  const auto at = [&](const char* name) { return last[static_cast<std::size_t>(table.column(name))]; };
+  // 500 ticks, then the zero the run ended with (not a tick)
+  ASSERT_EQ(table.rows.size(), 501u);
+  ASSERT_EQ(published.size(), 501u);
+  EXPECT_EQ(table.flags(500), haptico::kTraceStopped);
+  EXPECT_EQ(norm(table.force(500)), 0.0);
   EXPECT_EQ(s.haptic_ticks, 500u);
-  EXPECT_NEAR(s.time_s, at("tick_time_s"), 1e-9);
+  EXPECT_EQ(norm(s.force_world), 0.0) << "the state shows the zero the device got last";
+  // the last tick's state, as published, is the trace's last tick row
+  const SessionState& tick = published[499];
+  const std::vector<double>& last = table.rows[499];
+  const auto at = [&](const char* name) { return last[static_cast<std::size_t>(table.column(name))]; };
+  EXPECT_NEAR(tick.time_s, at("tick_time_s"), 1e-9);
   // the scene's workspace mapping is the identity: the tool sits at the handle, forces are the device's
-  EXPECT_NEAR(s.tool_position_world.x, at("x"), 1e-9);
-  EXPECT_NEAR(s.tool_position_world.z, at("z"), 1e-9);
-  EXPECT_NEAR(s.tool_orientation_world.w, at("qw"), 1e-9);
-  EXPECT_NEAR(s.force_world.z, at("fz"), 1e-6);
-  EXPECT_NEAR(s.torque_world.x, at("tx"), 1e-6);
-  EXPECT_GT(norm(s.force_world), 0.1) << "at 0.5 s the stylus is at its deepest in the bunny";
-  EXPECT_GT(s.contact_pairs, 0);
-  EXPECT_EQ(s.missed_deadlines, 0u);
+  EXPECT_NEAR(tick.tool_position_world.x, at("x"), 1e-9);
+  EXPECT_NEAR(tick.tool_position_world.z, at("z"), 1e-9);
+  EXPECT_NEAR(tick.tool_orientation_world.w, at("qw"), 1e-9);
+  EXPECT_NEAR(tick.force_world.z, at("fz"), 1e-6);
+  EXPECT_NEAR(tick.torque_world.x, at("tx"), 1e-6);
+  EXPECT_GT(norm(tick.force_world), 0.1) << "at 0.5 s the stylus is at its deepest in the bunny";
+  EXPECT_GT(tick.contact_pairs, 0);
+  EXPECT_EQ(tick.missed_deadlines, 0u);
+  EXPECT_EQ(s.tool_position_world, tick.tool_position_world) << "the tool has not moved since";
 }
 
 TEST_F(SessionFixture, ContactEventsAlternateAndMatchTheForceOnsets) {
@@ -220,7 +230,9 @@ TEST_F(SessionFixture, SmallestOfToolSafetyAndDeviceLimitBoundsEveryTick) {
     ASSERT_TRUE(session->run_stepped(1.0, 4, &trace).has_value());
     const SessionReport& r = session->report();
     const auto table = parse_trace(trace.str());
-    ASSERT_EQ(table.rows.size(), 1000u);
+    ASSERT_EQ(table.rows.size(), 1001u) << "1000 ticks and the zero the run ended with";
+    EXPECT_EQ(table.flags(1000), haptico::kTraceStopped);
+    EXPECT_EQ(norm(table.force(1000)), 0.0);
     std::uint64_t clamped_rows = 0;
     for (std::size_t i = 0; i < table.rows.size(); ++i) {
       ASSERT_LE(norm(table.force(i)), c.smallest * (1 + 1e-12)) << "tick " << i << ", limit " << c.smallest;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -13,6 +14,73 @@
 
 namespace uh::controllers {
 namespace {
+
+// A driver whose read_state() throws on its `throw_at`-th read (a tick that throws), around a
+// simulated line device; it records the last command it got.
+class ThrowingDevice final : public haptico::HapticDevice {
+ public:
+  ThrowingDevice(std::unique_ptr<haptico::HapticDevice> inner, int throw_at, haptico::DeviceCommand* last)
+      : inner_(std::move(inner)), throw_at_(throw_at), last_(last) {}
+  haptico::DeviceInfo info() const override { return inner_->info(); }
+  Status open() override { return inner_->open(); }
+  Status close() override { return inner_->close(); }
+  haptico::DeviceState read_state() override {
+    if (reads_++ == throw_at_) throw std::runtime_error("USB cable pulled");
+    return inner_->read_state();
+  }
+  void command(const haptico::DeviceCommand& command) override {
+    *last_ = command;
+    inner_->command(command);
+  }
+
+ private:
+  std::unique_ptr<haptico::HapticDevice> inner_;
+  int throw_at_;
+  int reads_ = 0;
+  haptico::DeviceCommand* last_;
+};
+
+// A tick that throws ends the session with an error naming the cause, the device at zero and the
+// trace ending with that zero, long before the session's time is up.
+TEST(HapticSessionThreaded, ThrowingTickEndsTheRunWithZeroForceAndTheCause) {
+  const auto cache = testing::fresh_cache("throwing");
+  haptico::DeviceCommand last{.force = {1, 1, 1}};
+  haptico::DeviceRegistry registry = haptico::DeviceRegistry::with_simulated_devices();
+  const haptico::DeviceRegistry simulated = haptico::DeviceRegistry::with_simulated_devices();
+  ASSERT_TRUE(registry.register_driver("throwing-line", [&](const haptico::DeviceConfig& config)
+                                           -> Result<std::unique_ptr<haptico::HapticDevice>> {
+    auto inner = simulated.create("sim-line", config);
+    if (!inner) return inner.error();
+    // 600 ticks: the stylus is in the bunny, pushed out with force, when the driver fails
+    return std::unique_ptr<haptico::HapticDevice>(new ThrowingDevice(std::move(inner).value(), 600, &last));
+  }));
+  const std::string json = testing::replaced(testing::small_scene_json(), R"("driver": "sim-line")",
+                                             R"("driver": "throwing-line")");
+  auto scene = parse_scene(json, "small.json", testing::test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  SessionOptions options;
+  options.cache_dir = cache;
+  auto session = HapticSession::create(*scene, options, registry);
+  ASSERT_TRUE(session.has_value()) << session.error().message;
+  std::ostringstream trace;
+  const Status ran = (*session)->run(30.0, {}, &trace);
+  ASSERT_FALSE(ran.has_value());
+  EXPECT_EQ(ran.error().message,
+            "small.json: the haptic thread stopped: reading the device state threw: USB cable pulled; the device was "
+            "sent zero force");
+  EXPECT_EQ(last.force, Vec3{});
+  EXPECT_EQ(last.torque, Vec3{});
+  const auto table = testing::parse_trace(trace.str());
+  ASSERT_GT(table.rows.size(), 500u);
+  EXPECT_EQ(table.flags(table.rows.size() - 1), haptico::kTraceStopped);
+  EXPECT_EQ(norm(table.force(table.rows.size() - 1)), 0.0);
+  double before = 0.0;
+  for (std::size_t i = 0; i + 1 < table.rows.size(); ++i) before = std::max(before, norm(table.force(i)));
+  EXPECT_GT(before, 0.1) << "there was a force to take away";
+  EXPECT_LT((*session)->report().seconds, 30.0) << "the run ended when the thread did";
+  EXPECT_FALSE((*session)->world().running());
+  std::filesystem::remove_all(cache);
+}
 
 // Runs the real three-thread pipeline (haptic, collision, application) for 2 s. Under
 // ThreadSanitizer this checks every cross-thread exchange of the pipeline.

@@ -371,3 +371,30 @@ static_assert(!std::is_move_constructible_v<uh::Delegator<int>>);
 // arguments reach delegates by reference: the thunk signature shows it
 static_assert(std::is_same_v<uh::Delegator<std::string>::Thunk, void (*)(void*, const std::string&)>);
 static_assert(std::is_same_v<uh::Delegator<double&>::Thunk, void (*)(void*, double&)>);
+
+TEST_F(DelegatorTest, RefusedBindingIsVisibleAndBindsNothing) {
+  uh::Delegator<int> d;
+  Listener listener{&trace};
+  d.add_delegate<&free_a>();
+  d.refuse_binding("test: the broadcasting thread runs");
+  EXPECT_TRUE(d.binding_refused());
+  const std::uint64_t errors_before = uh::log::message_count(uh::log::Level::error);
+  // every binding kind is refused: invalid handles, empty connections, nothing called
+  EXPECT_FALSE(d.add_delegate<&free_b>().valid());
+  EXPECT_FALSE(d.add_delegate<&Listener::on_value>(listener).valid());
+  auto owned = std::make_shared<int>(7);
+  EXPECT_FALSE(d.add_delegate([owned](int) { g_trace->push_back("lambda"); }).valid());
+  EXPECT_EQ(owned.use_count(), 1) << "the refused lambda's copy is destroyed at once";
+  uh::ScopedConnection c = d.connect([](int) { g_trace->push_back("connected"); });
+  EXPECT_FALSE(c.connected());
+  EXPECT_EQ(d.size(), 1u);
+  EXPECT_EQ(d.refused_bindings(), 4u);
+  EXPECT_EQ(uh::log::message_count(uh::log::Level::error) - errors_before, 4u) << "each refusal is logged";
+  d.broadcast(1);
+  EXPECT_EQ(trace, (std::vector<std::string>{"free_a:1"}));
+  // allowed again: binding works as before
+  d.allow_binding();
+  EXPECT_TRUE(d.add_delegate<&free_b>().valid());
+  d.broadcast(2);
+  EXPECT_EQ(trace, (std::vector<std::string>{"free_a:1", "free_a:2", "free_b:2"}));
+}

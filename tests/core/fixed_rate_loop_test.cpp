@@ -7,6 +7,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 using namespace std::chrono_literals;
@@ -219,4 +221,45 @@ TEST(FixedRateLoop, DestructorStopsTheThread) {
   const int after = calls.load();
   std::this_thread::sleep_for(10ms);
   EXPECT_EQ(calls.load(), after);
+}
+
+TEST(FixedRateLoop, ThrowingCallbackEndsTheLoopAndTheExitCallbackRunsOnItsThread) {
+  uh::FixedRateLoop loop({.rate_hz = 2000.0, .name = "throw-loop"});
+  std::atomic<int> ticks{0};
+  std::atomic<int> exits{0};
+  std::atomic<bool> exit_on_loop_thread{false};
+  std::atomic<bool> exit_saw_throw{false};
+  std::string exit_what;  // written by the exit callback, read after running() is false
+  std::thread::id loop_thread;
+  ASSERT_TRUE(loop.start(
+      [&](const uh::TickInfo&) {
+        loop_thread = std::this_thread::get_id();
+        if (ticks.fetch_add(1) == 4) throw std::runtime_error("sensor unplugged");
+      },
+      [&](const uh::LoopExit& e) {
+        exit_on_loop_thread.store(std::this_thread::get_id() == loop_thread);
+        exit_saw_throw.store(e.callback_threw);
+        exit_what = e.what;
+        exits.fetch_add(1);
+      }));
+  ASSERT_TRUE(wait_for([&] { return !loop.running(); }));
+  // ended by itself, before any stop(): the exit callback has already run, on the loop thread
+  EXPECT_EQ(exits.load(), 1);
+  EXPECT_EQ(ticks.load(), 5);
+  EXPECT_TRUE(exit_on_loop_thread.load());
+  EXPECT_TRUE(exit_saw_throw.load());
+  EXPECT_EQ(exit_what, "sensor unplugged");
+  EXPECT_EQ(loop.failure(), "the tick callback threw: sensor unplugged");
+  loop.stop();
+  EXPECT_EQ(exits.load(), 1) << "once per run";
+  // a new run clears the failure, and a requested stop is not one
+  ASSERT_TRUE(loop.start([](const uh::TickInfo&) {}, [&](const uh::LoopExit& e) {
+    exit_saw_throw.store(e.callback_threw);
+    exits.fetch_add(1);
+  }));
+  EXPECT_TRUE(loop.failure().empty());
+  loop.stop();
+  EXPECT_EQ(exits.load(), 2);
+  EXPECT_FALSE(exit_saw_throw.load());
+  EXPECT_TRUE(loop.failure().empty());
 }

@@ -6,11 +6,13 @@
 #include <chrono>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "allocation_counter.hpp"
+#include "uh/core/log.hpp"
 #include "uh/haptico/sim_hand_device.hpp"
 #include "uh/haptico/sim_line_device.hpp"
 
@@ -38,6 +40,7 @@ class FakeDevice final : public HapticDevice {
   }
   DeviceState read_state() override {
     if (log_) log_->push_back("read");
+    if (reads == throw_on_read) throw std::runtime_error("USB cable pulled");
     DeviceState s;
     s.time_s = frozen ? frozen_time : 0.001 * static_cast<double>(reads);
     ++reads;
@@ -48,6 +51,7 @@ class FakeDevice final : public HapticDevice {
   void command(const DeviceCommand& cmd) override {
     if (log_) log_->push_back("command");
     last = cmd;
+    last_command_thread = std::this_thread::get_id();
     ++commands;
   }
 
@@ -57,6 +61,8 @@ class FakeDevice final : public HapticDevice {
   double frozen_time = 0.0;
   DeviceStatus status = DeviceStatus::kOk;
   DeviceCommand last{};
+  std::thread::id last_command_thread{};
+  int throw_on_read = -1;  // read_state() throws on this read (0-based); -1: never
   int reads = 0;
   int commands = 0;
 
@@ -358,7 +364,7 @@ TEST(HapticManager, TraceRecordsTicksAndWritesCsv) {
 TEST(HapticManager, ThreadedRunTicksAndStopZeroesForce) {
   auto device = std::make_unique<SimLineDevice>(SimLineOptions{});
   SimLineDevice* raw = device.get();
-  HapticManager manager(std::move(device), {.rate_hz = 1000.0, .soft_start_s = 0.0});
+  HapticManager manager(std::move(device), {.rate_hz = 1000.0, .soft_start_s = 0.0, .limits = kNoRateLimit});
   std::atomic<int> moves{0};
   std::atomic<int> forces{0};
   manager.move_on_haptic_tick().add_delegate([&](const DeviceState&) { moves.fetch_add(1); });
@@ -410,6 +416,110 @@ TEST(HapticManager, TickTimeIsSteadyClockInThreadedSessions) {
   const double after = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   EXPECT_GE(seen.load(), before);
   EXPECT_LE(seen.load(), after);
+}
+
+// Waits until the haptic thread has ended by itself (or 10 s passed).
+void wait_for_end(const HapticManager& manager) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (manager.running() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+// A delegate that throws ends the haptic thread; before it exits, the thread itself commands zero
+// (3 N were on the device), and the cause is kept. Nobody calls stop() before the checks.
+TEST(HapticManager, ThrowingDelegateZeroesTheDeviceFromTheHapticThread) {
+  Fixture f({.trace_capacity = 1024, .soft_start_s = 0.0, .limits = kNoRateLimit}, false);
+  std::atomic<int> forces{0};
+  f.manager->force_on_haptic_tick().add_delegate([&](const DeviceState&, DeviceCommand& cmd) {
+    if (forces.fetch_add(1) == 50) throw std::runtime_error("contact solver diverged");
+    cmd.force = {0, 0, 3.0};
+  });
+  ASSERT_TRUE(f.manager->start());
+  wait_for_end(*f.manager);
+  ASSERT_FALSE(f.manager->running()) << "the thread ended by itself";
+  EXPECT_EQ(forces.load(), 51);
+  EXPECT_EQ(f.device->last.force, Vec3{}) << "zero, before anyone called stop()";
+  EXPECT_NE(f.device->last_command_thread, std::this_thread::get_id()) << "sent by the haptic thread";
+  EXPECT_EQ(f.device->commands, 51) << "50 ticks with 3 N, then the zero";
+  const Status status = f.manager->thread_status();
+  ASSERT_FALSE(status.has_value());
+  EXPECT_EQ(status.error().message,
+            "the haptic thread stopped: a ForceOnHapticTick delegate (computing the force) threw: contact solver "
+            "diverged; the device was sent zero force");
+  std::vector<TraceSample> trace;
+  f.manager->drain_trace(trace);
+  ASSERT_EQ(trace.size(), 51u);
+  EXPECT_EQ(trace[49].sent.force.z, 3.0);
+  EXPECT_EQ(trace.back().flags, kTraceStopped);
+  EXPECT_EQ(trace.back().sent.force, Vec3{});
+  f.manager->stop();
+  EXPECT_EQ(f.device->commands, 51) << "the zero is sent once";
+  EXPECT_FALSE(f.manager->thread_status().has_value()) << "the cause stays until the next start()";
+  // the manager runs again after stop(); the new run has no failure
+  ASSERT_TRUE(f.manager->start());
+  EXPECT_TRUE(f.manager->thread_status().has_value());
+  f.manager->stop();
+}
+
+TEST(HapticManager, ThrowingDriverIsNamedAndNotReadAgain) {
+  Fixture f({.trace_capacity = 1024, .soft_start_s = 0.0, .limits = kNoRateLimit}, false);
+  f.device->throw_on_read = 20;
+  f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {1, 0, 0}; });
+  ASSERT_TRUE(f.manager->start());
+  wait_for_end(*f.manager);
+  ASSERT_FALSE(f.manager->running());
+  EXPECT_EQ(f.device->last.force, Vec3{});
+  EXPECT_EQ(f.device->reads, 20) << "the stop sample does not ask a driver that threw";
+  EXPECT_EQ(f.manager->thread_status().error().message,
+            "the haptic thread stopped: reading the device state threw: USB cable pulled; the device was sent zero "
+            "force");
+  f.manager->stop();
+}
+
+// Stopped or stepped, a run ends with zero on the device and that zero as the trace's last sample.
+TEST(HapticManager, StopOfASteppedRunSendsAndTracesZero) {
+  Fixture f({.trace_capacity = 64, .soft_start_s = 0.0, .limits = kNoRateLimit}, false);
+  ASSERT_TRUE(f.manager->open());
+  f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {0, 2, 0}; });
+  for (int i = 0; i < 5; ++i) f.manager->step(0.001 * i);
+  EXPECT_EQ(f.device->last.force, (Vec3{0, 2, 0}));
+  f.manager->stop();
+  EXPECT_EQ(f.device->last.force, Vec3{});
+  std::vector<TraceSample> trace;
+  f.manager->drain_trace(trace);
+  ASSERT_EQ(trace.size(), 6u);
+  EXPECT_EQ(trace.back().flags, kTraceStopped);
+  EXPECT_NEAR(trace.back().tick_time_s, 0.005, 1e-12);
+  EXPECT_GT(trace.back().state.time_s, trace[4].state.time_s) << "device times keep increasing: the trace replays";
+  f.manager->stop();
+  EXPECT_EQ(f.device->commands, 6) << "stop() is idempotent";
+  EXPECT_EQ(f.manager->drain_trace(trace), 0u);
+}
+
+// Binding while the haptic thread runs would race with it: refused, visibly, on every event.
+TEST(HapticManager, BindingWhileRunningIsRefused) {
+  Fixture f({}, false);
+  f.manager->force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& cmd) { cmd.force = {1, 0, 0}; });
+  ASSERT_TRUE(f.manager->start());
+  const std::uint64_t errors_before = log::message_count(log::Level::error);
+  EXPECT_FALSE(f.manager->move_on_haptic_tick().add_delegate([](const DeviceState&) {}).valid());
+  ScopedConnection force = f.manager->force_on_haptic_tick().connect([](const DeviceState&, DeviceCommand& cmd) {
+    cmd.force = {100, 0, 0};
+  });
+  EXPECT_FALSE(force.connected());
+  ScopedConnection sent = f.manager->sent_on_haptic_tick().connect([](const TraceSample&) {});
+  EXPECT_FALSE(sent.connected());
+  EXPECT_TRUE(f.manager->force_on_haptic_tick().binding_refused());
+  EXPECT_EQ(f.manager->force_on_haptic_tick().size(), 1u);
+  EXPECT_EQ(log::message_count(log::Level::error) - errors_before, 3u) << "each refusal says why";
+  wait_for_ticks(*f.manager, 20);
+  f.manager->stop();
+  EXPECT_EQ(f.device->last.force, Vec3{});
+  // stopped: binding works again
+  EXPECT_FALSE(f.manager->force_on_haptic_tick().binding_refused());
+  ScopedConnection later = f.manager->force_on_haptic_tick().connect([](const DeviceState&, DeviceCommand&) {});
+  EXPECT_TRUE(later.connected());
 }
 
 TEST(HapticManager, TickDoesNotAllocate) {

@@ -37,15 +37,22 @@ TEST(TraceCsvWriter, WritesEveryTickOfAThreadedRun) {
   ASSERT_TRUE((*writer)->stop());
   const HapticStats stats = manager.stats();
   EXPECT_EQ(stats.trace_dropped, 0u);
-  EXPECT_EQ((*writer)->rows_written(), stats.ticks);
+  // every tick, then the zero the haptic thread sent as it ended
+  EXPECT_EQ((*writer)->rows_written(), stats.ticks + 1);
 
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);
   EXPECT_EQ(line.rfind("tick_time_s,device_time_s,", 0), 0u);
   std::uint64_t rows = 0;
-  while (std::getline(in, line)) ++rows;
-  EXPECT_EQ(rows, stats.ticks);
+  std::string last;
+  while (std::getline(in, line)) {
+    ++rows;
+    last = line;
+  }
+  EXPECT_EQ(rows, stats.ticks + 1);
+  EXPECT_NE(last.find(",0,0,0,0,0,0,0,0,0,0,0,0,1024"), std::string::npos)
+      << "requested and sent zero, flags kTraceStopped: " << last;
   EXPECT_GT(rows, 10u);
   std::remove(path.c_str());
 }

@@ -62,7 +62,8 @@ struct RateSample {
 struct SessionReport {
   std::string scene;
   bool stepped = false;
-  double seconds = 0.0;
+  double seconds = 0.0;                ///< the time run [s] (less than asked when stopped early)
+  bool stopped_early = false;          ///< request_stop() ended run() or run_stepped() before its time
   // haptic thread
   double haptic_target_hz = 0.0;
   double haptic_rate_hz = 0.0;
@@ -173,12 +174,21 @@ class HapticSession {
   bool running() const { return phase_ == Phase::kRunning; }
 
   /// start(), then calls `on_status` on this thread about every 250 ms for `seconds`, then stop().
+  /// Ends early (within 20 ms) on request_stop(), or when the haptic or collision thread ended by
+  /// itself (stop() then returns the cause, e.g. what a tick threw). stop() also runs when
+  /// `on_status` throws.
   Status run(double seconds, const std::function<void(const SessionState&)>& on_status = {},
              std::ostream* trace = nullptr);
 
   /// Runs deterministically on the calling thread without any other thread: haptic ticks at the
-  /// haptic rate in simulated time, one collision step every `ticks_per_collision_step` ticks.
+  /// haptic rate in simulated time, one collision step every `ticks_per_collision_step` ticks;
+  /// ends early on request_stop(); ends with zero force sent and traced, like a threaded run.
   Status run_stepped(double seconds, int ticks_per_collision_step, std::ostream* trace = nullptr);
+
+  /// Asks run() or run_stepped() to end early, as if its time were up (the report says
+  /// stopped_early). Any thread, and async-signal-safe (one lock-free atomic store): `uh run`
+  /// calls it from its SIGINT and SIGTERM handlers. It stays requested: a later run ends at once.
+  void request_stop() { stop_requested_.store(true, std::memory_order_relaxed); }
 
   /// The report of the run (complete after stop() or run_stepped()).
   const SessionReport& report() const { return report_; }
@@ -211,6 +221,8 @@ class HapticSession {
   ScopedConnection sent_connection_;
   ScopedConnection collision_connection_;
 
+  static_assert(std::atomic<bool>::is_always_lock_free, "request_stop() must be async-signal-safe");
+  std::atomic<bool> stop_requested_{false};
   Phase phase_ = Phase::kReady;
   Status stopped_{Ok{}};    // what the first stop() returned
   double t0_s_ = 0.0;       // steady-clock time of start() (0 in stepped runs) [s]

@@ -28,8 +28,10 @@
 ///
 /// Thread rules: a Delegator is NOT a cross-thread primitive. Binding, removing and broadcasting
 /// happen on one thread, or all binding happens before the broadcasting thread starts (with the
-/// thread start as the synchronisation point) and nothing binds while it runs. To move events
-/// across threads use SpscQueue or LatestValue.
+/// thread start as the synchronisation point) and nothing binds while it runs. An owner enforces
+/// the latter with refuse_binding() while its thread runs: binding then fails visibly (an invalid
+/// handle, an empty connection, a logged error, a count) instead of racing. To move events across
+/// threads use SpscQueue or LatestValue.
 ///
 /// Real-time: broadcast() is real-time safe if the bound delegates are (no allocation, no locks,
 /// no exceptions thrown by the delegator itself). add_delegate/remove_delegate/clear are not.
@@ -46,6 +48,8 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include "uh/core/log.hpp"
 
 namespace uh {
 
@@ -82,9 +86,11 @@ class [[nodiscard]] ScopedConnection {
   ScopedConnection() = default;
 
   /// Takes ownership of `handle`, a binding of `delegator`.
+  /// Takes ownership of `handle`, a binding of `delegator`; an invalid handle (a refused binding)
+  /// gives an empty connection.
   template <typename... Args>
   ScopedConnection(Delegator<Args...>& delegator, DelegateHandle handle)
-      : owner_(&delegator), handle_(handle), remove_(&remove_from<Args...>) {}
+      : owner_(handle.valid() ? &delegator : nullptr), handle_(handle), remove_(&remove_from<Args...>) {}
 
   ScopedConnection(const ScopedConnection&) = delete;
   ScopedConnection& operator=(const ScopedConnection&) = delete;
@@ -180,7 +186,7 @@ class Delegator {
     using Stored = std::remove_cvref_t<Callable>;
     auto owned = std::make_unique<Stored>(std::forward<Callable>(callable));
     const DelegateHandle handle = insert(&call_owned<Stored>, owned.get(), &delete_owned<Stored>);
-    owned.release();  // now owned by the entry
+    owned.release();  // now owned by the entry (or already deleted by insert() if refused)
     return handle;
   }
 
@@ -243,6 +249,17 @@ class Delegator {
   /// Reserves room for `n` bindings so that later binds do not reallocate. Not real-time safe.
   void reserve(std::size_t n) { entries_.reserve(n); }
 
+  /// Refuses every binding until allow_binding(): add_delegate() returns an invalid handle and
+  /// connect() an empty connection, `reason` is logged as an error and refused_bindings() counts
+  /// the attempt. For an owner whose broadcasting thread runs. `reason` must outlive the refusal
+  /// (a string literal). Owner's thread; not real-time safe.
+  void refuse_binding(const char* reason) { refusal_ = reason; }
+  /// Ends refuse_binding(). Owner's thread.
+  void allow_binding() { refusal_ = nullptr; }
+  [[nodiscard]] bool binding_refused() const { return refusal_ != nullptr; }
+  /// Bindings refused so far.
+  [[nodiscard]] std::uint64_t refused_bindings() const { return refused_; }
+
  private:
   struct Entry {
     Thunk fn = nullptr;  ///< nullptr once removed
@@ -286,6 +303,12 @@ class Delegator {
   }
 
   DelegateHandle insert(Thunk fn, void* payload, void (*deleter)(void*)) {
+    if (refusal_ != nullptr) {
+      if (deleter != nullptr) deleter(payload);
+      ++refused_;
+      log::error("{}", refusal_);
+      return DelegateHandle{};
+    }
     compact_if_idle();
     const DelegateHandle handle{detail::next_delegate_id()};
     try {
@@ -315,6 +338,8 @@ class Delegator {
   std::vector<Entry> entries_;
   std::size_t live_ = 0;
   int depth_ = 0;
+  const char* refusal_ = nullptr;  // set while binding is refused
+  std::uint64_t refused_ = 0;
 };
 
 /// The binding side of a Delegator, for classes that keep their Delegator private (EnTT's sink):
@@ -353,6 +378,7 @@ class DelegateSink {
   }
 
   bool remove_delegate(DelegateHandle handle) { return delegator_->remove_delegate(handle); }
+  [[nodiscard]] bool binding_refused() const { return delegator_->binding_refused(); }
   [[nodiscard]] std::size_t size() const { return delegator_->size(); }
   [[nodiscard]] bool empty() const { return delegator_->empty(); }
 

@@ -17,9 +17,15 @@
 /// Statistics are written by the loop thread into lock-free histograms (LatencyHistogram) and
 /// atomics; stats() may be called from any thread at any time and returns a plain snapshot.
 ///
+/// Ending: the loop ends on stop(), on request_stop(), or when the callback throws (it should not;
+/// the loop catches the exception, logs it and keeps its message in failure()). However it ends,
+/// the exit callback given to start() runs once on the loop thread before the thread exits: the
+/// place for a last action that must come from that thread, such as commanding a device to zero.
+///
 /// Threads: construct, start(), stop() and destroy from one controlling thread. The callback runs
-/// on the loop thread only; it must not throw, and must not call stop() (that would join itself;
-/// call request_stop() instead). stats(), running() and request_stop() are callable from any thread.
+/// on the loop thread only and must not call stop() (that would join itself; call request_stop()
+/// instead). stats(), running() and request_stop() are callable from any thread; failure() once
+/// running() is false.
 
 #include <atomic>
 #include <chrono>
@@ -71,9 +77,16 @@ struct FixedRateLoopStats {
   bool priority_raised = false;  ///< SCHED_FIFO was granted (only tried when raise_priority)
 };
 
+/// How a loop ended, as its exit callback sees it.
+struct LoopExit {
+  bool callback_threw = false;  ///< the tick callback threw (else a stop was requested)
+  const char* what = "";        ///< the exception's message when it threw ("" otherwise); valid during the call
+};
+
 class FixedRateLoop {
  public:
   using Callback = std::function<void(const TickInfo&)>;
+  using ExitCallback = std::function<void(const LoopExit&)>;
 
   explicit FixedRateLoop(FixedRateLoopOptions options = {});
   /// Stops and joins the loop thread if it runs.
@@ -82,10 +95,12 @@ class FixedRateLoop {
   FixedRateLoop& operator=(const FixedRateLoop&) = delete;
 
   /// Resets the statistics and starts the loop thread calling `callback` every period; the first
-  /// tick is scheduled one period after start(). Returns an error (and starts nothing) if the
-  /// loop is already running, the callback is empty or the options are invalid. Controlling
-  /// thread only; not real-time safe. A stopped loop may be started again.
-  Status start(Callback callback);
+  /// tick is scheduled one period after start(). `on_exit` (optional) runs once on the loop thread
+  /// when the loop ends, for any reason, before the thread exits (an exception from it is caught
+  /// and logged). Returns an error (and starts nothing) if the loop is already running, the
+  /// callback is empty or the options are invalid. Controlling thread only; not real-time safe. A
+  /// stopped loop may be started again.
+  Status start(Callback callback, ExitCallback on_exit = {});
 
   /// Asks the loop to stop and joins its thread; the current tick finishes first. Idempotent.
   /// Controlling thread only, never from the callback.
@@ -106,13 +121,18 @@ class FixedRateLoop {
     return missed_deadlines_.load(std::memory_order_relaxed);
   }
 
+  /// Why the last run ended, if the callback threw: "the tick callback threw: <message>"; empty
+  /// after a requested stop. Read once running() is false (or after stop()); controlling thread.
+  [[nodiscard]] const std::string& failure() const { return failure_; }
+
   [[nodiscard]] const FixedRateLoopOptions& options() const { return options_; }
 
  private:
-  void run(Callback callback);
+  void run(Callback callback, ExitCallback on_exit);
 
   FixedRateLoopOptions options_;
   std::thread thread_;
+  std::string failure_;  // written by the loop thread before running_ turns false
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
   std::atomic<bool> priority_raised_{false};

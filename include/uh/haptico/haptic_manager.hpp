@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include "uh/core/delegator.hpp"
@@ -82,10 +83,16 @@ struct HapticStats {
 ///
 /// Frames and units: those of the device (DeviceState, DeviceCommand), SI.
 ///
+/// Ending: however the haptic thread ends (stop(), or a tick that threw: a delegate or the
+/// driver), its last act is to command zero force and trace that zero (kTraceStopped); a thread
+/// that ended by a throw keeps the cause in thread_status(). A stepped session gets its zero from
+/// stop(). stop() and the destructor always leave the device at zero.
+///
 /// Threads: construct, open(), start(), stop(), step(), bind delegates and destroy from one
 /// controlling thread. Bind delegates only while no threaded session runs (the Delegator is not
-/// a cross-thread primitive; start() publishes the bindings to the haptic thread). Delegates run
-/// on the haptic thread and must be real-time safe. halt(), resume(), clear_fault(), stats() and
+/// a cross-thread primitive; start() publishes the bindings to the haptic thread): from start()
+/// to stop() binding is refused (an invalid handle or empty connection, an error logged, see
+/// Delegator::refuse_binding). Delegates run on the haptic thread and must be real-time safe. halt(), resume(), clear_fault(), stats() and
 /// running() may be called from any thread; drain_trace() from one consumer thread.
 class HapticManager {
  public:
@@ -101,9 +108,14 @@ class HapticManager {
   Status open();
   /// Opens the device if needed and starts the haptic thread at options().rate_hz.
   Status start();
-  /// Stops the haptic thread (the current tick finishes), then sends zero force. The device stays
-  /// open; start() or step() may follow. Idempotent.
+  /// Stops the haptic thread (the current tick finishes; the thread commands zero as it ends), or
+  /// after stepped ticks commands zero itself; the zero is traced. The device stays open; start()
+  /// or step() may follow. Idempotent.
   void stop();
+  /// Why the last threaded run ended: an Error naming the cause ("the haptic thread stopped:
+  /// a ForceOnHapticTick delegate (computing the force) threw: ...") once the thread ended because
+  /// a tick threw; Ok while it runs, after a requested stop, and before any run. Controlling thread.
+  Status thread_status() const;
   /// Runs one tick now on the calling thread, with `now_s` [s] as the tick time: the deterministic
   /// entry for stepped sessions and tests. The device must be open and no threaded session may
   /// run (asserted). Returns what happened in that tick.
@@ -126,9 +138,11 @@ class HapticManager {
   /// the safety stage (e.g. to publish the newest state to another thread). See the thread rules.
   DelegateSink<const TraceSample&> sent_on_haptic_tick() { return DelegateSink{sent_event_}; }
 
-  /// Binding side of MoveOnHapticTick(const DeviceState&). See the thread rules above.
+  /// Binding side of MoveOnHapticTick(const DeviceState&). See the thread rules above: refused
+  /// while the haptic thread runs.
   DelegateSink<const DeviceState&> move_on_haptic_tick() { return DelegateSink{move_event_}; }
   /// Binding side of ForceOnHapticTick(const DeviceState&, DeviceCommand&): add to the command.
+  /// Refused while the haptic thread runs.
   DelegateSink<const DeviceState&, DeviceCommand&> force_on_haptic_tick() { return DelegateSink{force_event_}; }
 
   /// Time of the tick being run [s]: in threaded sessions the steady-clock time of the tick's start
@@ -158,8 +172,17 @@ class HapticManager {
   const HapticManagerOptions& options() const { return options_; }
 
  private:
+  // where the haptic thread is in its tick, for the message when something in it throws
+  enum class TickPhase { kIdle, kReadState, kMove, kForce, kCommand, kSent };
+  static const char* phase_name(TickPhase phase);
+
   TraceSample tick(double now_s);
   void count(std::uint32_t flags);
+  void on_loop_exit(const LoopExit& exit);
+  void allow_binding();
+  // commands zero, restarts the limit chain from it and traces it (with the state read after it
+  // when `read_device`) as the run's last sample
+  void send_final_zero(double now_s, bool read_device);
 
   HapticManagerOptions options_;
   std::unique_ptr<HapticDevice> device_;
@@ -172,6 +195,10 @@ class HapticManager {
   Delegator<const TraceSample&> sent_event_;
   std::unique_ptr<SpscQueue<TraceSample>> trace_;
   double tick_time_s_ = 0.0;
+  TickPhase phase_ = TickPhase::kIdle;  // haptic thread
+  DeviceState last_state_{};            // haptic thread: the state of the last tick
+  bool ended_with_zero_ = false;        // no tick since the last final zero
+  std::string failure_;                 // written by the haptic thread as it ends (thread_status())
   std::int64_t fade_count_ = 0;
   int frozen_ticks_ = 0;          // consecutive ticks with the same device time (haptic thread)
   double last_device_time_s_ = 0.0;

@@ -1,0 +1,204 @@
+// `uh run` interrupted as a user interrupts it: SIGINT (Ctrl-C) or SIGTERM sent to the running
+// program. It must send zero force, print its summary, keep the trace (whose last row is that
+// zero) and exit with 128 + the signal number.
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace uh {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The stylus bounces into the bunny and out for a minute: in contact most of the time.
+std::string long_scene_json(const fs::path& assets) {
+  return fmt::format(R"({{
+  "name": "signal-test",
+  "rates": {{ "haptic_hz": 1000, "collision_hz": 500 }},
+  "seconds": 60,
+  "objects": [{{ "name": "bunny", "mesh": "{0}/meshes/bunny_npm_3674.obj", "meters_per_unit": 0.01, "spheres": 600,
+                "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
+  "tool": {{
+    "name": "stylus", "mesh": "{0}/meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
+    "force": {{ "mode": "6dof", "force_scale": 8.0e6, "damping": 1.0, "center_of_mass": [0, 0, 0.025],
+               "max_force_n": 6.0, "max_torque_nm": 0.3 }},
+    "device": {{ "driver": "sim-line",
+                "config": {{ "start": [0.0, 0.0, 0.07], "end": [0.0, 0.0, 0.045], "duration_s": 0.3, "bounce": true,
+                            "dof_actuated": 6, "max_force_n": 6 }} }}
+  }},
+  "watch": ["bunny"]
+}})",
+                     assets.string());
+}
+
+// True once process `pid` has a thread named `name` (Linux: /proc/PID/task/*/comm).
+bool has_thread(pid_t pid, const std::string& name) {
+  std::error_code ec;
+  for (const auto& task : fs::directory_iterator(fmt::format("/proc/{}/task", pid), ec)) {
+    std::string comm = read_text(task.path() / "comm");
+    while (!comm.empty() && comm.back() == '\n') comm.pop_back();
+    if (comm == name) return true;
+  }
+  return false;
+}
+
+struct Finished {
+  bool exited = false;
+  int code = -1;
+};
+
+// Waits for `pid` to end, at most `limit` (then kills it: a hang is a failure, not a wait).
+Finished wait_for_exit(pid_t pid, std::chrono::seconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return {};
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  return {WIFEXITED(status), WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+class RunSignalTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
+  const int signal_number = GetParam();
+  const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+  const fs::path dir =
+      fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}", ::getpid(), signal_number);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path scene = dir / "scene.json", trace = dir / "trace.csv", out = dir / "stdout.txt",
+                 err = dir / "stderr.txt";
+  std::ofstream(scene) << long_scene_json(fs::path(UH_TEST_DATA_DIR));
+
+  // everything the child needs is prepared before fork(): it only redirects and execs
+  const std::string cache_env = "UH_CACHE_DIR=" + (dir / "cache").string();
+  std::vector<std::string> args = {UH_CLI_PATH, "run",          scene.string(),
+                                   "--trace",   trace.string(), "--no-realtime"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_storage = {cache_env, "CI=1"};
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry(*e);
+    if (entry.rfind("UH_CACHE_DIR=", 0) != 0 && entry.rfind("CI=", 0) != 0) env_storage.push_back(entry);
+  }
+  std::vector<char*> envp;
+  for (auto& e : env_storage) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const std::string out_path = out.string(), err_path = err.string();
+
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int o = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (o < 0 || e < 0 || dup2(o, STDOUT_FILENO) < 0 || dup2(e, STDERR_FILENO) < 0) _exit(120);
+    execve(argv[0], argv.data(), envp.data());
+    _exit(121);
+  }
+
+  // running: the haptic thread exists (the handlers are in place before it starts); then some
+  // ticks in contact, so that there is a force to take away
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (!has_thread(pid, "uh-haptic") && std::chrono::steady_clock::now() < deadline) {
+    if (waitpid(pid, nullptr, WNOHANG) != 0) FAIL() << "uh run ended before it ran: " << read_text(err);
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_TRUE(has_thread(pid, "uh-haptic")) << "uh run never started its haptic thread: " << read_text(err);
+  std::this_thread::sleep_for(400ms);
+  ASSERT_EQ(kill(pid, signal_number), 0);
+  const auto signalled = std::chrono::steady_clock::now();
+  const Finished finished = wait_for_exit(pid, 30s);
+  const double stop_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - signalled).count();
+  RecordProperty("stop_ms", std::to_string(stop_ms));
+
+  ASSERT_TRUE(finished.exited) << "uh run did not end by itself after " << name;
+  EXPECT_EQ(finished.code, 128 + signal_number) << read_text(err);
+  const std::string stdout_text = read_text(out), stderr_text = read_text(err);
+  EXPECT_NE(stdout_text.find("scene signal-test:"), std::string::npos) << "the summary: " << stdout_text;
+  EXPECT_NE(stdout_text.find("(stopped early)"), std::string::npos) << stdout_text;
+  EXPECT_NE(stdout_text.find("  force     max"), std::string::npos) << stdout_text;
+  EXPECT_NE(stderr_text.find(fmt::format("stopped by {}", name)), std::string::npos) << stderr_text;
+
+  // the trace is kept, and its last row is the zero the device got
+  ASSERT_TRUE(fs::exists(trace)) << stderr_text;
+  std::istringstream lines(read_text(trace));
+  std::string header, line, last;
+  std::getline(lines, header);
+  std::vector<std::string> names;
+  {
+    std::istringstream h(header);
+    for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  }
+  const auto column = [&](const std::string& n) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == n) return i;
+    ADD_FAILURE() << "no column " << n;
+    return std::size_t{0};
+  };
+  const auto cells = [](const std::string& row) {
+    std::vector<double> v;
+    std::istringstream l(row);
+    for (std::string c; std::getline(l, c, ',');) v.push_back(std::strtod(c.c_str(), nullptr));
+    return v;
+  };
+  double max_force = 0.0;
+  std::size_t rows = 0;
+  while (std::getline(lines, line)) {
+    if (!last.empty()) {
+      const auto v = cells(last);
+      max_force = std::max(max_force,
+                           std::abs(v[column("fz")]) + std::abs(v[column("fx")]) + std::abs(v[column("fy")]));
+    }
+    last = line;
+    ++rows;
+  }
+  ASSERT_GT(rows, 100u);
+  const auto v = cells(last);
+  ASSERT_EQ(v.size(), names.size());
+  EXPECT_EQ(v[column("fx")], 0.0) << last;
+  EXPECT_EQ(v[column("fy")], 0.0) << last;
+  EXPECT_EQ(v[column("fz")], 0.0) << last;
+  EXPECT_EQ(v[column("tx")], 0.0) << last;
+  EXPECT_NE(static_cast<unsigned>(v[column("flags")]) & 1024u, 0u)
+      << "the zero sent as the haptic thread ended: " << last;
+  EXPECT_GT(max_force, 0.1) << "the stylus pressed into the bunny before the signal";
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest, ::testing::Values(SIGINT, SIGTERM),
+                         [](const ::testing::TestParamInfo<int>& p) {
+                           return p.param == SIGINT ? "Sigint" : "Sigterm";
+                         });
+
+}  // namespace
+}  // namespace uh
