@@ -6,6 +6,8 @@ find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(assimp REQUIRED)
 find_package(PNG REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
+# Beast and Asio (the service's WebSocket and HTTP server) are header-only
+find_package(Boost 1.74 REQUIRED)
 
 # readerwriterqueue ships headers only, without a CMake config.
 find_path(UH_READERWRITERQUEUE_INCLUDE_DIR readerwriterqueue/readerwriterqueue.h REQUIRED)

@@ -9,9 +9,15 @@ packages=(
   libeigen3-dev libassimp-dev libpng-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libreaderwriterqueue-dev
   libfcl-dev libbullet-dev libcairo2-dev
+  libboost-dev chromium python3-websockets
   clang libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
 )
+
+# the live view's build (npm ci, esbuild) needs node and npm: Debian's, unless another node is there
+if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

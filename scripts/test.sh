@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The whole test suite, three builds in separate directories:
-#   1. Release: every test (unit, integration, the C API, the installed-package consumer), then
-#      the Python module's pytest suite with Debian's /usr/bin/python3;
-#   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test;
+#   1. Release: every test (unit, integration, the C API, the installed-package consumer, the live
+#      view in Chromium), then the Python module's pytest suite with Debian's /usr/bin/python3;
+#   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test (the live view's browser test once,
+#      in the Release stage, is enough);
 #   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions);
 #   4. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds), the scene
-#      parser (the repository's scenes as seeds) and the CSV reader (fuzz/csv_seeds).
+#      parser (the repository's scenes as seeds), the CSV reader (fuzz/csv_seeds) and the service's
+#      message parser (fuzz/protocol_seeds).
 # Ends with one summary line: "tests: N passed, N failed".
 set -uo pipefail
 source "$(dirname "$0")/common.sh"
@@ -61,14 +63,14 @@ else
 fi
 
 echo "== build (AddressSanitizer + UndefinedBehaviorSanitizer) =="
-if uh_build build/asan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=address,undefined -DUH_BUILD_BENCHMARKS=OFF; then
+if uh_build build/asan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=address,undefined -DUH_BUILD_BENCHMARKS=OFF -DUH_BUILD_VIEW=OFF; then
   run_ctest asan+ubsan build/asan -LE no_sanitizer
 else
   echo "test: sanitizer build failed"; status=1; failed=$((failed + 1))
 fi
 
 echo "== build (ThreadSanitizer) =="
-if uh_build build/tsan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=thread -DUH_BUILD_BENCHMARKS=OFF; then
+if uh_build build/tsan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=thread -DUH_BUILD_BENCHMARKS=OFF -DUH_BUILD_VIEW=OFF; then
   run_ctest tsan build/tsan -L threads
 else
   echo "test: ThreadSanitizer build failed"; status=1; failed=$((failed + 1))
@@ -76,9 +78,9 @@ fi
 
 echo "== build (libFuzzer, clang) =="
 if command -v clang++ >/dev/null 2>&1; then
-  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz uh_csv_reader_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz uh_csv_reader_fuzz uh_service_protocol_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
        -DUH_BUILD_FUZZERS=ON -DUH_BUILD_APPS=OFF -DUH_BUILD_BENCHMARKS=OFF; then
-    run_ctest fuzz build/fuzz -R '^(ist_|scene_parser_fuzz|csv_reader_fuzz)'
+    run_ctest fuzz build/fuzz -R '^(ist_|scene_parser_fuzz|csv_reader_fuzz|service_protocol_fuzz)'
   else
     echo "test: fuzzer build failed"; status=1; failed=$((failed + 1))
   fi

@@ -17,6 +17,8 @@
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/atomic_file_writer.hpp"
+#include "uh/service/server.hpp"
+#include "view_assets.hpp"
 
 namespace uh::cli {
 namespace {
@@ -70,6 +72,8 @@ struct RunArgs {
   bool stepped = false;
   int ticks_per_collision = 4;
   bool no_realtime = false;
+  bool view = false;
+  int view_port = 7770;
 };
 
 void print_summary(const controllers::SessionReport& r) {
@@ -128,8 +132,19 @@ int run_session(const RunArgs& args) {
   const char* ci = std::getenv("CI");
   const bool live = !args.json && isatty(STDERR_FILENO) == 1 && (ci == nullptr || *ci == '\0');
 
+  // with the live view, the server runs the session (browsers watch it) and stops it after `seconds`
+  std::unique_ptr<service::Server> view_server;
+  if (args.view) {
+    auto server = service::Server::start({.port = static_cast<std::uint16_t>(args.view_port), .files = view::static_files()});
+    if (!server) return fail(server.error().message);
+    view_server = std::move(server).value();
+    std::fprintf(stderr, "  live view: %s\n", view_server->url().c_str());
+  }
   Status ran = Ok{};
-  {
+  if (view_server) {
+    ran = view_server->run_session(**session, seconds, trace);
+    view_server->stop();
+  } else {
     const StopOnSignals stop_on_signals(**session);
     ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
                        : (*session)->run(seconds,
@@ -184,6 +199,10 @@ void add_run_command(CLI::App& app, CommandRunner& runner) {
   r->add_flag("--stepped", args.stepped, "deterministic run on one thread in simulated time");
   r->add_option("--ticks-per-collision", args.ticks_per_collision, "with --stepped: haptic ticks per collision step")
       ->default_val(4)->check(CLI::Range(1, 1000));
+  auto* view_flag = r->add_flag("--view", args.view, "serve the live view of the session at http://127.0.0.1:PORT/ while it runs");
+  r->add_option("--port", args.view_port, "with --view: the port of the live view (0: any free port)")
+      ->default_val(7770)->check(CLI::Range(0, 65535))->needs(view_flag);
+  view_flag->excludes(r->get_option("--stepped"));
   r->add_flag("--no-realtime", args.no_realtime,
               "do not ask for SCHED_FIFO for the haptic and collision threads (asked by default; refused without privileges)");
   r->callback([&runner] { runner = [] { return run_session(args); }; });

@@ -15,6 +15,7 @@ using CommandRunner = std::function<int()>;
 void add_ist_commands(CLI::App& app, CommandRunner& runner);
 void add_query_command(CLI::App& app, CommandRunner& runner);
 void add_run_command(CLI::App& app, CommandRunner& runner);
+void add_serve_command(CLI::App& app, CommandRunner& runner);
 
 /// Prints "uh: <message>" to stderr and returns 1.
 int fail(const std::string& message);

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   uh::cli::add_ist_commands(app, runner);
   uh::cli::add_query_command(app, runner);
   uh::cli::add_run_command(app, runner);
+  uh::cli::add_serve_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

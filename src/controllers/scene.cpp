@@ -412,15 +412,24 @@ Status write_if_changed(const std::filesystem::path& path, std::string_view text
 
 }  // namespace
 
-Result<Scene> default_scene(const std::filesystem::path& cache_dir) {
+Result<std::filesystem::path> write_default_scene(const std::filesystem::path& cache_dir) {
   std::error_code ec;
   const std::filesystem::path dir = cache_dir / "default-scene";
   std::filesystem::create_directories(dir / "scenes", ec);
   std::filesystem::create_directories(dir / "assets" / "meshes", ec);
   if (ec) return Error{fmt::format("{}: cannot create the cache folder: {}", dir.string(), ec.message())};
-  for (const auto& file : embedded::files())
+  std::filesystem::path scene_file;
+  for (const auto& file : embedded::files()) {
     if (auto s = write_if_changed(dir / file.path, file.text); !s) return s.error();
-  return parse_scene(embedded::default_scene_json(), "<embedded default scene>", dir / "scenes");
+    if (file.text.data() == embedded::default_scene_json().data()) scene_file = dir / file.path;
+  }
+  return scene_file;
+}
+
+Result<Scene> default_scene(const std::filesystem::path& cache_dir) {
+  auto file = write_default_scene(cache_dir);
+  if (!file) return file.error();
+  return parse_scene(embedded::default_scene_json(), "<embedded default scene>", file->parent_path());
 }
 
 Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(

@@ -94,6 +94,10 @@ Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, co
 /// Its meshes are written into `cache_dir` on first use.
 Result<Scene> default_scene(const std::filesystem::path& cache_dir);
 
+/// Writes the embedded default scene file and its meshes into `cache_dir` (unless they are there
+/// already) and returns the scene file's path, for callers that edit the scene as JSON.
+Result<std::filesystem::path> write_default_scene(const std::filesystem::path& cache_dir);
+
 /// Where built .ist files are cached: $UH_CACHE_DIR, else $XDG_CACHE_HOME/unrealhaptics, else
 /// ~/.cache/unrealhaptics, else a folder in the system temp directory.
 std::filesystem::path default_cache_dir();

@@ -1,0 +1,68 @@
+// uh serve [--host 127.0.0.1] [--port 7770] [--token T] [--no-realtime]
+#include <csignal>
+#include <cstdio>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "uh/service/server.hpp"
+#include "view_assets.hpp"
+
+namespace uh::cli {
+namespace {
+
+struct ServeArgs {
+  std::string host = "127.0.0.1";
+  int port = 7770;
+  std::string token;
+  bool no_realtime = false;
+};
+
+int serve(const ServeArgs& args) {
+  // SIGINT and SIGTERM are taken by sigwait below: blocked here, before the server's threads
+  // start (they inherit the mask), so no thread is interrupted by them
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  auto server = service::Server::start({.host = args.host,
+                                        .port = static_cast<std::uint16_t>(args.port),
+                                        .token = args.token,
+                                        .files = view::static_files(),
+                                        .raise_priority = !args.no_realtime});
+  if (!server) {
+    const std::string& m = server.error().message;
+    return fail(m.find("token is required") != std::string::npos ? m + " (give --token)" : m);
+  }
+  const std::string url = (*server)->url();
+  const std::string ws = "ws" + url.substr(4) + "ws";
+  std::printf("uh serve: listening on %s (live view: %s); Ctrl-C stops\n", ws.c_str(), url.c_str());
+  std::fflush(stdout);
+  int signal = 0;
+  sigwait(&stop_signals, &signal);
+  (*server)->stop();
+  std::printf("uh serve: stopped\n");
+  return 0;
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app, CommandRunner& runner) {
+  static ServeArgs args;
+  auto* s = app.add_subcommand("serve",
+                               "run haptic sessions as a WebSocket service, with a live view in the browser");
+  s->add_option("--host", args.host, "address to listen on (other than loopback: a token is required)")
+      ->default_val("127.0.0.1");
+  s->add_option("--port", args.port, "port (0: any free port, printed)")
+      ->default_val(7770)
+      ->check(CLI::Range(0, 65535));
+  s->add_option("--token", args.token, "clients must send this token in their hello");
+  s->add_flag("--no-realtime", args.no_realtime,
+              "do not ask for SCHED_FIFO for the sessions' haptic and collision threads");
+  s->callback([&runner] { runner = [] { return serve(args); }; });
+}
+
+}  // namespace uh::cli

@@ -1,0 +1,75 @@
+#pragma once
+/// \file
+/// Server: haptic sessions as a service over WebSocket (`uh serve`), and the live view's page.
+///
+/// One port serves `ws://HOST:PORT/ws` (the JSON protocol of docs/protocol.md) and the files of
+/// the live view over HTTP (`/` is `/index.html`). At most one session is open at a time: the
+/// client that opened it controls it (edits, start, stop); every other client may watch it (its
+/// scene, meshes, the state stream, contact events). When the controlling client disconnects, its
+/// session stops (zero force at once). The server runs its own network thread; sessions run their
+/// own haptic and collision threads.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "uh/controllers/haptic_session.hpp"
+#include "uh/core/result.hpp"
+
+namespace uh::service {
+
+/// A file served over HTTP at `path` (e.g. "/index.html"). The text must outlive the server.
+struct StaticFile {
+  std::string path{};
+  std::string content_type{};
+  std::string_view body{};
+};
+
+/// How the server listens and what it serves (aggregate; Box2D-style defaults).
+struct ServerOptions {
+  std::string host = "127.0.0.1";  ///< an IP address or "localhost"
+  std::uint16_t port = 7770;       ///< 0: any free port (see Server::port())
+  /// Clients must present it in `hello`; required when `host` is not a loopback address.
+  std::string token{};
+  std::vector<StaticFile> files{};      ///< the live view's page and script
+  std::filesystem::path cache_dir{};    ///< where .ist builds are cached; empty: the default
+  std::filesystem::path working_dir{};  ///< relative paths in requests; empty: the current folder
+  bool raise_priority = false;          ///< sessions ask for SCHED_FIFO (as `uh run`)
+};
+
+class Server {
+ public:
+  /// Binds and starts the network thread. Errors: a non-loopback host without a token, an
+  /// address that does not parse, a port in use.
+  static Result<std::unique_ptr<Server>> start(ServerOptions options);
+  /// stop().
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  /// The port listened on (the chosen one when ServerOptions::port was 0).
+  std::uint16_t port() const;
+  /// "http://HOST:PORT/".
+  std::string url() const;
+
+  /// Runs `session` as the program's own (no client controls it; clients watch it) for `seconds`,
+  /// then stops it and returns what HapticSession::stop() returned; `trace` as in
+  /// HapticSession::start(). Blocks the calling thread; the session must not be used by the caller
+  /// meanwhile. An error when a client's session is open.
+  Status run_session(controllers::HapticSession& session, double seconds, std::ostream* trace = nullptr);
+
+  /// Stops any running session (zero force), closes every connection (WebSocket close 1001) and
+  /// joins the network thread. Idempotent. Not from the network thread.
+  void stop();
+
+ private:
+  struct Impl;
+  explicit Server(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uh::service

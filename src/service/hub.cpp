@@ -1,0 +1,458 @@
+#include "hub.hpp"
+
+#include <chrono>
+
+#include <fmt/format.h>
+#include <boost/asio/post.hpp>
+
+namespace uh::service {
+namespace {
+
+using namespace std::chrono_literals;
+
+json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+double steady_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+json state_json(const controllers::SessionState& s) {
+  const Quat& q = s.tool_orientation_world;
+  return {
+      {"time_s", s.time_s},
+      {"clock_s", steady_seconds()},
+      {"tool",
+       {{"position", vec3_json(s.tool_position_world)}, {"orientation", json::array({q.w, q.x, q.y, q.z})}}},
+      {"force", vec3_json(s.force_world)},
+      {"torque", vec3_json(s.torque_world)},
+      {"contact_pairs", s.contact_pairs},
+      {"haptic",
+       {{"rate_hz", s.haptic_rate_hz}, {"ticks", s.haptic_ticks}, {"missed_deadlines", s.missed_deadlines}}},
+      {"collision", {{"rate_hz", s.collision_rate_hz}}}};
+}
+
+// Compares without stopping at the first difference (the time does not tell how much matched).
+bool same_token(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  unsigned diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    diff |= static_cast<unsigned>(static_cast<unsigned char>(a[i]) ^ static_cast<unsigned char>(b[i]));
+  return diff == 0;
+}
+
+}  // namespace
+
+Hub::Hub(boost::asio::io_context& io, HubOptions options)
+    : io_(io), options_(std::move(options)), stop_timer_(io), event_timer_(io) {}
+
+Hub::~Hub() { shutdown(); }
+
+Hub::ClientId Hub::connect(Peer& peer) {
+  const ClientId id = next_id_++;
+  clients_[id].peer = &peer;
+  return id;
+}
+
+void Hub::send_to(ClientId id, std::string text) {
+  if (const auto it = clients_.find(id); it != clients_.end()) it->second.peer->send(std::move(text));
+}
+
+void Hub::receive(ClientId id, std::string_view text) {
+  const auto it = clients_.find(id);
+  if (it == clients_.end() || shut_down_) return;
+  Client& c = it->second;
+  ParsedRequest req = parse_request(text);
+  if (!req.body) {
+    c.peer->send(error_reply(req.id, req.type, req.error));
+    return;
+  }
+  if (!c.greeted && !std::holds_alternative<Hello>(*req.body)) {
+    c.peer->send(error_reply(
+        req.id, req.type,
+        fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{}}}", kProtocolVersion)));
+    return;
+  }
+  handle(id, c, req.id, req.type, *req.body);
+}
+
+void Hub::receive_binary(ClientId id) {
+  send_to(id, error_reply(nullptr, "",
+                          fmt::format("binary frames are not used by protocol {}; send JSON text",
+                                      kProtocolVersion)));
+}
+
+void Hub::handle(ClientId id, Client& c, const json& req_id, const std::string& type,
+                 const RequestBody& body) {
+  std::string error;
+  if (const auto* h = std::get_if<Hello>(&body)) {
+    error = on_hello(id, c, req_id, *h);
+  } else if (std::holds_alternative<Ping>(body)) {
+    c.peer->send(reply("pong", req_id, {{"time_s", steady_seconds()}}));
+  } else if (const auto* o = std::get_if<Open>(&body)) {
+    error = on_open(id, req_id, *o);
+  } else if (const auto* s = std::get_if<Start>(&body)) {
+    error = on_start(id, req_id, *s);
+  } else if (std::holds_alternative<Stop>(body)) {
+    error = on_stop(id, req_id);
+  } else if (std::holds_alternative<Close>(body)) {
+    error = on_close(id, req_id);
+  } else if (const auto* sub = std::get_if<Subscribe>(&body)) {
+    error = on_subscribe(id, c, req_id, *sub);
+  } else if (std::holds_alternative<Unsubscribe>(body)) {
+    c.rate_hz = 0.0;
+    if (c.state_timer) c.state_timer->cancel();
+    c.peer->send(reply("unsubscribed", req_id));
+  } else if (std::holds_alternative<GetScene>(body)) {
+    if (!slot_)
+      error = "no scene is open";
+    else
+      c.peer->send(reply("scene", req_id,
+                         {{"scene", describe_scene(slot_->scene())},
+                          {"status", slot_->phase == Phase::kRunning    ? "running"
+                                     : slot_->phase == Phase::kStarting ? "starting"
+                                                                        : "open"},
+                          {"controlled_here", slot_->controller == id}}));
+  } else if (const auto* g = std::get_if<GetMesh>(&body)) {
+    if (!slot_) {
+      error = "no scene is open";
+    } else {
+      auto mesh = scene_mesh(slot_->scene(), g->object);
+      if (!mesh)
+        error = mesh.error().message;
+      else
+        c.peer->send(reply("mesh", req_id, std::move(mesh).value()));
+    }
+  } else {
+    error = on_edit(id, req_id, type, body);
+  }
+  if (!error.empty()) c.peer->send(error_reply(req_id, type, error));
+}
+
+std::string Hub::on_hello(ClientId, Client& c, const json& req_id, const Hello& h) {
+  if (c.greeted) return "this connection already said hello";
+  if (h.protocol != kProtocolVersion)
+    return fmt::format("protocol {} is not supported (this service speaks protocol {})", h.protocol,
+                       kProtocolVersion);
+  if (!options_.token.empty() && !same_token(h.token, options_.token)) {
+    c.peer->send(error_reply(
+        req_id, "hello",
+        h.token.empty() ? "this service needs a token: send hello with \"token\"" : "wrong token"));
+    c.peer->close(1008, "wrong or missing token");
+    return {};
+  }
+  c.greeted = true;
+  json session = nullptr;
+  if (slot_)
+    session = {{"scene", slot_->scene().name},
+               {"status", slot_->phase == Phase::kRunning    ? "running"
+                          : slot_->phase == Phase::kStarting ? "starting"
+                                                             : "open"}};
+  c.peer->send(reply("welcome", req_id,
+                     {{"protocol", kProtocolVersion},
+                      {"version", UH_VERSION},
+                      {"max_message_bytes", kMaxMessageBytes},
+                      {"session", std::move(session)}}));
+  return {};
+}
+
+std::string Hub::check_control(ClientId id, bool needs_open) const {
+  if (!slot_) return needs_open ? "no scene is open (send open first)" : "";
+  if (slot_->controller != id)
+    return slot_->controller == kHost ? "the session belongs to the program that runs it; this connection "
+                                        "can watch it (subscribe, get_scene, get_mesh)"
+                                      : "another client controls the open session; this connection can watch "
+                                        "it (subscribe, get_scene, get_mesh)";
+  return {};
+}
+
+std::string Hub::on_open(ClientId id, const json& req_id, const Open& o) {
+  if (auto e = check_control(id, false); !e.empty()) return e;
+  if (slot_ && slot_->phase != Phase::kOpen)
+    return "the session is running; stop it before opening another scene";
+  auto document = o.scene ? SceneDocument::open_file(std::filesystem::path(*o.scene).is_absolute()
+                                                         ? std::filesystem::path(*o.scene)
+                                                         : options_.working_dir / *o.scene)
+                          : SceneDocument::open_default(options_.cache_dir);
+  if (!document) return document.error().message;
+  ++generation_;
+  slot_.emplace();
+  slot_->controller = id;
+  slot_->document = std::move(document).value();
+  const controllers::Scene& scene = slot_->scene();
+  json objects = json::array();
+  for (const auto& object : scene.objects) objects.push_back(object.name);
+  send_to(id, reply("opened", req_id,
+                    {{"scene", scene.name}, {"objects", std::move(objects)}, {"tool", scene.tool.name}}));
+  broadcast_session("opened");
+  return {};
+}
+
+std::string Hub::on_start(ClientId id, const json& req_id, const Start& s) {
+  if (auto e = check_control(id, true); !e.empty()) return e;
+  if (slot_->phase == Phase::kStarting) return "the session is starting already";
+  if (slot_->phase == Phase::kRunning) return "the session is running already";
+  slot_->phase = Phase::kStarting;
+  slot_->start_id = req_id;
+  const std::uint64_t generation = ++generation_;
+  controllers::SessionOptions options;
+  options.cache_dir = options_.cache_dir;
+  options.raise_priority = options_.raise_priority;
+  // a session build may pack meshes for seconds: off the network thread, answered when done
+  if (builder_.joinable()) builder_.join();
+  builder_ = std::jthread([this, generation, seconds = s.seconds, scene = slot_->scene(), options] {
+    auto built = std::make_shared<Result<std::unique_ptr<controllers::HapticSession>>>(
+        controllers::HapticSession::create(scene, options));
+    boost::asio::post(
+        io_, [this, generation, seconds, built] { build_finished(generation, std::move(*built), seconds); });
+  });
+  broadcast_session("starting");
+  return {};
+}
+
+void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<controllers::HapticSession>> built,
+                         std::optional<double> seconds) {
+  // the slot was closed, stopped or replaced meanwhile: the session never starts
+  if (shut_down_ || !slot_ || generation != generation_ || slot_->phase != Phase::kStarting) return;
+  const ClientId controller = slot_->controller;
+  const json start_id = slot_->start_id;
+  if (!built) {
+    slot_->phase = Phase::kOpen;
+    send_to(controller, error_reply(start_id, "start", built.error().message));
+    broadcast_session("open");
+    return;
+  }
+  slot_->owned = std::move(built).value();
+  if (auto started = slot_->owned->start(); !started) {
+    slot_->owned.reset();
+    slot_->phase = Phase::kOpen;
+    send_to(controller, error_reply(start_id, "start", started.error().message));
+    broadcast_session("open");
+    return;
+  }
+  slot_->session = slot_->owned.get();
+  slot_->phase = Phase::kRunning;
+  send_to(controller, reply("started", start_id, {{"scene", slot_->scene().name}}));
+  broadcast_session("started");
+  poll_events();
+  if (seconds) {
+    stop_timer_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(*seconds)));
+    stop_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
+      if (ec || !slot_ || generation != generation_ || slot_->phase != Phase::kRunning) return;
+      Status status{Ok{}};
+      json report = stop_session(&status);
+      json fields = {{"report", std::move(report)}, {"reason", "the session's seconds elapsed"}};
+      if (!status) fields["error"] = status.error().message;
+      send_to(slot_->controller, reply("stopped", nullptr, std::move(fields)));
+      broadcast_session("stopped");
+    });
+  }
+}
+
+json Hub::stop_session(Status* status_out) {
+  if (!slot_ || slot_->phase != Phase::kRunning) return nullptr;
+  stop_timer_.cancel();
+  event_timer_.cancel();
+  Status status = slot_->session->stop();
+  poll_events();  // the events up to the stop
+  event_timer_.cancel();
+  json report = json::parse(controllers::session_report_json(slot_->session->report()));
+  slot_->phase = Phase::kOpen;
+  slot_->session = nullptr;
+  slot_->owned.reset();
+  if (status_out != nullptr) *status_out = status;
+  if (slot_->host_done) {
+    auto done = std::move(slot_->host_done);
+    close_slot();
+    done(status);
+  }
+  return report;
+}
+
+std::string Hub::on_stop(ClientId id, const json& req_id) {
+  if (auto e = check_control(id, true); !e.empty()) return e;
+  if (slot_->phase == Phase::kOpen) return "the session is not running";
+  json fields = json::object();
+  if (slot_->phase == Phase::kStarting) {
+    // the build finishes on its own thread and is dropped then
+    ++generation_;
+    slot_->phase = Phase::kOpen;
+    fields["report"] = nullptr;
+  } else {
+    Status status{Ok{}};
+    fields["report"] = stop_session(&status);
+    if (!status) fields["error"] = status.error().message;
+  }
+  send_to(id, reply("stopped", req_id, std::move(fields)));
+  broadcast_session("stopped");
+  return {};
+}
+
+std::string Hub::on_close(ClientId id, const json& req_id) {
+  if (auto e = check_control(id, true); !e.empty()) return e;
+  stop_session();
+  close_slot();
+  send_to(id, reply("closed", req_id));
+  return {};
+}
+
+void Hub::close_slot() {
+  if (!slot_) return;
+  ++generation_;
+  stop_timer_.cancel();
+  event_timer_.cancel();
+  slot_.reset();
+  broadcast_session("closed");
+}
+
+void Hub::broadcast_session(std::string_view status) {
+  json fields = {{"status", std::string(status)}};
+  if (slot_) fields["scene"] = slot_->scene().name;
+  const std::string text = reply("session", nullptr, std::move(fields));
+  for (auto& [id, c] : clients_)
+    if (c.greeted) c.peer->send(text);
+}
+
+std::string Hub::on_subscribe(ClientId id, Client& c, const json& req_id, const Subscribe& s) {
+  c.rate_hz = s.rate_hz;
+  if (!c.state_timer) c.state_timer = std::make_unique<boost::asio::steady_timer>(io_);
+  c.state_timer->cancel();
+  c.peer->send(reply("subscribed", req_id, {{"rate_hz", s.rate_hz}}));
+  c.state_timer->expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / s.rate_hz)));
+  // each period from the previous deadline, so the rate does not drift with the send time
+  struct Tick {
+    Hub* hub;
+    ClientId id;
+    void operator()(const boost::system::error_code& ec) const {
+      if (ec) return;
+      const auto it = hub->clients_.find(id);
+      if (it == hub->clients_.end() || it->second.rate_hz <= 0.0) return;
+      hub->send_state(id);
+      auto& timer = *it->second.state_timer;
+      const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(1.0 / it->second.rate_hz));
+      const auto now = std::chrono::steady_clock::now();
+      auto next = timer.expiry() + period;
+      if (next < now) next = now + period;  // fell behind (a busy machine): skip, do not burst
+      timer.expires_at(next);
+      timer.async_wait(*this);
+    }
+  };
+  c.state_timer->async_wait(Tick{this, id});
+  return {};
+}
+
+void Hub::send_state(ClientId id) {
+  if (!slot_ || slot_->phase != Phase::kRunning) return;
+  const auto it = clients_.find(id);
+  if (it == clients_.end()) return;
+  it->second.peer->send(reply("state", nullptr, state_json(slot_->session->state())), true);
+}
+
+void Hub::poll_events() {
+  if (!slot_ || slot_->phase != Phase::kRunning) return;
+  controllers::ContactEvent event;
+  const controllers::Scene& scene = slot_->scene();
+  while (slot_->session->poll_event(event)) {
+    const bool known = event.object >= 0 && static_cast<std::size_t>(event.object) < scene.objects.size();
+    const std::string text =
+        reply("contact", nullptr,
+              {{"event", event.kind == controllers::ContactEventKind::kBegin ? "begin" : "end"},
+               {"object", known ? scene.objects[static_cast<std::size_t>(event.object)].name : std::string()},
+               {"time_s", event.time_s},
+               {"volume", event.volume},
+               {"pairs", event.pairs}});
+    for (auto& [id, c] : clients_)
+      if (c.greeted && (c.rate_hz > 0.0 || id == slot_->controller)) c.peer->send(text);
+  }
+  event_timer_.expires_after(10ms);
+  event_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec) poll_events();
+  });
+}
+
+std::string Hub::on_edit(ClientId id, const json& req_id, const std::string& type, const RequestBody& body) {
+  if (auto e = check_control(id, true); !e.empty()) return e;
+  if (slot_->phase != Phase::kOpen) return "the session is running; stop it before editing the scene";
+  SceneDocument& doc = *slot_->document;
+  Status done{Ok{}};
+  json fields = json::object();
+  if (const auto* a = std::get_if<AddObject>(&body)) {
+    done = doc.add_object(a->object, options_.working_dir);
+    if (done) fields["name"] = doc.scene().objects.back().name;
+  } else if (const auto* r = std::get_if<RemoveObject>(&body)) {
+    done = doc.remove_object(r->name);
+    fields["name"] = r->name;
+  } else if (const auto* p = std::get_if<SetPose>(&body)) {
+    done = doc.set_pose(p->object, p->pose);
+    fields["object"] = p->object;
+  } else if (const auto* w = std::get_if<SetWatch>(&body)) {
+    done = doc.set_watch(w->objects);
+    fields["objects"] = doc.scene().watch;
+  } else if (const auto* d = std::get_if<SetDevice>(&body)) {
+    done = doc.set_device(d->device, options_.working_dir);
+    fields["driver"] = doc.scene().tool.device.driver;
+  }
+  if (!done) return done.error().message;
+  static const std::map<std::string, std::string, std::less<>> kReplies = {
+      {"add_object", "object_added"},
+      {"remove_object", "object_removed"},
+      {"set_pose", "pose_set"},
+      {"set_watch", "watch_set"},
+      {"set_device", "device_set"}};
+  send_to(id, reply(kReplies.at(type), req_id, std::move(fields)));
+  broadcast_session("edited");
+  return {};
+}
+
+void Hub::disconnect(ClientId id) {
+  clients_.erase(id);
+  if (slot_ && slot_->controller == id) {
+    // the controlling client is gone: its session stops (zero force) and the slot is free
+    stop_session();
+    close_slot();
+  }
+}
+
+void Hub::host(controllers::HapticSession& session, double seconds, std::ostream* trace,
+               std::function<void(Status)> done) {
+  if (shut_down_) return done(Error{"the service is stopping"});
+  if (slot_) return done(Error{"a client's session is open in the service"});
+  ++generation_;
+  slot_.emplace();
+  slot_->controller = kHost;
+  slot_->hosted = session.scene();
+  broadcast_session("opened");
+  if (auto started = session.start(trace); !started) {
+    slot_.reset();
+    return done(started);
+  }
+  slot_->session = &session;
+  slot_->phase = Phase::kRunning;
+  slot_->host_done = std::move(done);
+  broadcast_session("started");
+  poll_events();
+  const std::uint64_t generation = generation_;
+  stop_timer_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(seconds)));
+  stop_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
+    if (ec || !slot_ || generation != generation_) return;
+    broadcast_session("stopped");
+    stop_session();
+  });
+}
+
+void Hub::shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  stop_session();
+  close_slot();
+  for (auto& [id, c] : clients_) {
+    if (c.state_timer) c.state_timer->cancel();
+    c.peer->close(1001, "the service is stopping");
+  }
+  if (builder_.joinable()) builder_.join();
+}
+
+}  // namespace uh::service

@@ -1,0 +1,119 @@
+#pragma once
+// The service's logic, apart from the network: clients, the one session slot, who controls it,
+// subscriptions and events. Everything here runs on the server's network thread (the io_context's
+// only thread), so nothing here locks; session builds run on their own threads and post back.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "protocol.hpp"
+#include "scene_document.hpp"
+#include "uh/controllers/haptic_session.hpp"
+
+namespace uh::service {
+
+/// One connected client as the hub sees it. Implemented by the WebSocket connection.
+class Peer {
+ public:
+  virtual ~Peer() = default;
+  /// Queues a text message. `state` messages replace an unsent older one (a slow client gets the
+  /// newest state, not a growing backlog).
+  virtual void send(std::string text, bool is_state = false) = 0;
+  /// Sends a close frame with `code` (RFC 6455) after the queued messages.
+  virtual void close(std::uint16_t code, std::string_view reason) = 0;
+};
+
+struct HubOptions {
+  std::string token;
+  std::filesystem::path cache_dir;
+  std::filesystem::path working_dir;
+  bool raise_priority = false;
+};
+
+class Hub {
+ public:
+  using ClientId = std::uint64_t;
+
+  Hub(boost::asio::io_context& io, HubOptions options);
+  ~Hub();
+
+  ClientId connect(Peer& peer);
+  void receive(ClientId client, std::string_view text);
+  void receive_binary(ClientId client);
+  void disconnect(ClientId client);
+
+  /// The program's own session (Server::run_session): `done` gets stop()'s status.
+  void host(controllers::HapticSession& session, double seconds, std::ostream* trace,
+            std::function<void(Status)> done);
+
+  /// Stops the session (zero force) and closes every client. Joins session builds.
+  void shutdown();
+
+ private:
+  struct Client {
+    Peer* peer = nullptr;
+    bool greeted = false;
+    double rate_hz = 0.0;  // 0: not subscribed
+    std::unique_ptr<boost::asio::steady_timer> state_timer;
+  };
+  enum class Phase : std::uint8_t { kOpen, kStarting, kRunning };
+  static constexpr ClientId kHost = 0;
+
+  // The open session: its scene (edited by the controller), and the running HapticSession.
+  struct Slot {
+    ClientId controller = kHost;
+    std::optional<SceneDocument> document;     // a client's slot
+    std::optional<controllers::Scene> hosted;  // the program's own
+    Phase phase = Phase::kOpen;
+    std::unique_ptr<controllers::HapticSession> owned;
+    controllers::HapticSession* session = nullptr;
+    json start_id;  // the start request, answered when running
+    std::function<void(Status)> host_done;
+    const controllers::Scene& scene() const { return document ? document->scene() : *hosted; }
+  };
+
+  void handle(ClientId id, Client& c, const json& req_id, const std::string& type, const RequestBody& body);
+  // each returns an error text, or empty when it replied itself
+  std::string on_hello(ClientId id, Client& c, const json& req_id, const Hello& h);
+  std::string on_open(ClientId id, const json& req_id, const Open& o);
+  std::string on_start(ClientId id, const json& req_id, const Start& s);
+  std::string on_stop(ClientId id, const json& req_id);
+  std::string on_close(ClientId id, const json& req_id);
+  std::string on_subscribe(ClientId id, Client& c, const json& req_id, const Subscribe& s);
+  std::string on_edit(ClientId id, const json& req_id, const std::string& type, const RequestBody& body);
+
+  // an error text when `id` may not change the session
+  std::string check_control(ClientId id, bool needs_open) const;
+  void build_finished(std::uint64_t generation, Result<std::unique_ptr<controllers::HapticSession>> built,
+                      std::optional<double> seconds);
+  // stops a running session; the report's JSON (or null when nothing ran)
+  json stop_session(Status* status_out = nullptr);
+  void close_slot();
+  void broadcast_session(std::string_view status);
+  void send_state(ClientId id);
+  void poll_events();
+  void send_to(ClientId id, std::string text);
+
+  boost::asio::io_context& io_;
+  HubOptions options_;
+  std::map<ClientId, Client> clients_;
+  ClientId next_id_ = 1;
+  std::optional<Slot> slot_;
+  std::uint64_t generation_ = 0;  // bumped whenever the slot changes; stale builds are dropped
+  boost::asio::steady_timer stop_timer_;
+  boost::asio::steady_timer event_timer_;
+  std::jthread builder_;  // the one session build at a time
+  bool shut_down_ = false;
+};
+
+}  // namespace uh::service

@@ -1,0 +1,250 @@
+#include "protocol.hpp"
+
+#include <cmath>
+#include <initializer_list>
+
+#include <fmt/format.h>
+
+namespace uh::service {
+namespace {
+
+// Deeper documents are refused before nlohmann parses them, so that nothing later (dump, the
+// scene parser) recurses deeply on a client's input.
+constexpr int kMaxNesting = 32;
+
+// The deepest nesting of arrays and objects in `text`, ignoring brackets inside strings.
+int nesting_depth(std::string_view text) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (c == '"')
+      in_string = true;
+    else if (c == '[' || c == '{')
+      deepest = std::max(deepest, ++depth);
+    else if (c == ']' || c == '}')
+      --depth;
+  }
+  return deepest;
+}
+
+// Reads the fields of one request object; every error names the field.
+class Fields {
+ public:
+  explicit Fields(const json& j) : j_(j) {}
+
+  std::string check_known(std::initializer_list<std::string_view> known) const {
+    for (const auto& [key, value] : j_.items()) {
+      if (key == "type" || key == "id") continue;
+      bool ok = false;
+      for (std::string_view k : known) ok = ok || key == k;
+      if (!ok) {
+        std::string list;
+        for (std::string_view k : known) list += fmt::format("{}{}", list.empty() ? "" : ", ", k);
+        return fmt::format("unknown field '{}' (known here: {})", key, list.empty() ? "none" : list);
+      }
+    }
+    return {};
+  }
+
+  const json* find(std::string_view key) const {
+    const auto it = j_.find(std::string(key));
+    return it == j_.end() ? nullptr : &*it;
+  }
+
+  std::string string(std::string_view key, std::string& out, bool required) const {
+    const json* v = find(key);
+    if (v == nullptr) return required ? fmt::format("field '{}' is missing (expected a string)", key) : "";
+    if (!v->is_string() || v->get_ref<const std::string&>().empty())
+      return fmt::format("field '{}': expected a non-empty string, got {}", key, v->type_name());
+    out = v->get<std::string>();
+    return {};
+  }
+
+  std::string number(std::string_view key, double& out, double min, double max) const {
+    const json* v = find(key);
+    if (v == nullptr) return {};
+    if (!v->is_number()) return fmt::format("field '{}': expected a number, got {}", key, v->type_name());
+    const double d = v->get<double>();
+    if (!std::isfinite(d) || d < min || d > max)
+      return fmt::format("field '{}': expected a number in [{}, {}], got {}", key, min, max, d);
+    out = d;
+    return {};
+  }
+
+  std::string object(std::string_view key, json& out) const {
+    const json* v = find(key);
+    if (v == nullptr) return fmt::format("field '{}' is missing (expected an object)", key);
+    if (!v->is_object()) return fmt::format("field '{}': expected an object, got {}", key, v->type_name());
+    out = *v;
+    return {};
+  }
+
+ private:
+  const json& j_;
+};
+
+// Parses the body of a request whose type is known; returns an error text or fills `body`.
+std::string parse_body(const std::string& type, const Fields& f, std::optional<RequestBody>& body) {
+  std::string e;
+  if (type == "hello") {
+    if (e = f.check_known({"protocol", "token"}); !e.empty()) return e;
+    const json* p = f.find("protocol");
+    if (p == nullptr) return "field 'protocol' is missing (expected the protocol version, 1)";
+    if (!p->is_number_integer())
+      return fmt::format("field 'protocol': expected a whole number, got {}", p->type_name());
+    Hello h;
+    const auto v = p->get<std::int64_t>();
+    h.protocol = v < 0 || v > 1'000'000 ? -1 : static_cast<int>(v);
+    if (e = f.string("token", h.token, false); !e.empty()) return e;
+    body = h;
+  } else if (type == "open") {
+    if (e = f.check_known({"scene"}); !e.empty()) return e;
+    Open o;
+    std::string scene;
+    if (e = f.string("scene", scene, false); !e.empty()) return e;
+    if (!scene.empty()) o.scene = scene;
+    body = o;
+  } else if (type == "start") {
+    if (e = f.check_known({"seconds"}); !e.empty()) return e;
+    Start s;
+    double seconds = -1.0;
+    if (e = f.number("seconds", seconds, 1e-3, 86400.0); !e.empty()) return e;
+    if (seconds > 0.0) s.seconds = seconds;
+    body = s;
+  } else if (type == "stop" || type == "ping" || type == "close" || type == "unsubscribe" ||
+             type == "get_scene") {
+    if (e = f.check_known({}); !e.empty()) return e;
+    if (type == "stop")
+      body = Stop{};
+    else if (type == "ping")
+      body = Ping{};
+    else if (type == "close")
+      body = Close{};
+    else if (type == "unsubscribe")
+      body = Unsubscribe{};
+    else
+      body = GetScene{};
+  } else if (type == "subscribe") {
+    if (e = f.check_known({"rate_hz"}); !e.empty()) return e;
+    Subscribe s;
+    if (e = f.number("rate_hz", s.rate_hz, kMinStateRateHz, kMaxStateRateHz); !e.empty()) return e;
+    body = s;
+  } else if (type == "get_mesh") {
+    if (e = f.check_known({"object"}); !e.empty()) return e;
+    GetMesh g;
+    if (e = f.string("object", g.object, true); !e.empty()) return e;
+    body = g;
+  } else if (type == "add_object") {
+    if (e = f.check_known({"object"}); !e.empty()) return e;
+    AddObject a;
+    if (e = f.object("object", a.object); !e.empty()) return e;
+    body = a;
+  } else if (type == "remove_object") {
+    if (e = f.check_known({"name"}); !e.empty()) return e;
+    RemoveObject r;
+    if (e = f.string("name", r.name, true); !e.empty()) return e;
+    body = r;
+  } else if (type == "set_pose") {
+    if (e = f.check_known({"object", "pose"}); !e.empty()) return e;
+    SetPose s;
+    if (e = f.string("object", s.object, true); !e.empty()) return e;
+    if (e = f.object("pose", s.pose); !e.empty()) return e;
+    body = s;
+  } else if (type == "set_watch") {
+    if (e = f.check_known({"objects"}); !e.empty()) return e;
+    const json* list = f.find("objects");
+    if (list == nullptr || !list->is_array()) return "field 'objects': expected a list of object names";
+    SetWatch s;
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      const json& name = (*list)[i];
+      if (!name.is_string() || name.get_ref<const std::string&>().empty())
+        return fmt::format("field 'objects[{}]': expected an object name, got {}", i, name.type_name());
+      s.objects.push_back(name.get<std::string>());
+    }
+    body = s;
+  } else if (type == "set_device") {
+    if (e = f.check_known({"device"}); !e.empty()) return e;
+    SetDevice s;
+    if (e = f.object("device", s.device); !e.empty()) return e;
+    body = s;
+  } else {
+    return fmt::format(
+        "unknown message type '{}' (known: hello, open, start, stop, ping, close, subscribe, unsubscribe, "
+        "get_scene, "
+        "get_mesh, add_object, remove_object, set_pose, set_watch, set_device)",
+        type);
+  }
+  return {};
+}
+
+std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+}  // namespace
+
+ParsedRequest parse_request(std::string_view text) {
+  ParsedRequest out;
+  if (nesting_depth(text) > kMaxNesting) {
+    out.error = fmt::format("message nested deeper than {} levels", kMaxNesting);
+    return out;
+  }
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::exception& e) {
+    // parse_error for bad syntax, out_of_range for a number too large for a double
+    out.error = fmt::format("not valid JSON: {}", e.what());
+    return out;
+  }
+  if (!j.is_object()) {
+    out.error = fmt::format("expected a JSON object, got {}", j.type_name());
+    return out;
+  }
+  std::string id_error;
+  if (const auto it = j.find("id"); it != j.end()) {
+    if (it->is_number_integer() || it->is_string())
+      out.id = *it;
+    else
+      id_error = fmt::format("field 'id': expected a whole number or a string, got {}", it->type_name());
+  }
+  const auto type = j.find("type");
+  if (type == j.end()) {
+    out.error = "field 'type' is missing (expected the message type, e.g. \"hello\")";
+    return out;
+  }
+  if (!type->is_string()) {
+    out.error = fmt::format("field 'type': expected a string, got {}", type->type_name());
+    return out;
+  }
+  out.type = type->get<std::string>();
+  if (!id_error.empty()) {
+    out.error = id_error;
+    return out;
+  }
+  out.error = parse_body(out.type, Fields(j), out.body);
+  return out;
+}
+
+std::string reply(std::string_view type, const json& id, json fields) {
+  json out = json::object();
+  out["type"] = std::string(type);
+  if (!id.is_null()) out["id"] = id;
+  for (auto& [key, value] : fields.items()) out[key] = std::move(value);
+  return dump(out);
+}
+
+std::string error_reply(const json& id, std::string_view request_type, std::string_view message) {
+  json fields = {{"message", std::string(message)}};
+  if (!request_type.empty()) fields["request"] = std::string(request_type);
+  return reply("error", id, std::move(fields));
+}
+
+}  // namespace uh::service

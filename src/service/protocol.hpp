@@ -1,0 +1,86 @@
+#pragma once
+// The service's JSON protocol (docs/protocol.md): the requests a client may send, parsed and
+// checked field by field, and the replies and events the service sends. Parsing never throws and
+// never crashes on any input (fuzz/service_protocol_fuzz.cpp); every error names the field.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace uh::service {
+
+using nlohmann::json;
+
+/// The protocol version this build speaks (`hello.protocol`, `welcome.protocol`).
+inline constexpr int kProtocolVersion = 1;
+/// Larger messages are refused and the connection is closed (WebSocket close code 1009).
+inline constexpr std::size_t kMaxMessageBytes = 1 << 20;
+/// Bounds of `subscribe.rate_hz` [Hz] and its default.
+inline constexpr double kMinStateRateHz = 1.0;
+inline constexpr double kMaxStateRateHz = 1000.0;
+inline constexpr double kDefaultStateRateHz = 60.0;
+
+struct Hello {
+  int protocol = 0;
+  std::string token;  ///< empty when absent
+};
+struct Open {
+  std::optional<std::string> scene;  ///< a scene file; none: the default scene
+};
+struct Start {
+  std::optional<double> seconds;  ///< stop by itself after this long [s]; none: run until stop
+};
+struct Stop {};
+struct Ping {};
+struct Close {};
+struct Subscribe {
+  double rate_hz = kDefaultStateRateHz;
+};
+struct Unsubscribe {};
+struct GetScene {};
+struct GetMesh {
+  std::string object;  ///< an object's or the tool's name
+};
+struct AddObject {
+  json object;  ///< as an entry of a scene file's `objects` (checked by the scene parser)
+};
+struct RemoveObject {
+  std::string name;
+};
+struct SetPose {
+  std::string object;
+  json pose;  ///< {"position": [..], "rotation": [..]} (checked by the scene parser)
+};
+struct SetWatch {
+  std::vector<std::string> objects;
+};
+struct SetDevice {
+  json device;  ///< as a scene file's `tool.device` (checked by the scene parser)
+};
+
+using RequestBody = std::variant<Hello, Open, Start, Stop, Ping, Close, Subscribe, Unsubscribe, GetScene,
+                                 GetMesh, AddObject, RemoveObject, SetPose, SetWatch, SetDevice>;
+
+/// One parsed message: the request, or what is wrong with it. `id` and `type` are kept whenever
+/// they could be read, so that an error reply can echo them.
+struct ParsedRequest {
+  json id;           ///< the request's `id` (a number or a string), null when absent or unusable
+  std::string type;  ///< the request's `type`, empty when unreadable
+  std::optional<RequestBody> body;
+  std::string error;  ///< set when body is empty
+};
+
+/// Parses one text message. Never throws.
+ParsedRequest parse_request(std::string_view text);
+
+/// A reply of `type` that echoes `id` (when not null), with `fields` merged in.
+std::string reply(std::string_view type, const json& id, json fields = json::object());
+
+/// `{"type":"error","id":..,"request":..,"message":..}`.
+std::string error_reply(const json& id, std::string_view request_type, std::string_view message);
+
+}  // namespace uh::service

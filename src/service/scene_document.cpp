@@ -1,0 +1,161 @@
+#include "scene_document.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "uh/collette/mesh_import.hpp"
+
+namespace uh::service {
+namespace {
+
+using nlohmann::json;
+
+json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+json pose_json(const Pose& p) {
+  return {{"position", vec3_json(p.position)},
+          {"rotation", json::array({p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z})}};
+}
+
+// A relative path given by a client is relative to the service's folder: made absolute here,
+// before the scene parser would resolve it against the scene file's folder.
+void absolutise(json& holder, const char* key, const std::filesystem::path& dir) {
+  const auto it = holder.find(key);
+  if (it == holder.end() || !it->is_string()) return;
+  const std::filesystem::path p(it->get<std::string>());
+  if (!p.empty() && p.is_relative()) *it = (dir / p).lexically_normal().string();
+}
+
+}  // namespace
+
+Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{fmt::format("{}: cannot open the scene file", path.string())};
+  std::stringstream text;
+  text << in.rdbuf();
+  // the scene parser names what is wrong; the document is read only once it accepted the text
+  auto scene = controllers::parse_scene(text.str(), path.string(), path.parent_path());
+  if (!scene) return scene.error();
+  SceneDocument d;
+  d.doc_ = json::parse(text.str());
+  d.source_ = path.string();
+  d.base_dir_ = path.parent_path();
+  d.scene_ = std::move(scene).value();
+  return d;
+}
+
+Result<SceneDocument> SceneDocument::open_default(const std::filesystem::path& cache_dir) {
+  auto file = controllers::write_default_scene(cache_dir);
+  if (!file) return file.error();
+  return open_file(*file);
+}
+
+Status SceneDocument::apply(json candidate) {
+  auto scene = controllers::parse_scene(candidate.dump(), source_, base_dir_);
+  if (!scene) return scene.error();
+  doc_ = std::move(candidate);
+  scene_ = std::move(scene).value();
+  return Ok{};
+}
+
+json* SceneDocument::find_object(json& doc, const std::string& name) {
+  for (json& o : doc["objects"])
+    if (o.value("name", "") == name) return &o;
+  return nullptr;
+}
+
+Status SceneDocument::add_object(json object, const std::filesystem::path& dir) {
+  absolutise(object, "mesh", dir);
+  absolutise(object, "ist", dir);
+  json candidate = doc_;
+  candidate["objects"].push_back(std::move(object));
+  // an explicit watch list is kept as it is (set_watch changes it); without one, all are watched
+  return apply(std::move(candidate));
+}
+
+Status SceneDocument::remove_object(const std::string& name) {
+  json candidate = doc_;
+  json& objects = candidate["objects"];
+  const auto before = objects.size();
+  for (auto it = objects.begin(); it != objects.end(); ++it)
+    if (it->value("name", "") == name) {
+      objects.erase(it);
+      break;
+    }
+  if (objects.size() == before) return Error{fmt::format("no object is named '{}'", name)};
+  if (candidate.contains("watch") && candidate["watch"].is_array()) {
+    json kept = json::array();
+    for (const json& w : candidate["watch"])
+      if (!(w.is_string() && w.get<std::string>() == name)) kept.push_back(w);
+    candidate["watch"] = std::move(kept);
+  }
+  if (objects.empty()) return Error{fmt::format("'{}' is the last object; a scene needs at least one", name)};
+  return apply(std::move(candidate));
+}
+
+Status SceneDocument::set_pose(const std::string& name, const json& pose) {
+  json candidate = doc_;
+  json* object = find_object(candidate, name);
+  if (object == nullptr) return Error{fmt::format("no object is named '{}'", name)};
+  (*object)["pose"] = pose;
+  return apply(std::move(candidate));
+}
+
+Status SceneDocument::set_watch(const std::vector<std::string>& names) {
+  json candidate = doc_;
+  candidate["watch"] = names;
+  return apply(std::move(candidate));
+}
+
+Status SceneDocument::set_device(json device, const std::filesystem::path& dir) {
+  if (const auto config = device.find("config"); config != device.end() && config->is_object())
+    absolutise(*config, "file", dir);
+  json candidate = doc_;
+  candidate["tool"]["device"] = std::move(device);
+  return apply(std::move(candidate));
+}
+
+json describe_scene(const controllers::Scene& scene) {
+  json objects = json::array();
+  for (const auto& o : scene.objects) {
+    const bool watched = std::find(scene.watch.begin(), scene.watch.end(), o.name) != scene.watch.end();
+    objects.push_back({{"name", o.name},
+                       {"pose", pose_json(o.pose)},
+                       {"watched", watched},
+                       {"has_mesh", !o.shape.mesh.empty()}});
+  }
+  return {{"name", scene.name},
+          {"objects", std::move(objects)},
+          {"tool",
+           {{"name", scene.tool.name},
+            {"has_mesh", !scene.tool.shape.mesh.empty()},
+            {"device", scene.tool.device.driver}}},
+          {"haptic_hz", scene.haptic_hz},
+          {"collision_hz", scene.collision_hz}};
+}
+
+Result<json> scene_mesh(const controllers::Scene& scene, const std::string& name) {
+  const controllers::SceneShape* shape = nullptr;
+  for (const auto& o : scene.objects)
+    if (o.name == name) shape = &o.shape;
+  if (name == scene.tool.name) shape = &scene.tool.shape;
+  if (shape == nullptr) return Error{fmt::format("no object or tool is named '{}'", name)};
+  if (shape->mesh.empty())
+    return Error{fmt::format("'{}' was given as a .ist file, which holds no mesh", name)};
+  auto mesh = collette::load_mesh(shape->mesh);
+  if (!mesh) return mesh.error();
+  json vertices = json::array(), triangles = json::array();
+  const double s = shape->meters_per_unit;
+  for (const Vec3& v : mesh->vertices) {
+    vertices.push_back(v.x * s);
+    vertices.push_back(v.y * s);
+    vertices.push_back(v.z * s);
+  }
+  for (const auto& t : mesh->triangles)
+    for (const std::int32_t i : t) triangles.push_back(i);
+  return json{{"object", name}, {"vertices", std::move(vertices)}, {"triangles", std::move(triangles)}};
+}
+
+}  // namespace uh::service

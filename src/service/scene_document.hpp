@@ -1,0 +1,55 @@
+#pragma once
+// A scene as a client edits it: the scene file's JSON document plus the Scene the scene parser
+// made of it. Every edit changes a copy of the document and goes through parse_scene() again, so
+// the service accepts exactly what a scene file accepts, with the same messages; a refused edit
+// leaves the document as it was.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "uh/controllers/scene.hpp"
+#include "uh/core/result.hpp"
+
+namespace uh::service {
+
+class SceneDocument {
+ public:
+  /// A scene file; relative paths inside it are relative to its folder.
+  static Result<SceneDocument> open_file(const std::filesystem::path& path);
+  /// The embedded default scene (written into `cache_dir`).
+  static Result<SceneDocument> open_default(const std::filesystem::path& cache_dir);
+
+  const controllers::Scene& scene() const { return scene_; }
+
+  /// Paths given in edits (`mesh`, `ist`, a device's `file`) are relative to `dir` (the service's
+  /// working directory), not to the scene file.
+  Status add_object(nlohmann::json object, const std::filesystem::path& dir);
+  Status remove_object(const std::string& name);
+  Status set_pose(const std::string& name, const nlohmann::json& pose);
+  Status set_watch(const std::vector<std::string>& names);
+  Status set_device(nlohmann::json device, const std::filesystem::path& dir);
+
+ private:
+  SceneDocument() = default;
+  // parse_scene() on `candidate`; on success it becomes the document
+  Status apply(nlohmann::json candidate);
+  nlohmann::json* find_object(nlohmann::json& doc, const std::string& name);
+
+  nlohmann::json doc_;
+  std::string source_;
+  std::filesystem::path base_dir_;
+  controllers::Scene scene_;
+};
+
+/// A scene for a `scene` reply: name, objects with poses, watched names, tool and device, rates.
+nlohmann::json describe_scene(const controllers::Scene& scene);
+
+/// The mesh of a scene's object or tool for a `mesh` reply: vertices in metres in the object's
+/// frame and triangle indices, both flat. An error when there is no such object or it was given
+/// as a .ist (which holds spheres, not a mesh).
+Result<nlohmann::json> scene_mesh(const controllers::Scene& scene, const std::string& name);
+
+}  // namespace uh::service

@@ -1,0 +1,409 @@
+// `uh serve`'s server over real sockets on loopback: Beast clients speak the protocol of
+// docs/protocol.md to a Server in this process. The happy path runs the default scene; every
+// error and fault path of the protocol is driven from the client side.
+
+#include "uh/service/server.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <set>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+#include "protocol.hpp"
+#include "service_test_support.hpp"
+
+namespace uh::service {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+// Guards against a server that never answers; not a measurement.
+constexpr auto kPatience = 60s;
+
+// A protocol client on its own io_context; every wait is bounded by kPatience.
+class Client {
+ public:
+  explicit Client(std::uint16_t port) {
+    tcp::resolver resolver(io_);
+    asio::connect(ws_.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
+    ws_.handshake("127.0.0.1", "/ws");
+  }
+
+  void send(const json& message) { send_text(message.dump()); }
+  void send_text(const std::string& text) {
+    ws_.text(true);
+    ws_.write(asio::buffer(text));
+  }
+  void send_binary(const std::string& bytes) {
+    ws_.binary(true);
+    ws_.write(asio::buffer(bytes));
+  }
+
+  /// The next message, or an error code when the connection ended.
+  std::optional<json> read(beast::error_code* ended = nullptr) {
+    beast::flat_buffer buffer;
+    beast::error_code ec;
+    bool done = false;
+    ws_.async_read(buffer, [&](beast::error_code e, std::size_t) {
+      ec = e;
+      done = true;
+    });
+    io_.restart();
+    io_.run_for(kPatience);
+    if (!done) {
+      ADD_FAILURE() << "no message within the patience limit";
+      ws_.next_layer().close();
+      io_.restart();
+      io_.run();
+      return std::nullopt;
+    }
+    if (ec) {
+      if (ended != nullptr) *ended = ec;
+      return std::nullopt;
+    }
+    return json::parse(beast::buffers_to_string(buffer.data()));
+  }
+
+  /// Reads until a message of `type` (others, e.g. state and session events, are skipped).
+  json expect(const std::string& type) {
+    for (;;) {
+      auto m = read();
+      if (!m) {
+        ADD_FAILURE() << "connection ended while waiting for '" << type << "'";
+        return json::object();
+      }
+      if ((*m)["type"] == type) return *m;
+      if ((*m)["type"] == "error" && type != "error") ADD_FAILURE() << "unexpected error: " << m->dump();
+    }
+  }
+
+  json request(json message, const std::string& reply_type) {
+    send(message);
+    return expect(reply_type);
+  }
+
+  json hello(const std::string& token = "") {
+    json h = {{"type", "hello"}, {"protocol", 1}};
+    if (!token.empty()) h["token"] = token;
+    return request(h, "welcome");
+  }
+
+  websocket::close_reason close_reason() const { return ws_.reason(); }
+
+ private:
+  asio::io_context io_;
+  websocket::stream<tcp::socket> ws_{io_};
+};
+
+// A plain HTTP GET on loopback: status and body.
+std::pair<unsigned, std::string> http_get(std::uint16_t port, const std::string& target) {
+  asio::io_context io;
+  tcp::socket socket(io);
+  tcp::resolver resolver(io);
+  asio::connect(socket, resolver.resolve("127.0.0.1", std::to_string(port)));
+  http::request<http::empty_body> req(http::verb::get, target, 11);
+  req.set(http::field::host, "127.0.0.1");
+  http::write(socket, req);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> res;
+  http::read(socket, buffer, res);
+  return {res.result_int(), res.body()};
+}
+
+constexpr std::string_view kPage = "<!doctype html><title>test page</title>";
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::scratch("server");
+    scene_ = testing::write_small_scene(dir_);
+    start_server({});
+  }
+  void TearDown() override {
+    server_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+  void start_server(std::string token) {
+    server_.reset();
+    ServerOptions options{.host = "127.0.0.1", .port = 0, .token = std::move(token)};
+    options.files = {{.path = "/index.html", .content_type = "text/html", .body = kPage}};
+    options.cache_dir = UH_TEST_CACHE_DIR;
+    options.working_dir = dir_;
+    auto s = Server::start(std::move(options));
+    ASSERT_TRUE(s.has_value()) << s.error().message;
+    server_ = std::move(s).value();
+  }
+  std::uint16_t port() const { return server_->port(); }
+
+  std::filesystem::path dir_;
+  std::filesystem::path scene_;
+  std::unique_ptr<Server> server_;
+};
+
+TEST_F(ServerTest, HelloIsAnsweredWithTheVersionAndEchoesTheId) {
+  Client c(port());
+  c.send({{"type", "hello"}, {"protocol", 1}, {"id", 17}});
+  const json w = c.expect("welcome");
+  EXPECT_EQ(w["id"], 17);
+  EXPECT_EQ(w["protocol"], 1);
+  EXPECT_FALSE(w["version"].get<std::string>().empty());
+  EXPECT_EQ(w["max_message_bytes"], 1 << 20);
+  EXPECT_TRUE(w["session"].is_null());
+  const json p = c.request({{"type", "ping"}, {"id", "p"}}, "pong");
+  EXPECT_EQ(p["id"], "p");
+}
+
+TEST_F(ServerTest, BadRequestsGetErrorsAndTheConnectionStaysUsable) {
+  Client c(port());
+  // before hello, only hello
+  const json early = c.request({{"type", "ping"}, {"id", 1}}, "error");
+  EXPECT_NE(early["message"].get<std::string>().find("send hello first"), std::string::npos) << early;
+  EXPECT_EQ(early["id"], 1);
+  const json wrong_version = c.request({{"type", "hello"}, {"protocol", 2}}, "error");
+  EXPECT_NE(wrong_version["message"].get<std::string>().find("protocol 2 is not supported"),
+            std::string::npos);
+  c.hello();
+
+  struct Case {
+    std::string text;
+    std::string expected;
+  };
+  const Case cases[] = {
+      {R"({"type":"ping")", "not valid JSON"},
+      {R"({"type":"teleport","id":3})", "unknown message type 'teleport'"},
+      {R"({"type":"subscribe","rate_hz":"fast"})", "field 'rate_hz': expected a number, got string"},
+      {R"({"type":"open","scene":"no_such_scene.json"})", "no_such_scene.json: cannot open the scene file"},
+      {R"({"type":"start"})", "no scene is open"},
+      {R"({"type":"get_scene"})", "no scene is open"},
+      {R"({"type":"hello","protocol":1})", "already said hello"},
+  };
+  for (const Case& k : cases) {
+    c.send_text(k.text);
+    const json e = c.expect("error");
+    EXPECT_NE(e["message"].get<std::string>().find(k.expected), std::string::npos) << k.text << " -> " << e;
+  }
+  c.send_binary(std::string("\x00\x01\x02", 3));
+  EXPECT_NE(c.expect("error")["message"].get<std::string>().find("binary frames"), std::string::npos);
+  c.request({{"type", "ping"}}, "pong");
+}
+
+TEST_F(ServerTest, AMessageAboveTheLimitClosesTheConnectionCleanly) {
+  Client c(port());
+  c.hello();
+  c.send_text(R"({"type":"get_mesh","object":")" + std::string(kMaxMessageBytes, 'a') + "\"}");
+  beast::error_code ended;
+  EXPECT_FALSE(c.read(&ended).has_value());
+  EXPECT_EQ(ended, websocket::error::closed) << ended.message();
+  EXPECT_EQ(c.close_reason().code, websocket::close_code::too_big);
+  // the service goes on for others
+  Client other(port());
+  other.hello();
+}
+
+TEST_F(ServerTest, ATokenIsRequiredWhenConfiguredAndOffLoopback) {
+  auto refused = Server::start({.host = "0.0.0.0", .port = 0});
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("not a loopback address"), std::string::npos)
+      << refused.error().message;
+  auto bad_host = Server::start({.host = "my-laptop", .port = 0});
+  ASSERT_FALSE(bad_host.has_value());
+  EXPECT_NE(bad_host.error().message.find("not an IP address"), std::string::npos);
+
+  start_server("s3cret");
+  {
+    Client c(port());
+    const json e = c.request({{"type", "hello"}, {"protocol", 1}}, "error");
+    EXPECT_NE(e["message"].get<std::string>().find("needs a token"), std::string::npos) << e;
+    beast::error_code ended;
+    EXPECT_FALSE(c.read(&ended).has_value());
+    EXPECT_EQ(c.close_reason().code, websocket::close_code::policy_error);
+  }
+  {
+    Client c(port());
+    c.request({{"type", "hello"}, {"protocol", 1}, {"token", "guess"}}, "error");
+    EXPECT_FALSE(c.read().has_value());
+  }
+  Client c(port());
+  c.hello("s3cret");
+  c.request({{"type", "ping"}}, "pong");
+}
+
+TEST_F(ServerTest, ServesThePageOverHttp) {
+  EXPECT_EQ(http_get(port(), "/"), std::make_pair(200u, std::string(kPage)));
+  EXPECT_EQ(http_get(port(), "/index.html?token=x").first, 200u);
+  EXPECT_EQ(http_get(port(), "/nothing.js").first, 404u);
+  EXPECT_EQ(http_get(port(), "/ws").first, 426u);
+}
+
+TEST_F(ServerTest, DefaultSessionRunsStreamsStateAndStopsWithTheReport) {
+  Client c(port());
+  c.hello();
+  const json opened = c.request({{"type", "open"}, {"id", 1}}, "opened");
+  EXPECT_EQ(opened["id"], 1);
+  EXPECT_EQ(opened["scene"], "bunny-sweep");
+  EXPECT_EQ(opened["objects"], json::array({"bunny"}));
+  const json subscribed = c.request({{"type", "subscribe"}, {"rate_hz", 100}}, "subscribed");
+  EXPECT_EQ(subscribed["rate_hz"], 100.0);
+  const json started = c.request({{"type", "start"}, {"id", 2}}, "started");
+  EXPECT_EQ(started["id"], 2);
+
+  // the tool moves (sim-raster); states carry every documented field
+  std::set<double> xs;
+  double last_time = -1.0;
+  for (int i = 0; i < 40; ++i) {
+    const json s = c.expect("state");
+    const double t = s["time_s"].get<double>();
+    EXPECT_GE(t, last_time);
+    last_time = t;
+    ASSERT_EQ(s["tool"]["position"].size(), 3u);
+    ASSERT_EQ(s["tool"]["orientation"].size(), 4u);
+    ASSERT_EQ(s["force"].size(), 3u);
+    ASSERT_EQ(s["torque"].size(), 3u);
+    EXPECT_TRUE(s["contact_pairs"].is_number_integer());
+    EXPECT_TRUE(s["haptic"]["ticks"].is_number_unsigned());
+    EXPECT_TRUE(s["haptic"]["missed_deadlines"].is_number_unsigned());
+    EXPECT_TRUE(s["haptic"]["rate_hz"].is_number());
+    EXPECT_TRUE(s["collision"]["rate_hz"].is_number());
+    double norm = 0.0;
+    for (const auto& f : s["force"]) norm += f.get<double>() * f.get<double>();
+    EXPECT_LE(std::sqrt(norm), 8.0 + 1e-9) << "the scene's force limit";
+    xs.insert(s["tool"]["position"][0].get<double>());
+  }
+  EXPECT_GT(xs.size(), 5u) << "the tool's position changes between states";
+
+  const json scene = c.request({{"type", "get_scene"}}, "scene");
+  EXPECT_EQ(scene["status"], "running");
+  EXPECT_EQ(scene["controlled_here"], true);
+  const json mesh = c.request({{"type", "get_mesh"}, {"object", "bunny"}}, "mesh");
+  EXPECT_GT(mesh["vertices"].size(), 3000u);
+
+  const json stopped = c.request({{"type", "stop"}, {"id", 3}}, "stopped");
+  EXPECT_EQ(stopped["id"], 3);
+  const json& report = stopped["report"];
+  EXPECT_EQ(report["scene"], "bunny-sweep");
+  EXPECT_GT(report["haptic"]["ticks"].get<std::uint64_t>(), 0u);
+  EXPECT_TRUE(report.contains("collision"));
+  EXPECT_TRUE(report.contains("force"));
+  EXPECT_EQ(c.request({{"type", "stop"}}, "error")["message"], "the session is not running");
+  c.request({{"type", "close"}}, "closed");
+}
+
+TEST_F(ServerTest, OneClientControlsOthersWatchAndItsDisconnectStopsTheSession) {
+  Client watcher(port());
+  watcher.hello();
+  std::optional<Client> controller;
+  controller.emplace(port());
+  controller->hello();
+  controller->request({{"type", "open"}, {"scene", scene_.filename().string()}}, "opened");
+  EXPECT_EQ(watcher.expect("session")["status"], "opened");
+
+  // the watcher may look, not change
+  for (const json& m : {json{{"type", "open"}}, json{{"type", "start"}}, json{{"type", "stop"}},
+                        json{{"type", "remove_object"}, {"name", "bunny"}}}) {
+    const json e = watcher.request(m, "error");
+    EXPECT_NE(e["message"].get<std::string>().find("another client controls"), std::string::npos) << e;
+  }
+  EXPECT_EQ(watcher.request({{"type", "get_scene"}}, "scene")["controlled_here"], false);
+  watcher.request({{"type", "subscribe"}, {"rate_hz", 200}}, "subscribed");
+
+  controller->request({{"type", "start"}}, "started");
+  EXPECT_EQ(watcher.expect("state")["tool"]["position"].size(), 3u);
+  // the stylus goes into the bunny within 0.5 s: the watcher is told
+  const json contact = watcher.expect("contact");
+  EXPECT_EQ(contact["event"], "begin");
+  EXPECT_EQ(contact["object"], "bunny");
+  EXPECT_GT(contact["pairs"].get<int>(), 0);
+  EXPECT_GT(contact["volume"].get<double>(), 0.0);
+
+  controller.reset();  // the controlling client goes away without a word
+  for (;;) {
+    const json m = watcher.expect("session");
+    if (m["status"] == "closed") break;
+  }
+  // the slot is free: the watcher may now open its own session
+  watcher.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+}
+
+TEST_F(ServerTest, EditsTheSceneBeforeStartAndRefusesEditsWhileRunning) {
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  const json missing =
+      c.request({{"type", "add_object"}, {"object", {{"name", "b2"}, {"mesh", "missing.obj"}}}}, "error");
+  EXPECT_NE(missing["message"].get<std::string>().find("file not found"), std::string::npos) << missing;
+  const auto bunny = (testing::assets() / "meshes" / "bunny_npm_3674.obj").string();
+  const json added = c.request({{"type", "add_object"},
+                                {"id", 5},
+                                {"object",
+                                 {{"name", "b2"},
+                                  {"mesh", bunny},
+                                  {"spheres", 200},
+                                  {"meters_per_unit", 0.01},
+                                  {"pose", {{"position", {0.3, 0, 0}}}}}}},
+                               "object_added");
+  EXPECT_EQ(added["id"], 5);
+  EXPECT_EQ(added["name"], "b2");
+  c.request({{"type", "set_pose"}, {"object", "b2"}, {"pose", {{"position", {0.4, 0, 0}}}}}, "pose_set");
+  c.request({{"type", "set_watch"}, {"objects", {"bunny"}}}, "watch_set");
+  const json bad_device = c.request({{"type", "set_device"}, {"device", {{"driver", 7}}}}, "error");
+  EXPECT_NE(bad_device["message"].get<std::string>().find("tool.device.driver"), std::string::npos)
+      << bad_device;
+  const json scene = c.request({{"type", "get_scene"}}, "scene")["scene"];
+  ASSERT_EQ(scene["objects"].size(), 2u);
+  EXPECT_EQ(scene["objects"][1]["pose"]["position"][0], 0.4);
+  EXPECT_EQ(scene["objects"][1]["watched"], false);
+
+  c.request({{"type", "start"}}, "started");
+  const json refused = c.request({{"type", "remove_object"}, {"name", "b2"}}, "error");
+  EXPECT_NE(refused["message"].get<std::string>().find("stop it before editing"), std::string::npos);
+  c.request({{"type", "stop"}}, "stopped");
+  c.request({{"type", "remove_object"}, {"name", "b2"}}, "object_removed");
+  // a stopped session starts again, as a new run of the edited scene
+  c.request({{"type", "start"}, {"seconds", 0.2}}, "started");
+  const json stopped = c.expect("stopped");
+  EXPECT_EQ(stopped["reason"], "the session's seconds elapsed");
+  EXPECT_GT(stopped["report"]["haptic"]["ticks"].get<std::uint64_t>(), 0u);
+}
+
+TEST_F(ServerTest, AStartThatCannotBuildTheSessionIsAnError) {
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  c.request({{"type", "set_device"}, {"device", {{"driver", "no-such-device"}}}}, "device_set");
+  const json e = c.request({{"type", "start"}, {"id", 9}}, "error");
+  EXPECT_EQ(e["id"], 9);
+  EXPECT_NE(e["message"].get<std::string>().find("no-such-device"), std::string::npos) << e;
+  c.request({{"type", "set_device"}, {"device", {{"driver", "sim-line"}}}}, "device_set");
+  c.request({{"type", "start"}}, "started");
+}
+
+TEST_F(ServerTest, StoppingTheServerStopsTheSessionAndClosesClients) {
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  c.request({{"type", "start"}}, "started");
+  server_->stop();
+  beast::error_code ended;
+  for (;;) {
+    if (!c.read(&ended)) break;
+  }
+  EXPECT_EQ(c.close_reason().code, websocket::close_code::going_away);
+}
+
+}  // namespace
+}  // namespace uh::service
