@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The state stream of `uh serve` on loopback, seen by a client (docs/benchmarks.md).
 
 Starts `uh serve --port 0`, opens and starts the default session, subscribes at each rate for a
@@ -6,9 +6,10 @@ few seconds and reports the received rate and the delivery latency of state mess
 client's CLOCK_MONOTONIC at receipt minus the service's `clock_s` at sending, same clock on one
 machine), and the round trip of `ping` for comparison.
 
-    python3 scripts/bench-serve.py [UH_BINARY] [--seconds S] [--rates 60,250,1000]
+    /usr/bin/python3 scripts/bench-serve.py [UH_BINARY] [--seconds S] [--rates 60,250,1000]
 
-Needs Debian's python3-websockets (scripts/install-deps.sh).
+Needs Debian's python3 with python3-websockets (scripts/install-deps.sh): /usr/bin/python3, which
+may not be the first python3 on PATH.
 """
 import argparse
 import asyncio
@@ -45,9 +46,12 @@ async def bench(url, seconds, rates):
         for rate in rates:
             await ask(type="subscribe", rate_hz=rate)
             latencies, count = [], 0
-            await asyncio.sleep(0.5)  # settle
+            # the first half second settles (read, not counted), then `seconds` are measured
+            settle = time.monotonic() + 0.5
+            while time.monotonic() < settle:
+                await ws.recv()
             begin = time.monotonic()
-            while (now := time.monotonic()) - begin < seconds:
+            while time.monotonic() - begin < seconds:
                 message = json.loads(await ws.recv())
                 if message["type"] == "state":
                     latencies.append((time.monotonic() - message["clock_s"]) * 1e6)

@@ -270,6 +270,7 @@ struct Server::Impl {
   OpenSockets open_sockets;
   std::thread thread;
   std::uint16_t port = 0;
+  std::string url;
   int live = 0;           // connections being served (network thread)
   bool stopping = false;  // network thread
   std::atomic<bool> stopped{false};
@@ -299,6 +300,11 @@ Result<std::unique_ptr<Server>> Server::start(ServerOptions options) {
   if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) return Error{fmt::format("cannot listen on {}:{}: {}", host, impl->options.port, ec.message())};
   impl->port = acceptor.local_endpoint().port();
+  // before the network thread starts: the acceptor is its own from then on
+  const auto bound = acceptor.local_endpoint().address();
+  impl->url =
+      fmt::format("http://{}:{}/", bound.is_v6() ? fmt::format("[{}]", bound.to_string()) : bound.to_string(),
+                  impl->port);
   asio::co_spawn(impl->io, impl->accept(), report_exception);
   Impl* raw = impl.get();
   impl->thread = std::thread([raw] { raw->io.run(); });
@@ -307,11 +313,7 @@ Result<std::unique_ptr<Server>> Server::start(ServerOptions options) {
 
 std::uint16_t Server::port() const { return impl_->port; }
 
-std::string Server::url() const {
-  const auto address = impl_->acceptor.local_endpoint().address();
-  const std::string host = address.is_v6() ? fmt::format("[{}]", address.to_string()) : address.to_string();
-  return fmt::format("http://{}:{}/", host, impl_->port);
-}
+std::string Server::url() const { return impl_->url; }
 
 Status Server::run_session(controllers::HapticSession& session, double seconds, std::ostream* trace) {
   auto done = std::make_shared<std::promise<Status>>();
