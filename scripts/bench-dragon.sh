@@ -55,7 +55,11 @@ for run in $(seq "$runs"); do
   # wall and CPU time of the whole command, as a user sees it
   start=$(date +%s.%N)
   cpu_before=$(awk '{print $14 + $15 + $16 + $17}' /proc/$$/stat)
-  "$uh" ist build "$mesh" -o "$out" --spheres "$spheres" --json >"$json" 2>/dev/null
+  # the progress bar and any error go to stderr: shown, so a refused mesh says why
+  if ! "$uh" ist build "$mesh" -o "$out" --spheres "$spheres" --json >"$json"; then
+    echo "bench-dragon: uh ist build failed (above)" >&2
+    exit 1
+  fi
   end=$(date +%s.%N)
   cpu_after=$(awk '{print $14 + $15 + $16 + $17}' /proc/$$/stat)
   python3 - "$json" "$start" "$end" "$cpu_before" "$cpu_after" "$(getconf CLK_TCK)" "$run" <<'PY'
