@@ -1,4 +1,8 @@
 # Every dependency comes from a Debian 12 package; scripts/install-deps.sh installs them.
+if(WIN32)
+  include(UhWindowsDependencies)
+  return()
+endif()
 find_package(Threads REQUIRED)
 find_package(fmt REQUIRED)
 find_package(spdlog REQUIRED)

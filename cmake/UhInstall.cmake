@@ -3,6 +3,15 @@
 #   target_link_libraries(app PRIVATE uh::haptico)
 include(CMakePackageConfigHelpers)
 
+# Windows: what an engine links, uh.dll with its import library and the C header
+if(WIN32)
+  install(FILES ${PROJECT_SOURCE_DIR}/include/uh/uh.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/uh)
+  install(TARGETS uh_capi
+          RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  return()
+endif()
+
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/uh DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS uh_core uh_collette uh_forcecomp uh_haptico uh_controllers uh_capi uh_service uh_readerwriterqueue
         EXPORT UnrealHapticsTargets

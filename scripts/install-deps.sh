@@ -12,6 +12,7 @@ packages=(
   libboost-dev chromium python3-websockets
   clang libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
+  g++-mingw-w64-x86-64-posix wine64
 )
 
 # the live view's build (npm ci, esbuild) needs node and npm: Debian's, unless another node is there

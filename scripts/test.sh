@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# The whole test suite, three builds in separate directories:
+# The whole test suite, five builds in separate directories:
 #   1. Release: every test (unit, integration, the C API, the installed-package consumer, the live
 #      view in Chromium), then the Python module's pytest suite with Debian's /usr/bin/python3;
 #   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test (the live view's browser test once,
 #      in the Release stage, is enough);
 #   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions);
-#   4. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds), the scene
+#   4. Windows x64 (mingw-w64 cross build): the modules, uh.dll and the C API's tests, run under
+#      wine64 (cmake/mingw-w64-x86_64.cmake);
+#   5. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds), the scene
 #      parser (the repository's scenes as seeds), the CSV reader (fuzz/csv_seeds) and the service's
 #      message parser (fuzz/protocol_seeds).
 # Ends with one summary line: "tests: N passed, N failed".
@@ -74,6 +76,16 @@ if uh_build build/tsan -- -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUH_SANITIZE=thread
   run_ctest tsan build/tsan -L threads
 else
   echo "test: ThreadSanitizer build failed"; status=1; failed=$((failed + 1))
+fi
+
+echo "== build (Windows x64, mingw-w64; the C API's tests under wine64) =="
+if uh_build build/windows uh_capi_test -- -DCMAKE_TOOLCHAIN_FILE="$uh_root/cmake/mingw-w64-x86_64.cmake" \
+     -DCMAKE_BUILD_TYPE=Release; then
+  run_ctest windows build/windows
+  # wine's server outlives the last test program by a few seconds: let it end with the stage
+  WINEPREFIX="$uh_root/build/windows/wine-prefix" /usr/lib/wine/wineserver -w 2>/dev/null || true
+else
+  echo "test: Windows build failed"; status=1; failed=$((failed + 1))
 fi
 
 echo "== build (libFuzzer, clang) =="

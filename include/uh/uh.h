@@ -99,9 +99,9 @@ UH_API uh_tree_build_def uh_default_tree_build_def(void);
 /* Loads a .ist file (checksummed; a damaged file is refused with the reason). */
 UH_API uh_status uh_tree_load(const char* ist_path, uh_tree** out);
 
-/* Loads a closed mesh (OBJ, STL, PLY, OFF, ...), validates it (an open or non-manifold mesh is
- * refused with the counts of bad edges), packs it and builds the tree. Takes about a second per
- * 10,000 spheres. `def` may be NULL (defaults). */
+/* Loads a closed mesh (OBJ, STL, PLY, OFF, ...; the Windows build reads OBJ and STL only),
+ * validates it (an open or non-manifold mesh is refused with the counts of bad edges), packs it
+ * and builds the tree. Takes about a second per 10,000 spheres. `def` may be NULL (defaults). */
 UH_API uh_status uh_tree_build(const char* mesh_path, const uh_tree_build_def* def, uh_tree** out);
 
 /* Same from arrays: `vertices` holds vertex_count * 3 coordinates (x, y, z, in mesh units),

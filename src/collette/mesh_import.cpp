@@ -1,14 +1,13 @@
 #include "uh/collette/mesh_import.hpp"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <fmt/format.h>
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <system_error>
+
+#include "mesh_file_reader.hpp"
 
 namespace uh::collette {
 namespace {
@@ -329,31 +328,9 @@ Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoad
   if (std::filesystem::file_size(path, ec) == 0) {
     return Error{fmt::format("{}: file is empty, no mesh to read", name)};
   }
-  Assimp::Importer importer;
-  // no JoinIdenticalVertices: it also compares normals, so STL stays unwelded; we weld ourselves
-  const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices);
-  if (scene == nullptr) {
-    return Error{fmt::format("{}: cannot read mesh: {}", name, importer.GetErrorString())};
-  }
-  TriangleMesh mesh;
-  mesh.source_name = name;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* am = scene->mMeshes[m];
-    const auto base = static_cast<std::int32_t>(mesh.vertices.size());
-    for (unsigned i = 0; i < am->mNumVertices; ++i) {
-      const aiVector3D& v = am->mVertices[i];
-      mesh.vertices.push_back({static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)});
-    }
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      mesh.triangles.push_back({base + static_cast<std::int32_t>(face.mIndices[0]),
-                                base + static_cast<std::int32_t>(face.mIndices[1]),
-                                base + static_cast<std::int32_t>(face.mIndices[2])});
-    }
-  }
-  return validate_mesh(std::move(mesh), options);
+  auto mesh = read_mesh_file(path);
+  if (!mesh) return mesh.error();
+  return validate_mesh(std::move(*mesh), options);
 }
 
 }  // namespace uh::collette

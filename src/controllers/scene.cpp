@@ -390,6 +390,9 @@ std::filesystem::path default_cache_dir() {
   if (const char* dir = std::getenv("UH_CACHE_DIR"); dir != nullptr && *dir != '\0') return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0')
     return std::filesystem::path(xdg) / "unrealhaptics";
+  // Windows' per-user cache folder (set there, never on Linux)
+  if (const char* local = std::getenv("LOCALAPPDATA"); local != nullptr && *local != '\0')
+    return std::filesystem::path(local) / "unrealhaptics" / "cache";
   if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
     return std::filesystem::path(home) / ".cache" / "unrealhaptics";
   return std::filesystem::temp_directory_path() / "unrealhaptics-cache";

@@ -1,25 +1,24 @@
 #include "uh/core/atomic_file_writer.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <unistd.h>
 #include <atomic>
-#include <cerrno>
-#include <cstring>
 #include <streambuf>
 #include <string>
+#include <system_error>
 #include <utility>
+
+#include "file_ops.hpp"
 
 namespace uh {
 
 namespace {
 
-// a stream buffer over a file descriptor that keeps the first write error (errno) instead of
-// losing it inside an ofstream
+// a stream buffer over a file descriptor that keeps the first write error instead of losing it
+// inside an ofstream
 class FdStreamBuf final : public std::streambuf {
  public:
   explicit FdStreamBuf(int fd) : fd_(fd) { setp(buffer_, buffer_ + sizeof(buffer_)); }
-  int error() const { return error_; }
+  std::error_code error() const { return error_; }
 
  protected:
   int_type overflow(int_type c) override {
@@ -34,28 +33,17 @@ class FdStreamBuf final : public std::streambuf {
 
  private:
   bool drain() {
-    const char* p = pbase();
-    std::size_t left = static_cast<std::size_t>(pptr() - pbase());
-    while (left > 0 && error_ == 0) {
-      const ssize_t w = ::write(fd_, p, left);
-      if (w < 0) {
-        if (errno == EINTR) continue;
-        error_ = errno;
-        break;
-      }
-      p += w;
-      left -= static_cast<std::size_t>(w);
-    }
+    if (!error_) error_ = detail::write_all(fd_, pbase(), static_cast<std::size_t>(pptr() - pbase()));
     setp(buffer_, buffer_ + sizeof(buffer_));
-    return error_ == 0;
+    return !error_;
   }
 
   int fd_;
-  int error_ = 0;
+  std::error_code error_;
   char buffer_[1 << 16];
 };
 
-std::string reason(int error) { return error != 0 ? std::strerror(error) : "unknown error"; }
+std::string reason(std::error_code error) { return error ? error.message() : "unknown error"; }
 
 }  // namespace
 
@@ -76,11 +64,11 @@ Result<AtomicFileWriter> AtomicFileWriter::create(const std::filesystem::path& t
   // process id plus a per-process counter: concurrent writers never share a temporary file
   static std::atomic<unsigned> counter{0};
   const std::filesystem::path temp = dir / fmt::format(".{}.tmp{}-{}", target.filename().string(),
-                                                       static_cast<long>(::getpid()), counter.fetch_add(1));
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) {
+                                                       detail::process_id(), counter.fetch_add(1));
+  int fd = -1;
+  if (const std::error_code error = detail::create_new_file(temp, fd)) {
     return Error{
-        fmt::format("{}: cannot create a file in {}: {}", target.string(), dir.string(), reason(errno))};
+        fmt::format("{}: cannot create a file in {}: {}", target.string(), dir.string(), reason(error))};
   }
   return AtomicFileWriter(std::make_unique<State>(target, temp, fd));
 }
@@ -97,8 +85,8 @@ AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept
 
 AtomicFileWriter::~AtomicFileWriter() {
   if (state_ == nullptr || state_->done) return;
-  ::close(state_->fd);
-  ::unlink(state_->temp.c_str());
+  (void)detail::close_file(state_->fd);
+  detail::remove_file(state_->temp);
 }
 
 std::ostream& AtomicFileWriter::stream() { return state_->out; }
@@ -109,36 +97,28 @@ Status AtomicFileWriter::commit() {
   State& s = *state_;
   if (s.done) return Error{fmt::format("{}: already committed", s.target.string())};
   s.done = true;
-  auto fail = [&](std::string_view what, int error) {
-    ::unlink(s.temp.c_str());
+  auto fail = [&](std::string_view what, std::error_code error) {
+    detail::remove_file(s.temp);
     return Error{fmt::format("{}: {}: {}", s.target.string(), what, reason(error))};
   };
   s.out.flush();
-  if (!s.out || s.buf.error() != 0) {
-    ::close(s.fd);
+  if (!s.out || s.buf.error()) {
+    (void)detail::close_file(s.fd);
     return fail("write failed", s.buf.error());
   }
-  if (::fsync(s.fd) != 0) {
-    const int e = errno;
-    ::close(s.fd);
-    return fail("write failed (fsync)", e);
+  if (const std::error_code error = detail::sync_file(s.fd)) {
+    (void)detail::close_file(s.fd);
+    return fail("write failed (fsync)", error);
   }
-  if (::close(s.fd) != 0) return fail("write failed (close)", errno);
-  if (::rename(s.temp.c_str(), s.target.c_str()) != 0)
-    return fail("cannot move the finished file into place", errno);
-  // the rename is durable only once the directory is: sync it (file systems that cannot sync a
-  // directory say EINVAL; the rename has happened then, so that is no failure)
+  if (const std::error_code error = detail::close_file(s.fd)) return fail("write failed (close)", error);
+  if (const std::error_code error = detail::replace_file(s.temp, s.target))
+    return fail("cannot move the finished file into place", error);
+  // the rename is durable only once the directory is
   const std::filesystem::path dir =
       s.target.has_parent_path() ? s.target.parent_path() : std::filesystem::path(".");
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    const int synced = ::fsync(dir_fd);
-    const int e = errno;
-    ::close(dir_fd);
-    if (synced != 0 && e != EINVAL) {
-      return Error{fmt::format("{}: written, but its directory could not be synced: {}", s.target.string(),
-                               reason(e))};
-    }
+  if (const std::error_code error = detail::sync_directory(dir)) {
+    return Error{fmt::format("{}: written, but its directory could not be synced: {}", s.target.string(),
+                             reason(error))};
   }
   return Ok{};
 }

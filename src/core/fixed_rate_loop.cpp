@@ -1,19 +1,14 @@
 #include "uh/core/fixed_rate_loop.hpp"
 
-#include <pthread.h>
-#include <sched.h>
-#include <sys/prctl.h>
-#include <time.h>
-
 #include <algorithm>
 #include <cassert>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <string>
 #include <utility>
 
+#include "loop_thread.hpp"
 #include "uh/core/log.hpp"
 
 namespace uh {
@@ -33,17 +28,6 @@ inline void cpu_relax() {
 #elif defined(__aarch64__)
   asm volatile("yield");
 #endif
-}
-
-// libstdc++'s steady_clock is CLOCK_MONOTONIC, so an absolute clock_nanosleep on that clock
-// wakes at the steady_clock time asked for (plus the OS wake-up latency)
-void sleep_until(Clock::time_point t) {
-  const std::int64_t ns = to_ns(t);
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(ns % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
 }
 
 std::uint64_t abs_ns(std::int64_t v) { return static_cast<std::uint64_t>(v < 0 ? -v : v); }
@@ -134,21 +118,14 @@ FixedRateLoopStats FixedRateLoop::stats() const {
 }
 
 void FixedRateLoop::run(Callback callback, ExitCallback on_exit) {
-  {
-    const std::string short_name = options_.name.substr(0, 15);
-    pthread_setname_np(pthread_self(), short_name.c_str());
-  }
-  // the default timer slack (50 us) would add up to 50 us to every wake-up
-  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  detail::LoopThread os_thread(options_.name);
   if (options_.raise_priority) {
-    sched_param param{};
-    param.sched_priority = options_.fifo_priority;
-    const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
-    priority_raised_.store(rc == 0, std::memory_order_relaxed);
+    const std::string refused = os_thread.raise_priority(options_.fifo_priority);
+    priority_raised_.store(refused.empty(), std::memory_order_relaxed);
     // still before the first tick, so the loop thread may log here
-    if (rc != 0) {
-      log::warn("FixedRateLoop '{}': SCHED_FIFO priority {} refused ({}); running at normal priority",
-                options_.name, options_.fifo_priority, rc == EPERM ? "no CAP_SYS_NICE" : "error " + std::to_string(rc));
+    if (!refused.empty()) {
+      log::warn("FixedRateLoop '{}': real-time priority refused: {}; running at normal priority",
+                options_.name, refused);
     }
   }
 
@@ -170,7 +147,7 @@ void FixedRateLoop::run(Callback callback, ExitCallback on_exit) {
       // sleep in chunks (so that a stop request is seen), then spin the last stretch
       const Clock::time_point wake = scheduled - spin;
       for (Clock::time_point now = Clock::now(); now < wake; now = Clock::now()) {
-        sleep_until(std::min(wake, now + kMaxSleepChunk));
+        os_thread.sleep_until(std::min(wake, now + kMaxSleepChunk));
         if (stop_requested_.load(std::memory_order_acquire)) break;
       }
       if (stop_requested_.load(std::memory_order_acquire)) break;

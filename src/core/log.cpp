@@ -3,7 +3,7 @@
 #include <array>
 #include <atomic>
 
-#include <spdlog/spdlog.h>
+#include "log_sink.hpp"
 
 namespace uh::log {
 namespace {
@@ -11,24 +11,11 @@ namespace {
 std::atomic<int> g_level{static_cast<int>(Level::info)};
 std::array<std::atomic<std::uint64_t>, 6> g_counts{};
 
-spdlog::level::level_enum to_spdlog(Level level) {
-  switch (level) {
-    case Level::trace: return spdlog::level::trace;
-    case Level::debug: return spdlog::level::debug;
-    case Level::info: return spdlog::level::info;
-    case Level::warn: return spdlog::level::warn;
-    case Level::error: return spdlog::level::err;
-    case Level::off: return spdlog::level::off;
-  }
-  return spdlog::level::off;
-}
-
 }  // namespace
 
 void set_level(Level level) {
   g_level.store(static_cast<int>(level), std::memory_order_relaxed);
-  // the default spdlog logger filters too: let everything through that passes our level
-  spdlog::set_level(to_spdlog(level));
+  detail::sink_set_level(level);
 }
 
 Level level() { return static_cast<Level>(g_level.load(std::memory_order_relaxed)); }
@@ -38,7 +25,7 @@ bool enabled(Level l) { return l != Level::off && static_cast<int>(l) >= g_level
 void write(Level l, std::string_view message) {
   if (!enabled(l)) return;
   g_counts[static_cast<std::size_t>(l)].fetch_add(1, std::memory_order_relaxed);
-  spdlog::log(to_spdlog(l), "{}", message);
+  detail::sink_write(l, message);
 }
 
 std::uint64_t message_count(Level l) { return g_counts[static_cast<std::size_t>(l)].load(std::memory_order_relaxed); }

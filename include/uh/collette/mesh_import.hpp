@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// Loading and validating triangle meshes (OBJ, STL, PLY, OFF and every other format assimp reads).
+/// Loading and validating triangle meshes (OBJ, STL, PLY, OFF and every other format assimp reads;
+/// builds without assimp, such as the Windows build, read OBJ and STL with the in-tree reader).
 
 #include <filesystem>
 
@@ -38,6 +39,16 @@ struct MeshLoadOptions {
 /// Missing, unreadable and empty files are errors too. All meshes in the file are merged. Setup
 /// code only (allocates, reads files); any thread; not real-time safe.
 Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options = {});
+
+/// Reads the vertices and triangles of an OBJ or STL file with the in-tree reader, as they are:
+/// no welding, no validation (load_mesh() does those). It is what load_mesh() reads with in builds
+/// without assimp (the Windows build). OBJ: `v` and `f` lines (corners i, i/t, i//n or i/t/n; a
+/// negative i counts back from the last vertex; faces with more than 3 corners are fanned from
+/// their first corner, right for the convex faces exporters write), all else is ignored. STL:
+/// binary when the file size is 84 + 50 n bytes for its n triangles, else ASCII. Coordinates are
+/// rounded to float, as assimp keeps them, so both readers give the same mesh. Errors name the
+/// file and line. Not real-time safe; any thread.
+Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path);
 
 /// Welds, repairs, validates and orients an in-memory mesh the same way load_mesh() does (used by
 /// load_mesh() and by code that builds meshes itself). `mesh.source_name` names it in messages.

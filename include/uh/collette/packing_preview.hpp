@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// A software-rendered PNG picture of a sphere packing (like the paper's bunny figures).
+/// A software-rendered PNG picture of a sphere packing (like the paper's bunny figures). Part of
+/// builds with libpng only: the Windows build leaves it out (the uh program is its only user).
 
 #include <filesystem>
 #include <vector>

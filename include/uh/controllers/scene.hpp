@@ -99,7 +99,8 @@ Result<Scene> default_scene(const std::filesystem::path& cache_dir);
 Result<std::filesystem::path> write_default_scene(const std::filesystem::path& cache_dir);
 
 /// Where built .ist files are cached: $UH_CACHE_DIR, else $XDG_CACHE_HOME/unrealhaptics, else
-/// ~/.cache/unrealhaptics, else a folder in the system temp directory.
+/// (Windows) %LOCALAPPDATA%\unrealhaptics\cache, else ~/.cache/unrealhaptics, else a folder in the
+/// system temp directory.
 std::filesystem::path default_cache_dir();
 
 /// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the
