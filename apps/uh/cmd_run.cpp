@@ -132,7 +132,7 @@ int run_session(const RunArgs& args) {
   const char* ci = std::getenv("CI");
   const bool live = !args.json && isatty(STDERR_FILENO) == 1 && (ci == nullptr || *ci == '\0');
 
-  // with the live view, the server runs the session (browsers watch it) and stops it after `seconds`
+  // with the live view, the server shows the session to browsers while this thread runs it
   std::unique_ptr<service::Server> view_server;
   if (args.view) {
     auto server = service::Server::start({.port = static_cast<std::uint16_t>(args.view_port), .files = view::static_files()});
@@ -140,21 +140,23 @@ int run_session(const RunArgs& args) {
     view_server = std::move(server).value();
     std::fprintf(stderr, "  live view: %s\n", view_server->url().c_str());
   }
+  const auto on_status = [live](const controllers::SessionState& s) {
+    if (!live) return;
+    std::fprintf(stderr, "\r  t %5.1f s | haptic %6.0f Hz | collision %6.0f Hz | force %5.2f N | pairs %6d ",
+                 s.time_s, s.haptic_rate_hz, s.collision_rate_hz, norm(s.force_world), s.contact_pairs);
+  };
   Status ran = Ok{};
-  if (view_server) {
-    ran = view_server->run_session(**session, seconds, trace);
-    view_server->stop();
-  } else {
+  {
     const StopOnSignals stop_on_signals(**session);
-    ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
-                       : (*session)->run(seconds,
-                                         [live](const controllers::SessionState& s) {
-                                           if (!live) return;
-                                           std::fprintf(stderr, "\r  t %5.1f s | haptic %6.0f Hz | collision %6.0f Hz | force %5.2f N | pairs %6d ",
-                                                        s.time_s, s.haptic_rate_hz, s.collision_rate_hz, norm(s.force_world), s.contact_pairs);
-                                         },
-                                         trace);
+    if (view_server) {
+      ran = view_server->run_session(**session, seconds, on_status, trace);
+    } else {
+      ran = args.stepped ? (*session)->run_stepped(seconds, args.ticks_per_collision, trace)
+                         : (*session)->run(seconds, on_status, trace);
+    }
   }
+  // the session has stopped (zero force): closing the browsers' connections may take a moment
+  if (view_server) view_server->stop();
   if (live) std::fputc('\n', stderr);
   // a session that ended in an error keeps its trace too: it shows what happened up to the end
   const Status traced = trace_file ? trace_file->commit() : Status{Ok{}};

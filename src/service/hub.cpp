@@ -251,6 +251,11 @@ void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<contro
 
 json Hub::stop_session(Status* status_out) {
   if (!slot_ || slot_->phase != Phase::kRunning) return nullptr;
+  if (slot_->hosted) {
+    // the program's own session stops on its owner's thread: ask it to (it ends within 20 ms)
+    slot_->session->request_stop();
+    return nullptr;
+  }
   stop_timer_.cancel();
   event_timer_.cancel();
   Status status = slot_->session->stop();
@@ -261,11 +266,6 @@ json Hub::stop_session(Status* status_out) {
   slot_->session = nullptr;
   slot_->owned.reset();
   if (status_out != nullptr) *status_out = status;
-  if (slot_->host_done) {
-    auto done = std::move(slot_->host_done);
-    close_slot();
-    done(status);
-  }
   return report;
 }
 
@@ -415,32 +415,26 @@ void Hub::disconnect(ClientId id) {
   }
 }
 
-void Hub::host(controllers::HapticSession& session, double seconds, std::ostream* trace,
-               std::function<void(Status)> done) {
-  if (shut_down_) return done(Error{"the service is stopping"});
-  if (slot_) return done(Error{"a client's session is open in the service"});
+Status Hub::show(controllers::HapticSession& session) {
+  if (shut_down_) return Error{"the service is stopping"};
+  if (slot_) return Error{"a client's session is open in the service"};
   ++generation_;
   slot_.emplace();
   slot_->controller = kHost;
   slot_->hosted = session.scene();
-  broadcast_session("opened");
-  if (auto started = session.start(trace); !started) {
-    slot_.reset();
-    return done(started);
-  }
   slot_->session = &session;
   slot_->phase = Phase::kRunning;
-  slot_->host_done = std::move(done);
+  broadcast_session("opened");
   broadcast_session("started");
   poll_events();
-  const std::uint64_t generation = generation_;
-  stop_timer_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(seconds)));
-  stop_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
-    if (ec || !slot_ || generation != generation_) return;
-    broadcast_session("stopped");
-    stop_session();
-  });
+  return Ok{};
+}
+
+void Hub::unshow() {
+  if (!slot_ || !slot_->hosted) return;
+  poll_events();  // the events up to the end
+  broadcast_session("stopped");
+  close_slot();
 }
 
 void Hub::shutdown() {

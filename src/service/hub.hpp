@@ -52,9 +52,13 @@ class Hub {
   void receive_binary(ClientId client);
   void disconnect(ClientId client);
 
-  /// The program's own session (Server::run_session): `done` gets stop()'s status.
-  void host(controllers::HapticSession& session, double seconds, std::ostream* trace,
-            std::function<void(Status)> done);
+  /// Shows the program's own session (Server::run_session) to the clients while the program runs
+  /// it on its own thread: no client controls it, clients watch its scene, state and events. The
+  /// session need not have started yet (its state is zero until then). An error when a client's
+  /// session is open or the service is stopping.
+  Status show(controllers::HapticSession& session);
+  /// The program's session has ended (its owner stopped it): the clients are told, the slot freed.
+  void unshow();
 
   /// Stops the session (zero force) and closes every client. Joins session builds.
   void shutdown();
@@ -73,12 +77,11 @@ class Hub {
   struct Slot {
     ClientId controller = kHost;
     std::optional<SceneDocument> document;     // a client's slot
-    std::optional<controllers::Scene> hosted;  // the program's own
+    std::optional<controllers::Scene> hosted;  // the program's own (show()): its owner stops it
     Phase phase = Phase::kOpen;
     std::unique_ptr<controllers::HapticSession> owned;
     controllers::HapticSession* session = nullptr;
     json start_id;  // the start request, answered when running
-    std::function<void(Status)> host_done;
     const controllers::Scene& scene() const { return document ? document->scene() : *hosted; }
   };
 

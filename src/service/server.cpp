@@ -315,13 +315,25 @@ std::uint16_t Server::port() const { return impl_->port; }
 
 std::string Server::url() const { return impl_->url; }
 
-Status Server::run_session(controllers::HapticSession& session, double seconds, std::ostream* trace) {
-  auto done = std::make_shared<std::promise<Status>>();
-  auto result = done->get_future();
-  asio::post(impl_->io, [this, &session, seconds, trace, done] {
-    impl_->hub.host(session, seconds, trace, [done](Status s) { done->set_value(std::move(s)); });
+Status Server::run_session(controllers::HapticSession& session, double seconds,
+                           const std::function<void(const controllers::SessionState&)>& on_status,
+                           std::ostream* trace) {
+  if (impl_->stopped) return Error{"the server is stopped"};
+  // the hub is the network thread's: show() and unshow() run there, and this thread waits
+  auto on_network_thread = [this](auto call) {
+    std::promise<Status> done;
+    asio::post(impl_->io, [&] { done.set_value(call()); });
+    return done.get_future().get();
+  };
+  if (auto shown = on_network_thread([&] { return impl_->hub.show(session); }); !shown) return shown;
+  // run() on this thread, as `uh run` without the view: the session's time, request_stop() (a
+  // signal handler's), a thread that ends by itself, each with zero force and the same report
+  Status ran = session.run(seconds, on_status, trace);
+  (void)on_network_thread([&] {
+    impl_->hub.unshow();
+    return Status{Ok{}};
   });
-  return result.get();
+  return ran;
 }
 
 void Server::stop() {

@@ -1,6 +1,6 @@
 // `uh run` interrupted as a user interrupts it: SIGINT (Ctrl-C) or SIGTERM sent to the running
-// program. It must send zero force, print its summary, keep the trace (whose last row is that
-// zero) and exit with 128 + the signal number.
+// program, with and without the live view (--view). It must send zero force, print its summary,
+// keep the trace (whose last row is that zero) and exit with 128 + the signal number.
 
 #include <gtest/gtest.h>
 
@@ -85,13 +85,24 @@ Finished wait_for_exit(pid_t pid, std::chrono::seconds limit) {
   return {WIFEXITED(status), WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
-class RunSignalTest : public ::testing::TestWithParam<int> {};
+struct Interrupt {
+  int signal_number;
+  bool view;  // uh run --view: the live view's server shows the session meanwhile
+};
+
+// names the case in test output (instead of the struct's bytes)
+void PrintTo(const Interrupt& i, std::ostream* out) {
+  *out << (i.signal_number == SIGINT ? "SIGINT" : "SIGTERM") << (i.view ? " with --view" : "");
+}
+
+class RunSignalTest : public ::testing::TestWithParam<Interrupt> {};
 
 TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
-  const int signal_number = GetParam();
+  const int signal_number = GetParam().signal_number;
+  const bool view = GetParam().view;
   const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
-  const fs::path dir =
-      fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}", ::getpid(), signal_number);
+  const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}", ::getpid(),
+                                                               signal_number, view ? "_view" : "");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.json", trace = dir / "trace.csv", out = dir / "stdout.txt",
@@ -102,6 +113,7 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   const std::string cache_env = "UH_CACHE_DIR=" + (dir / "cache").string();
   std::vector<std::string> args = {UH_CLI_PATH, "run",          scene.string(),
                                    "--trace",   trace.string(), "--no-realtime"};
+  if (view) args.insert(args.end(), {"--view", "--port", "0"});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -148,6 +160,9 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   EXPECT_NE(stdout_text.find("(stopped early)"), std::string::npos) << stdout_text;
   EXPECT_NE(stdout_text.find("  force     max"), std::string::npos) << stdout_text;
   EXPECT_NE(stderr_text.find(fmt::format("stopped by {}", name)), std::string::npos) << stderr_text;
+  if (view) {
+    EXPECT_NE(stderr_text.find("live view: http://127.0.0.1:"), std::string::npos) << stderr_text;
+  }
 
   // the trace is kept, and its last row is the zero the device got
   ASSERT_TRUE(fs::exists(trace)) << stderr_text;
@@ -195,9 +210,12 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   fs::remove_all(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest, ::testing::Values(SIGINT, SIGTERM),
-                         [](const ::testing::TestParamInfo<int>& p) {
-                           return p.param == SIGINT ? "Sigint" : "Sigterm";
+INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest,
+                         ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false},
+                                           Interrupt{SIGINT, true}, Interrupt{SIGTERM, true}),
+                         [](const ::testing::TestParamInfo<Interrupt>& p) {
+                           return std::string(p.param.signal_number == SIGINT ? "Sigint" : "Sigterm") +
+                                  (p.param.view ? "WithView" : "");
                          });
 
 }  // namespace

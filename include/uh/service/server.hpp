@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -56,11 +57,14 @@ class Server {
   /// "http://HOST:PORT/".
   std::string url() const;
 
-  /// Runs `session` as the program's own (no client controls it; clients watch it) for `seconds`,
-  /// then stops it and returns what HapticSession::stop() returned; `trace` as in
-  /// HapticSession::start(). Blocks the calling thread; the session must not be used by the caller
-  /// meanwhile. An error when a client's session is open.
-  Status run_session(controllers::HapticSession& session, double seconds, std::ostream* trace = nullptr);
+  /// Runs `session` as the program's own (no client controls it; clients watch it): the calling
+  /// thread runs HapticSession::run(seconds, on_status, trace), so it ends as run() ends (its time
+  /// up, request_stop(), a thread that ended by itself) and returns what run() returned. Blocks the
+  /// calling thread, which owns the session meanwhile. An error when a client's session is open.
+  /// Not concurrently with stop().
+  Status run_session(controllers::HapticSession& session, double seconds,
+                     const std::function<void(const controllers::SessionState&)>& on_status = {},
+                     std::ostream* trace = nullptr);
 
   /// Stops any running session (zero force), closes every connection (WebSocket close 1001) and
   /// joins the network thread. Idempotent. Not from the network thread.
