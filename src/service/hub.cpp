@@ -1,9 +1,13 @@
 #include "hub.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <utility>
 
 #include <fmt/format.h>
 #include <boost/asio/post.hpp>
+
+#include "mesh_binary.hpp"
 
 namespace uh::service {
 namespace {
@@ -40,6 +44,14 @@ bool same_token(std::string_view a, std::string_view b) {
   return diff == 0;
 }
 
+// "add_object 'bunny'": names the request in messages about its binary frame.
+std::string add_object_label(const AddObject& add) {
+  const auto name = add.object.find("name");
+  return name != add.object.end() && name->is_string()
+             ? fmt::format("add_object '{}'", name->get<std::string>())
+             : std::string("add_object");
+}
+
 }  // namespace
 
 Hub::Hub(boost::asio::io_context& io, HubOptions options)
@@ -61,7 +73,21 @@ void Hub::receive(ClientId id, std::string_view text) {
   const auto it = clients_.find(id);
   if (it == clients_.end() || shut_down_) return;
   Client& c = it->second;
+  if (c.pending_mesh) {
+    // the announced frame did not come: that add_object fails, this message is read as usual
+    const auto pending = std::exchange(c.pending_mesh, std::nullopt);
+    if (pending->add)
+      c.peer->send(
+          error_reply(pending->req_id, "add_object",
+                      fmt::format("{}: its mesh_binary frame ({} bytes) must be the next message, but "
+                                  "a text message came; the object was not added",
+                                  add_object_label(*pending->add), pending->add->mesh_binary->bytes())));
+  }
   ParsedRequest req = parse_request(text);
+  if (req.announces_binary) {
+    if (auto e = on_announce_mesh(id, c, req); !e.empty()) c.peer->send(error_reply(req.id, req.type, e));
+    return;
+  }
   if (!req.body) {
     c.peer->send(error_reply(req.id, req.type, req.error));
     return;
@@ -75,10 +101,66 @@ void Hub::receive(ClientId id, std::string_view text) {
   handle(id, c, req.id, req.type, *req.body);
 }
 
-void Hub::receive_binary(ClientId id) {
-  send_to(id, error_reply(nullptr, "",
-                          fmt::format("binary frames are not used by protocol {}; send JSON text",
-                                      kProtocolVersion)));
+std::size_t Hub::message_limit(ClientId id) const {
+  const auto it = clients_.find(id);
+  if (it == clients_.end() || !it->second.pending_mesh) return kMaxMessageBytes;
+  const auto& pending = *it->second.pending_mesh;
+  return std::max(kMaxMessageBytes, pending.add ? pending.add->mesh_binary->bytes() : kMaxMeshBinaryBytes);
+}
+
+std::string Hub::on_announce_mesh(ClientId id, Client& c, const ParsedRequest& req) {
+  // whatever happens to the request, the frame that follows it is its own
+  c.pending_mesh.emplace(Client::PendingMesh{req.id, std::nullopt});
+  if (!req.body) return req.error;
+  if (!c.greeted)
+    return fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{}}}", kProtocolVersion);
+  if (auto e = check_control(id, true); !e.empty()) return e;
+  if (slot_->phase != Phase::kOpen) return "the session is running; stop it before editing the scene";
+  c.pending_mesh->add = std::get<AddObject>(*req.body);
+  return {};
+}
+
+void Hub::receive_binary(ClientId id, std::span<const std::byte> bytes) {
+  const auto it = clients_.find(id);
+  if (it == clients_.end() || shut_down_) return;
+  Client& c = it->second;
+  if (!c.pending_mesh) {
+    c.peer->send(error_reply(nullptr, "",
+                             "a binary frame must follow an add_object that announces it with "
+                             "\"mesh_binary\"; none did, so this frame was dropped"));
+    return;
+  }
+  const auto pending = std::exchange(c.pending_mesh, std::nullopt);
+  if (!pending->add) return;  // its request was refused, and said so
+  if (auto e = on_mesh_frame(id, *pending, bytes); !e.empty())
+    send_to(id, error_reply(pending->req_id, "add_object", e));
+}
+
+std::string Hub::on_mesh_frame(ClientId id, const Client::PendingMesh& pending,
+                               std::span<const std::byte> bytes) {
+  // the session cannot have changed hands or started meanwhile (only this client controls it and
+  // it sent nothing in between), but the slot's state is checked again rather than assumed
+  if (auto e = check_control(id, true); !e.empty()) return e;
+  if (slot_->phase != Phase::kOpen) return "the session is running; stop it before editing the scene";
+  const AddObject& add = *pending.add;
+  const std::string label = add_object_label(add);
+  auto mesh = decode_mesh_binary(bytes, *add.mesh_binary, label);
+  if (!mesh) return mesh.error().message;
+  SceneDocument& doc = *slot_->document;
+  auto report =
+      doc.add_inline_object(add.object, std::move(mesh).value(), options_.cache_dir / "inline-meshes");
+  if (!report) return report.error().message;
+  send_to(id, reply("object_added", pending.req_id,
+                    {{"name", doc.scene().objects.back().name},
+                     {"mesh",
+                      {{"vertices", report->vertex_count},
+                       {"triangles", report->triangle_count},
+                       {"welded_vertices", report->welded_vertices},
+                       {"degenerate_faces", report->degenerate_faces},
+                       {"duplicate_faces", report->duplicate_faces},
+                       {"winding_flipped", report->winding_flipped}}}}));
+  broadcast_session("edited");
+  return {};
 }
 
 void Hub::handle(ClientId id, Client& c, const json& req_id, const std::string& type,
@@ -151,6 +233,7 @@ std::string Hub::on_hello(ClientId, Client& c, const json& req_id, const Hello& 
                      {{"protocol", kProtocolVersion},
                       {"version", UH_VERSION},
                       {"max_message_bytes", kMaxMessageBytes},
+                      {"max_mesh_binary_bytes", kMaxMeshBinaryBytes},
                       {"session", std::move(session)}}));
   return {};
 }
@@ -374,7 +457,11 @@ void Hub::poll_events() {
 
 std::string Hub::on_edit(ClientId id, const json& req_id, const std::string& type, const RequestBody& body) {
   if (auto e = check_control(id, true); !e.empty()) return e;
-  if (slot_->phase != Phase::kOpen) return "the session is running; stop it before editing the scene";
+  if (const auto* p = std::get_if<SetPose>(&body); p != nullptr && slot_->phase == Phase::kRunning)
+    return move_object(id, req_id, *p);
+  if (slot_->phase != Phase::kOpen)
+    return "the session is running; stop it before editing the scene (only set_pose moves objects while it "
+           "runs)";
   SceneDocument& doc = *slot_->document;
   Status done{Ok{}};
   json fields = json::object();
@@ -403,6 +490,20 @@ std::string Hub::on_edit(ClientId id, const json& req_id, const std::string& typ
       {"set_device", "device_set"}};
   send_to(id, reply(kReplies.at(type), req_id, std::move(fields)));
   broadcast_session("edited");
+  return {};
+}
+
+std::string Hub::move_object(ClientId id, const json& req_id, const SetPose& p) {
+  SceneDocument& doc = *slot_->document;
+  if (auto done = doc.set_pose(p.object, p.pose); !done) return done.error().message;
+  const auto& objects = doc.scene().objects;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    if (objects[i].name == p.object) {
+      if (auto moved = slot_->session->set_object_pose(static_cast<std::int32_t>(i), objects[i].pose); !moved)
+        return moved.error().message;
+      break;
+    }
+  send_to(id, reply("pose_set", req_id, {{"object", p.object}}));
   return {};
 }
 

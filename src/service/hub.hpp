@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -49,7 +50,10 @@ class Hub {
 
   ClientId connect(Peer& peer);
   void receive(ClientId client, std::string_view text);
-  void receive_binary(ClientId client);
+  void receive_binary(ClientId client, std::span<const std::byte> bytes);
+  /// The largest message the client may send next: kMaxMessageBytes, or the size of the binary
+  /// frame an `add_object` announced (up to kMaxMeshBinaryBytes).
+  std::size_t message_limit(ClientId client) const;
   void disconnect(ClientId client);
 
   /// Shows the program's own session (Server::run_session) to the clients while the program runs
@@ -69,6 +73,13 @@ class Hub {
     bool greeted = false;
     double rate_hz = 0.0;  // 0: not subscribed
     std::unique_ptr<boost::asio::steady_timer> state_timer;
+    // an add_object that announced mesh_binary waits for its frame; without `add` (the request
+    // was refused) the frame is dropped when it comes
+    struct PendingMesh {
+      json req_id;
+      std::optional<AddObject> add;
+    };
+    std::optional<PendingMesh> pending_mesh;
   };
   enum class Phase : std::uint8_t { kOpen, kStarting, kRunning };
   static constexpr ClientId kHost = 0;
@@ -94,6 +105,12 @@ class Hub {
   std::string on_close(ClientId id, const json& req_id);
   std::string on_subscribe(ClientId id, Client& c, const json& req_id, const Subscribe& s);
   std::string on_edit(ClientId id, const json& req_id, const std::string& type, const RequestBody& body);
+  // set_pose while the session runs: the document and the running session's object
+  std::string move_object(ClientId id, const json& req_id, const SetPose& p);
+  // an add_object with mesh_binary: held until its frame comes (error text, or empty)
+  std::string on_announce_mesh(ClientId id, Client& c, const ParsedRequest& req);
+  std::string on_mesh_frame(ClientId id, const Client::PendingMesh& pending,
+                            std::span<const std::byte> bytes);
 
   // an error text when `id` may not change the session
   std::string check_control(ClientId id, bool needs_open) const;

@@ -92,6 +92,45 @@ class Fields {
   const json& j_;
 };
 
+// `add_object.mesh_binary`: {"vertices": V, "triangles": T}, the counts of the binary frame that
+// follows; the object then takes its mesh from that frame and names no file.
+std::string parse_mesh_binary(const Fields& f, AddObject& a) {
+  const json& m = *f.find("mesh_binary");
+  if (!m.is_object())
+    return fmt::format(
+        "field 'mesh_binary': expected an object {{\"vertices\": V, \"triangles\": T}}, got {}",
+        m.type_name());
+  for (const auto& [key, value] : m.items())
+    if (key != "vertices" && key != "triangles")
+      return fmt::format("unknown field 'mesh_binary.{}' (known here: vertices, triangles)", key);
+  MeshBinary counts;
+  const std::int64_t max_count = static_cast<std::int64_t>(kMaxMeshBinaryBytes / 12);
+  for (const auto& [key, out] : {std::pair<const char*, std::int64_t*>{"vertices", &counts.vertices},
+                                 std::pair<const char*, std::int64_t*>{"triangles", &counts.triangles}}) {
+    const auto it = m.find(key);
+    if (it == m.end()) return fmt::format("field 'mesh_binary.{}' is missing (expected a whole number)", key);
+    if (!it->is_number_integer())
+      return fmt::format("field 'mesh_binary.{}': expected a whole number, got {}", key, it->type_name());
+    const auto n = it->get<std::int64_t>();
+    // a closed mesh has at least a tetrahedron's 4 vertices and 4 triangles
+    if (n < 4 || n > max_count)
+      return fmt::format("field 'mesh_binary.{}': expected a whole number in [4, {}], got {}", key, max_count,
+                         n);
+    *out = n;
+  }
+  if (counts.bytes() > kMaxMeshBinaryBytes)
+    return fmt::format(
+        "field 'mesh_binary': {} vertices and {} triangles make a frame of {} bytes, above the "
+        "limit of {} bytes",
+        counts.vertices, counts.triangles, counts.bytes(), kMaxMeshBinaryBytes);
+  for (const char* key : {"mesh", "ist"})
+    if (a.object.contains(key))
+      return fmt::format(
+          "field 'object.{}': not allowed with 'mesh_binary' (the mesh comes in the binary frame)", key);
+  a.mesh_binary = counts;
+  return {};
+}
+
 // Parses the body of a request whose type is known; returns an error text or fills `body`.
 std::string parse_body(const std::string& type, const Fields& f, std::optional<RequestBody>& body) {
   std::string e;
@@ -144,9 +183,12 @@ std::string parse_body(const std::string& type, const Fields& f, std::optional<R
     if (e = f.string("object", g.object, true); !e.empty()) return e;
     body = g;
   } else if (type == "add_object") {
-    if (e = f.check_known({"object"}); !e.empty()) return e;
+    if (e = f.check_known({"object", "mesh_binary"}); !e.empty()) return e;
     AddObject a;
     if (e = f.object("object", a.object); !e.empty()) return e;
+    if (f.find("mesh_binary") != nullptr) {
+      if (e = parse_mesh_binary(f, a); !e.empty()) return e;
+    }
     body = a;
   } else if (type == "remove_object") {
     if (e = f.check_known({"name"}); !e.empty()) return e;
@@ -225,6 +267,7 @@ ParsedRequest parse_request(std::string_view text) {
     return out;
   }
   out.type = type->get<std::string>();
+  out.announces_binary = out.type == "add_object" && j.contains("mesh_binary");
   if (!id_error.empty()) {
     out.error = id_error;
     return out;

@@ -3,6 +3,8 @@
 // checked field by field, and the replies and events the service sends. Parsing never throws and
 // never crashes on any input (fuzz/service_protocol_fuzz.cpp); every error names the field.
 
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,6 +21,9 @@ using nlohmann::json;
 inline constexpr int kProtocolVersion = 1;
 /// Larger messages are refused and the connection is closed (WebSocket close code 1009).
 inline constexpr std::size_t kMaxMessageBytes = 1 << 20;
+/// An announced binary frame (`add_object` with `mesh_binary`) may be this large; only the frame
+/// that was announced is read with this limit, every other message with kMaxMessageBytes.
+inline constexpr std::size_t kMaxMeshBinaryBytes = std::size_t{64} << 20;
 /// Bounds of `subscribe.rate_hz` [Hz] and its default.
 inline constexpr double kMinStateRateHz = 1.0;
 inline constexpr double kMaxStateRateHz = 1000.0;
@@ -45,8 +50,18 @@ struct GetScene {};
 struct GetMesh {
   std::string object;  ///< an object's or the tool's name
 };
+/// The counts of an inline mesh sent in the binary frame that follows its `add_object`: the frame
+/// holds `vertices` * 3 little-endian float32 (x, y, z in mesh units), then `triangles` * 3
+/// little-endian uint32 vertex indices (counter-clockwise seen from outside).
+struct MeshBinary {
+  std::int64_t vertices = 0;
+  std::int64_t triangles = 0;
+  /// The frame's exact size [bytes].
+  std::size_t bytes() const { return static_cast<std::size_t>(vertices + triangles) * 12u; }
+};
 struct AddObject {
   json object;  ///< as an entry of a scene file's `objects` (checked by the scene parser)
+  std::optional<MeshBinary> mesh_binary;  ///< the mesh comes in the next binary frame (no `mesh`/`ist`)
 };
 struct RemoveObject {
   std::string name;
@@ -72,6 +87,9 @@ struct ParsedRequest {
   std::string type;  ///< the request's `type`, empty when unreadable
   std::optional<RequestBody> body;
   std::string error;  ///< set when body is empty
+  /// An `add_object` that names `mesh_binary` (valid or not): the next frame, if binary, belongs
+  /// to it and is consumed with it (dropped when the request was refused).
+  bool announces_binary = false;
 };
 
 /// Parses one text message. Never throws.

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <fstream>
+#include <span>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "uh/collette/ist_file.hpp"
 #include "uh/collette/mesh_import.hpp"
+#include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::service {
 namespace {
@@ -73,6 +76,26 @@ Status SceneDocument::add_object(json object, const std::filesystem::path& dir) 
   candidate["objects"].push_back(std::move(object));
   // an explicit watch list is kept as it is (set_watch changes it); without one, all are watched
   return apply(std::move(candidate));
+}
+
+Result<collette::MeshReport> SceneDocument::add_inline_object(json object, collette::TriangleMesh mesh,
+                                                              const std::filesystem::path& mesh_dir) {
+  auto valid = collette::validate_mesh(std::move(mesh));
+  if (!valid) return valid.error();
+  std::string obj = "# an inline mesh sent to uh serve (add_object with mesh_binary), welded and checked\n";
+  for (const Vec3& v : valid->vertices) obj += fmt::format("v {} {} {}\n", v.x, v.y, v.z);
+  for (const auto& t : valid->triangles) obj += fmt::format("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+  const std::uint64_t hash = collette::ist_hash_bytes(std::as_bytes(std::span<const char>(obj)));
+  const auto path = mesh_dir / fmt::format("{:016x}.obj", hash);
+  std::error_code ec;
+  std::filesystem::create_directories(mesh_dir, ec);
+  if (ec) return Error{fmt::format("{}: cannot create the folder: {}", mesh_dir.string(), ec.message())};
+  // named by its content: a file already there holds this very mesh
+  if (!std::filesystem::exists(path, ec))
+    if (auto written = write_file_atomically(path, obj); !written) return written.error();
+  object["mesh"] = path.string();
+  if (auto added = add_object(std::move(object), mesh_dir); !added) return added.error();
+  return valid->report;
 }
 
 Status SceneDocument::remove_object(const std::string& name) {

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "uh/collette/triangle_mesh.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/result.hpp"
 
@@ -27,6 +28,12 @@ class SceneDocument {
   /// Paths given in edits (`mesh`, `ist`, a device's `file`) are relative to `dir` (the service's
   /// working directory), not to the scene file.
   Status add_object(nlohmann::json object, const std::filesystem::path& dir);
+  /// An object whose mesh came inline (a decoded `mesh_binary` frame, in mesh units): welded,
+  /// repaired and checked as a mesh file is (a mesh that is not closed is refused with the counts),
+  /// written as OBJ into `mesh_dir` under a name made of its content (so the packing cache finds
+  /// the same mesh again) and added with that file as its `mesh`. Returns what validation found.
+  Result<collette::MeshReport> add_inline_object(nlohmann::json object, collette::TriangleMesh mesh,
+                                                 const std::filesystem::path& mesh_dir);
   Status remove_object(const std::string& name);
   Status set_pose(const std::string& name, const nlohmann::json& pose);
   Status set_watch(const std::vector<std::string>& names);

@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <span>
 #include <thread>
 
 #include <fmt/format.h>
@@ -83,13 +84,16 @@ class Connection final : public Peer, public std::enable_shared_from_this<Connec
     asio::co_spawn(ws_.get_executor(), write_loop(), report_exception);
     beast::flat_buffer buffer;
     for (;;) {
+      // larger only for the binary frame an add_object announced
+      ws_.read_message_max(hub_.message_limit(id_));
       co_await ws_.async_read(buffer, asio::redirect_error(asio::use_awaitable, ec));
       // a message above read_message_max fails here after Beast sent close 1009 (too big)
       if (ec) break;
       if (ws_.got_text())
         hub_.receive(id_, std::string_view(static_cast<const char*>(buffer.data().data()), buffer.size()));
       else
-        hub_.receive_binary(id_);
+        hub_.receive_binary(id_,
+                            std::span(static_cast<const std::byte*>(buffer.data().data()), buffer.size()));
       buffer.consume(buffer.size());
     }
     finished_ = true;

@@ -5,8 +5,15 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "mesh_binary.hpp"
 #include "scene_document.hpp"
 #include "service_test_support.hpp"
+#include "uh/collette/mesh_import.hpp"
 
 namespace uh::service {
 namespace {
@@ -189,6 +196,134 @@ TEST_F(SceneDocumentTest, MeshesAreInMetresInTheObjectFrame) {
   const json description = describe_scene(doc_->scene());
   EXPECT_EQ(description["objects"][0]["name"], "bunny");
   EXPECT_EQ(description["tool"]["device"], "sim-line");
+}
+
+TEST(Protocol, AddObjectAnnouncesAnInlineMesh) {
+  const ParsedRequest ok = parse(
+      R"({"type":"add_object","id":3,"object":{"name":"b"},"mesh_binary":{"vertices":5,"triangles":6}})");
+  ASSERT_TRUE(ok.body) << ok.error;
+  EXPECT_TRUE(ok.announces_binary);
+  const auto& counts = *std::get<AddObject>(*ok.body).mesh_binary;
+  EXPECT_EQ(counts.vertices, 5);
+  EXPECT_EQ(counts.bytes(), 12u * 11u);
+  EXPECT_FALSE(parse(R"({"type":"add_object","object":{"name":"b","mesh":"b.obj"}})").announces_binary);
+
+  struct Case {
+    const char* text;
+    const char* part;
+  };
+  const Case cases[] = {
+      {R"({"type":"add_object","object":{"name":"b"},"mesh_binary":[5,6]})",
+       "field 'mesh_binary': expected an object"},
+      {R"({"type":"add_object","object":{"name":"b"},"mesh_binary":{"vertices":5}})",
+       "'mesh_binary.triangles' is missing"},
+      {R"({"type":"add_object","object":{"name":"b"},"mesh_binary":{"vertices":5.5,"triangles":6}})",
+       "'mesh_binary.vertices': expected a whole number, got number"},
+      {R"({"type":"add_object","object":{"name":"b"},"mesh_binary":{"vertices":3,"triangles":6}})",
+       "'mesh_binary.vertices': expected a whole number in [4, "},
+      {R"({"type":"add_object","object":{"name":"b"},"mesh_binary":{"vertices":5,"triangles":6,"normals":1}})",
+       "unknown field 'mesh_binary.normals'"},
+      {R"({"type":"add_object","object":{"name":"b"},"mesh_binary":{"vertices":4000000,"triangles":4000000}})",
+       "above the limit of 67108864 bytes"},
+      {R"({"type":"add_object","object":{"name":"b","mesh":"b.obj"},"mesh_binary":{"vertices":5,"triangles":6}})",
+       "field 'object.mesh': not allowed with 'mesh_binary'"},
+  };
+  for (const Case& c : cases) {
+    const ParsedRequest r = parse(c.text);
+    EXPECT_FALSE(r.body) << c.text;
+    EXPECT_TRUE(r.announces_binary) << "a refused announcement still owns its frame: " << c.text;
+    EXPECT_NE(r.error.find(c.part), std::string::npos) << c.text << " -> " << r.error;
+  }
+}
+
+// The frame written by hand, byte by byte, as a client on a little-endian machine sends it
+// (memcpy of float and uint32): the reference for the decoder's and encoder's byte shuffling.
+std::string frame_by_hand(const std::vector<float>& coordinates, const std::vector<std::uint32_t>& indices) {
+  static_assert(std::endian::native == std::endian::little, "the reference assumes a little-endian host");
+  std::string out(4 * (coordinates.size() + indices.size()), '\0');
+  std::memcpy(out.data(), coordinates.data(), 4 * coordinates.size());
+  std::memcpy(out.data() + 4 * coordinates.size(), indices.data(), 4 * indices.size());
+  return out;
+}
+
+std::span<const std::byte> bytes_of(const std::string& s) {
+  return std::as_bytes(std::span(s.data(), s.size()));
+}
+
+const std::vector<float> kTetrahedron = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1.5f};
+const std::vector<std::uint32_t> kTetrahedronFaces = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+
+TEST(MeshBinary, DecodesTheFrameAsSentAndEncodesItBack) {
+  const std::string frame = frame_by_hand(kTetrahedron, kTetrahedronFaces);
+  auto mesh = decode_mesh_binary(bytes_of(frame), MeshBinary{4, 4}, "add_object 't'");
+  ASSERT_TRUE(mesh.has_value()) << mesh.error().message;
+  ASSERT_EQ(mesh->vertices.size(), 4u);
+  EXPECT_EQ(mesh->vertices[3].z, 1.5);
+  EXPECT_EQ(mesh->triangles[3], (std::array<std::int32_t, 3>{1, 2, 3}));
+  EXPECT_EQ(mesh->source_name, "add_object 't' (mesh_binary)");
+  EXPECT_EQ(encode_mesh_binary(*mesh), frame);
+}
+
+TEST(MeshBinary, RefusesFramesThatDoNotMatchTheirAnnouncement) {
+  const auto fails_with = [](const std::string& frame, MeshBinary counts, const std::string& part) {
+    auto mesh = decode_mesh_binary(bytes_of(frame), counts, "add_object 't'");
+    ASSERT_FALSE(mesh.has_value()) << part;
+    EXPECT_NE(mesh.error().message.find(part), std::string::npos) << mesh.error().message;
+    EXPECT_EQ(mesh.error().message.rfind("add_object 't': ", 0), 0u) << "names the request";
+  };
+  const std::string good = frame_by_hand(kTetrahedron, kTetrahedronFaces);
+  fails_with(good.substr(0, good.size() - 1), {4, 4}, "the binary frame has 95 bytes");
+  fails_with(good + "xxxx", {4, 4}, "12 * (4 + 4) = 96 bytes");
+  fails_with(good, {5, 4}, "12 * (5 + 4) = 108 bytes");
+  auto nan = kTetrahedron;
+  nan[4] = std::numeric_limits<float>::quiet_NaN();
+  fails_with(frame_by_hand(nan, kTetrahedronFaces), {4, 4}, "vertex 1 is not finite");
+  auto inf = kTetrahedron;
+  inf[11] = -std::numeric_limits<float>::infinity();
+  fails_with(frame_by_hand(inf, kTetrahedronFaces), {4, 4}, "vertex 3 is not finite");
+  auto far = kTetrahedronFaces;
+  far[7] = 4;
+  fails_with(frame_by_hand(kTetrahedron, far), {4, 4},
+             "triangle 2 uses vertex 4, but there are only 4 vertices");
+  far[7] = 0xffffffffu;  // not read as -1
+  fails_with(frame_by_hand(kTetrahedron, far), {4, 4}, "uses vertex 4294967295");
+}
+
+TEST_F(SceneDocumentTest, AnInlineMeshIsCheckedLikeAFileAndStoredByContent) {
+  auto bunny = collette::load_mesh(testing::assets() / "meshes" / "bunny_npm_3674.obj");
+  ASSERT_TRUE(bunny.has_value()) << bunny.error().message;
+  const json object = {{"name", "inline"}, {"spheres", 200}, {"meters_per_unit", 0.01}};
+  const auto mesh_dir = dir_ / "inline-meshes";
+  // sent with the opposite winding, as an engine with clockwise front faces would: fixed as for files
+  collette::TriangleMesh flipped = *bunny;
+  for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+  auto report = doc_->add_inline_object(object, flipped, mesh_dir);
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  EXPECT_TRUE(report->winding_flipped);
+  EXPECT_EQ(report->vertex_count, static_cast<std::int64_t>(bunny->vertices.size()));
+  const std::filesystem::path stored_path = doc_->scene().objects.back().shape.mesh;
+  EXPECT_EQ(stored_path.parent_path(), mesh_dir);
+  // the stored file reads back as the same closed mesh
+  auto stored = collette::load_mesh(stored_path);
+  ASSERT_TRUE(stored.has_value()) << stored.error().message;
+  EXPECT_EQ(stored->triangles.size(), bunny->triangles.size());
+  EXPECT_NEAR(stored->report.volume, bunny->report.volume, 1e-9 * bunny->report.volume);
+  // the same mesh again is the same file (the packing cache is keyed by the file's content)
+  ASSERT_TRUE(doc_->add_inline_object({{"name", "again"}, {"spheres", 200}}, flipped, mesh_dir));
+  EXPECT_EQ(doc_->scene().objects.back().shape.mesh, stored_path);
+
+  // an open mesh is refused naming the request, as a file is naming the file
+  collette::TriangleMesh open = *bunny;
+  open.source_name = "add_object 'open' (mesh_binary)";
+  open.triangles.pop_back();
+  auto refused = doc_->add_inline_object({{"name", "open"}}, open, mesh_dir);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("add_object 'open' (mesh_binary): mesh is not closed"),
+            std::string::npos)
+      << refused.error().message;
+  // a refused object (its name is taken) changes nothing
+  EXPECT_FALSE(doc_->add_inline_object({{"name", "bunny"}}, *bunny, mesh_dir).has_value());
+  EXPECT_EQ(doc_->scene().objects.size(), 3u);
 }
 
 TEST(SceneDocument, MissingSceneFileIsNamed) {

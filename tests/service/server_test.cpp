@@ -18,8 +18,10 @@
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
 
+#include "mesh_binary.hpp"
 #include "protocol.hpp"
 #include "service_test_support.hpp"
+#include "uh/collette/mesh_import.hpp"
 
 namespace uh::service {
 namespace {
@@ -198,7 +200,8 @@ TEST_F(ServerTest, BadRequestsGetErrorsAndTheConnectionStaysUsable) {
     EXPECT_NE(e["message"].get<std::string>().find(k.expected), std::string::npos) << k.text << " -> " << e;
   }
   c.send_binary(std::string("\x00\x01\x02", 3));
-  EXPECT_NE(c.expect("error")["message"].get<std::string>().find("binary frames"), std::string::npos);
+  EXPECT_NE(c.expect("error")["message"].get<std::string>().find("none did, so this frame was dropped"),
+            std::string::npos);
   c.request({{"type", "ping"}}, "pong");
 }
 
@@ -378,6 +381,113 @@ TEST_F(ServerTest, EditsTheSceneBeforeStartAndRefusesEditsWhileRunning) {
   const json stopped = c.expect("stopped");
   EXPECT_EQ(stopped["reason"], "the session's seconds elapsed");
   EXPECT_GT(stopped["report"]["haptic"]["ticks"].get<std::uint64_t>(), 0u);
+}
+
+TEST_F(ServerTest, AnInlineMeshInABinaryFrameBecomesAnObjectThatTheSessionFeels) {
+  auto bunny = collette::load_mesh(testing::assets() / "meshes" / "bunny_npm_3674.obj");
+  ASSERT_TRUE(bunny.has_value()) << bunny.error().message;
+  const std::string frame = encode_mesh_binary(*bunny);
+  const json counts = {{"vertices", bunny->vertices.size()}, {"triangles", bunny->triangles.size()}};
+  Client c(port());
+  c.hello();
+  // the scene's own bunny is replaced by the same mesh sent inline, where the tool goes
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  const auto add = [&](const std::string& name, const json& mesh_binary) {
+    return json{{"type", "add_object"},
+                {"id", name},
+                {"object",
+                 {{"name", name},
+                  {"spheres", 400},
+                  {"meters_per_unit", 0.01},
+                  {"pose", {{"rotation", {0.70710678, 0.70710678, 0, 0}}}}}},
+                {"mesh_binary", mesh_binary}};
+  };
+  c.send(add("inline", counts));
+  c.send_binary(frame);
+  const json added = c.expect("object_added");
+  EXPECT_EQ(added["id"], "inline");
+  EXPECT_EQ(added["name"], "inline");
+  EXPECT_EQ(added["mesh"]["vertices"], bunny->vertices.size());
+  EXPECT_EQ(added["mesh"]["triangles"], bunny->triangles.size());
+  c.request({{"type", "remove_object"}, {"name", "bunny"}}, "object_removed");
+  const json mesh = c.request({{"type", "get_mesh"}, {"object", "inline"}}, "mesh");
+  EXPECT_EQ(mesh["triangles"].size(), 3 * bunny->triangles.size());
+  EXPECT_NEAR(mesh["vertices"][0].get<double>(), 0.01 * bunny->vertices[0].x, 1e-8)
+      << "float32 in mesh units";
+
+  // every bad frame is an error naming the request, and nothing is added
+  std::string wrong_size = frame;
+  wrong_size.pop_back();
+  c.send(add("short", counts));
+  c.send_binary(wrong_size);
+  json e = c.expect("error");
+  EXPECT_EQ(e["id"], "short");
+  EXPECT_NE(e["message"].get<std::string>().find("add_object 'short': the binary frame has"),
+            std::string::npos)
+      << e;
+  std::string bad_index = frame;
+  bad_index.replace(bad_index.size() - 4, 4, std::string("\xff\xff\x00\x00", 4));
+  c.send(add("far", counts));
+  c.send_binary(bad_index);
+  e = c.expect("error");
+  EXPECT_NE(e["message"].get<std::string>().find("uses vertex 65535, but there are only"), std::string::npos)
+      << e;
+  // a mesh that is not closed: the closed-mesh rule of mesh files
+  json open_counts = counts;
+  open_counts["triangles"] = bunny->triangles.size() - 1;
+  c.send(add("open", open_counts));
+  c.send_binary(frame.substr(0, frame.size() - 12));
+  e = c.expect("error");
+  EXPECT_NE(e["message"].get<std::string>().find("add_object 'open' (mesh_binary): mesh is not closed"),
+            std::string::npos)
+      << e;
+  // the announced frame must come next: a text message instead fails the add, then is answered
+  c.send(add("late", counts));
+  c.send({{"type", "ping"}, {"id", "p"}});
+  e = c.expect("error");
+  EXPECT_EQ(e["id"], "late");
+  EXPECT_NE(e["message"].get<std::string>().find("must be the next message"), std::string::npos) << e;
+  EXPECT_EQ(c.expect("pong")["id"], "p");
+  // a refused announcement owns its frame too: one error, and the frame is not taken for another
+  c.send(add("inline", {{"vertices", 2}, {"triangles", 4}}));
+  c.send_binary(frame);
+  e = c.expect("error");
+  EXPECT_NE(e["message"].get<std::string>().find("mesh_binary.vertices"), std::string::npos) << e;
+  const json scene = c.request({{"type", "get_scene"}}, "scene")["scene"];
+  ASSERT_EQ(scene["objects"].size(), 1u) << scene;
+  EXPECT_EQ(scene["objects"][0]["name"], "inline");
+
+  // the session feels the inline bunny; while it runs, set_pose moves it
+  c.request({{"type", "subscribe"}, {"rate_hz", 50}}, "subscribed");
+  c.request({{"type", "start"}}, "started");
+  const json contact = c.expect("contact");
+  EXPECT_EQ(contact["object"], "inline");
+  c.request({{"type", "set_pose"}, {"object", "inline"}, {"pose", {{"position", {0.5, 0, 0}}}}}, "pose_set");
+  const json refused = c.request({{"type", "remove_object"}, {"name", "inline"}}, "error");
+  EXPECT_NE(refused["message"].get<std::string>().find("stop it before editing"), std::string::npos);
+  const json stopped = c.request({{"type", "stop"}}, "stopped");
+  EXPECT_GT(stopped["report"]["force"]["max_n"].get<double>(), 0.0) << stopped["report"]["force"];
+  const json moved = c.request({{"type", "get_scene"}}, "scene")["scene"];
+  EXPECT_EQ(moved["objects"][0]["pose"]["position"][0], 0.5);
+}
+
+TEST_F(ServerTest, AnAnnouncedFrameLargerThanTheTextLimitIsRead) {
+  // 100,000 vertices and triangles: 2.4 MB, above the 1 MiB of text messages; a grid of that size
+  // is not closed, so the reply is the closed-mesh error, which shows the frame was read whole
+  collette::TriangleMesh grid;
+  for (int i = 0; i < 100000; ++i) grid.vertices.push_back(Vec3{double(i % 300), double(i / 300), 0.0});
+  for (int t = 0; t < 100000; ++t) grid.triangles.push_back({t % 99000, t % 99000 + 1, t % 99000 + 300});
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  c.send({{"type", "add_object"},
+          {"object", {{"name", "grid"}}},
+          {"mesh_binary", {{"vertices", 100000}, {"triangles", 100000}}}});
+  c.send_binary(encode_mesh_binary(grid));
+  const json e = c.expect("error");
+  EXPECT_NE(e["message"].get<std::string>().find("add_object 'grid' (mesh_binary)"), std::string::npos) << e;
+  EXPECT_EQ(e["message"].get<std::string>().find("binary frame has"), std::string::npos) << e;
+  c.request({{"type", "ping"}}, "pong");
 }
 
 TEST_F(ServerTest, AStartThatCannotBuildTheSessionIsAnError) {
