@@ -323,8 +323,11 @@ void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<contro
     stop_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
       if (ec || !slot_ || generation != generation_ || slot_->phase != Phase::kRunning) return;
       Status status{Ok{}};
-      json report = stop_session(&status);
-      json fields = {{"report", std::move(report)}, {"reason", "the session's seconds elapsed"}};
+      json state;
+      json report = stop_session(&status, &state);
+      json fields = {{"report", std::move(report)},
+                     {"state", std::move(state)},
+                     {"reason", "the session's seconds elapsed"}};
       if (!status) fields["error"] = status.error().message;
       send_to(slot_->controller, reply("stopped", nullptr, std::move(fields)));
       broadcast_session("stopped");
@@ -332,7 +335,7 @@ void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<contro
   }
 }
 
-json Hub::stop_session(Status* status_out) {
+json Hub::stop_session(Status* status_out, json* state_out) {
   if (!slot_ || slot_->phase != Phase::kRunning) return nullptr;
   if (slot_->hosted) {
     // the program's own session stops on its owner's thread: ask it to (it ends within 20 ms)
@@ -344,6 +347,8 @@ json Hub::stop_session(Status* status_out) {
   Status status = slot_->session->stop();
   poll_events();  // the events up to the stop
   event_timer_.cancel();
+  // after the stop: the zero force the device was sent last
+  if (state_out != nullptr) *state_out = state_json(slot_->session->state());
   json report = json::parse(controllers::session_report_json(slot_->session->report()));
   slot_->phase = Phase::kOpen;
   slot_->session = nullptr;
@@ -361,9 +366,12 @@ std::string Hub::on_stop(ClientId id, const json& req_id) {
     ++generation_;
     slot_->phase = Phase::kOpen;
     fields["report"] = nullptr;
+    fields["state"] = nullptr;
   } else {
     Status status{Ok{}};
-    fields["report"] = stop_session(&status);
+    json state;
+    fields["report"] = stop_session(&status, &state);
+    fields["state"] = std::move(state);
     if (!status) fields["error"] = status.error().message;
   }
   send_to(id, reply("stopped", req_id, std::move(fields)));
@@ -480,14 +488,19 @@ std::string Hub::on_edit(ClientId id, const json& req_id, const std::string& typ
   } else if (const auto* d = std::get_if<SetDevice>(&body)) {
     done = doc.set_device(d->device, options_.working_dir);
     fields["driver"] = doc.scene().tool.device.driver;
+  } else if (const auto* t = std::get_if<SetTool>(&body)) {
+    done = doc.set_tool(t->tool, options_.working_dir);
+    fields["name"] = doc.scene().tool.name;
+  } else if (const auto* rates = std::get_if<SetRates>(&body)) {
+    done = doc.set_rates(rates->haptic_hz, rates->collision_hz);
+    fields["haptic_hz"] = doc.scene().haptic_hz;
+    fields["collision_hz"] = doc.scene().collision_hz;
   }
   if (!done) return done.error().message;
   static const std::map<std::string, std::string, std::less<>> kReplies = {
-      {"add_object", "object_added"},
-      {"remove_object", "object_removed"},
-      {"set_pose", "pose_set"},
-      {"set_watch", "watch_set"},
-      {"set_device", "device_set"}};
+      {"add_object", "object_added"}, {"remove_object", "object_removed"}, {"set_pose", "pose_set"},
+      {"set_watch", "watch_set"},     {"set_device", "device_set"},        {"set_tool", "tool_set"},
+      {"set_rates", "rates_set"}};
   send_to(id, reply(kReplies.at(type), req_id, std::move(fields)));
   broadcast_session("edited");
   return {};

@@ -116,8 +116,9 @@ class Hub {
   std::string check_control(ClientId id, bool needs_open) const;
   void build_finished(std::uint64_t generation, Result<std::unique_ptr<controllers::HapticSession>> built,
                       std::optional<double> seconds);
-  // stops a running session; the report's JSON (or null when nothing ran)
-  json stop_session(Status* status_out = nullptr);
+  // stops a running session; the report's JSON (or null when nothing ran); `state_out` gets the
+  // state after the stop (with the zero force sent)
+  json stop_session(Status* status_out = nullptr, json* state_out = nullptr);
   void close_slot();
   void broadcast_session(std::string_view status);
   void send_state(ClientId id);

@@ -218,11 +218,28 @@ std::string parse_body(const std::string& type, const Fields& f, std::optional<R
     SetDevice s;
     if (e = f.object("device", s.device); !e.empty()) return e;
     body = s;
+  } else if (type == "set_tool") {
+    if (e = f.check_known({"tool"}); !e.empty()) return e;
+    SetTool s;
+    if (e = f.object("tool", s.tool); !e.empty()) return e;
+    body = s;
+  } else if (type == "set_rates") {
+    if (e = f.check_known({"haptic_hz", "collision_hz"}); !e.empty()) return e;
+    SetRates s;
+    // the scene parser checks the ranges and names the scene field
+    double hz = -1.0;
+    if (e = f.number("haptic_hz", hz, 0.0, 1e9); !e.empty()) return e;
+    if (hz >= 0.0) s.haptic_hz = hz;
+    hz = -1.0;
+    if (e = f.number("collision_hz", hz, 0.0, 1e9); !e.empty()) return e;
+    if (hz >= 0.0) s.collision_hz = hz;
+    if (!s.haptic_hz && !s.collision_hz) return "set_rates needs 'haptic_hz' or 'collision_hz'";
+    body = s;
   } else {
     return fmt::format(
         "unknown message type '{}' (known: hello, open, start, stop, ping, close, subscribe, unsubscribe, "
-        "get_scene, "
-        "get_mesh, add_object, remove_object, set_pose, set_watch, set_device)",
+        "get_scene, get_mesh, add_object, remove_object, set_pose, set_watch, set_device, set_tool, "
+        "set_rates)",
         type);
   }
   return {};

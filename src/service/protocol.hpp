@@ -76,9 +76,17 @@ struct SetWatch {
 struct SetDevice {
   json device;  ///< as a scene file's `tool.device` (checked by the scene parser)
 };
+struct SetTool {
+  json tool;  ///< a JSON merge patch (RFC 7386) of the scene file's `tool` (checked by the scene parser)
+};
+struct SetRates {
+  std::optional<double> haptic_hz;     ///< [Hz]; none: unchanged
+  std::optional<double> collision_hz;  ///< [Hz], 0 = free-running; none: unchanged
+};
 
-using RequestBody = std::variant<Hello, Open, Start, Stop, Ping, Close, Subscribe, Unsubscribe, GetScene,
-                                 GetMesh, AddObject, RemoveObject, SetPose, SetWatch, SetDevice>;
+using RequestBody =
+    std::variant<Hello, Open, Start, Stop, Ping, Close, Subscribe, Unsubscribe, GetScene, GetMesh, AddObject,
+                 RemoveObject, SetPose, SetWatch, SetDevice, SetTool, SetRates>;
 
 /// One parsed message: the request, or what is wrong with it. `id` and `type` are kept whenever
 /// they could be read, so that an error reply can echo them.

@@ -140,6 +140,24 @@ Status SceneDocument::set_device(json device, const std::filesystem::path& dir) 
   return apply(std::move(candidate));
 }
 
+Status SceneDocument::set_tool(json patch, const std::filesystem::path& dir) {
+  absolutise(patch, "mesh", dir);
+  absolutise(patch, "ist", dir);
+  if (const auto device = patch.find("device"); device != patch.end() && device->is_object())
+    if (const auto config = device->find("config"); config != device->end() && config->is_object())
+      absolutise(*config, "file", dir);
+  json candidate = doc_;
+  candidate["tool"].merge_patch(patch);
+  return apply(std::move(candidate));
+}
+
+Status SceneDocument::set_rates(std::optional<double> haptic_hz, std::optional<double> collision_hz) {
+  json candidate = doc_;
+  if (haptic_hz) candidate["rates"]["haptic_hz"] = *haptic_hz;
+  if (collision_hz) candidate["rates"]["collision_hz"] = *collision_hz;
+  return apply(std::move(candidate));
+}
+
 json describe_scene(const controllers::Scene& scene) {
   json objects = json::array();
   for (const auto& o : scene.objects) {

@@ -5,6 +5,7 @@
 // leaves the document as it was.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,11 @@ class SceneDocument {
   Status set_pose(const std::string& name, const nlohmann::json& pose);
   Status set_watch(const std::vector<std::string>& names);
   Status set_device(nlohmann::json device, const std::filesystem::path& dir);
+  /// Applies `patch` to the scene's `tool` as a JSON merge patch (RFC 7386: given fields replace,
+  /// null removes, objects merge), e.g. {"force": {"damping": 3}} or {"mesh": "t.obj", "ist": null}.
+  Status set_tool(nlohmann::json patch, const std::filesystem::path& dir);
+  /// The scene's `rates`; a rate not given stays as it is.
+  Status set_rates(std::optional<double> haptic_hz, std::optional<double> collision_hz);
 
  private:
   SceneDocument() = default;

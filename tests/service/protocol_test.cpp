@@ -38,6 +38,8 @@ TEST(Protocol, ParsesEveryRequestType) {
       R"({"type":"set_pose","object":"b","pose":{}})",
       R"({"type":"set_watch","objects":["b"]})",
       R"({"type":"set_device","device":{"driver":"sim-line"}})",
+      R"({"type":"set_tool","tool":{"force":{"damping":3}}})",
+      R"({"type":"set_rates","haptic_hz":2000})",
   };
   for (const char* m : messages) {
     const ParsedRequest r = parse(m);
@@ -74,6 +76,8 @@ TEST(Protocol, ErrorsNameWhatIsWrong) {
       {R"({"protocol":1})", "field 'type' is missing"},
       {R"({"type":5})", "field 'type': expected a string, got number"},
       {R"({"type":"helo","protocol":1})", "unknown message type 'helo'"},
+      {R"({"type":"set_rates"})", "needs 'haptic_hz' or 'collision_hz'"},
+      {R"({"type":"set_tool","tool":"stylus"})", "field 'tool': expected an object, got string"},
       {R"({"type":"hello"})", "field 'protocol' is missing"},
       {R"({"type":"hello","protocol":"1"})", "field 'protocol': expected a whole number, got string"},
       {R"({"type":"open","scene":3})", "field 'scene': expected a non-empty string, got number"},
@@ -158,6 +162,25 @@ TEST_F(SceneDocumentTest, EditsGoThroughTheSceneParser) {
 
   ASSERT_TRUE(doc_->set_device({{"driver", "sim-circle"}, {"config", {{"radius", 0.03}}}}, assets));
   EXPECT_EQ(doc_->scene().tool.device.driver, "sim-circle");
+
+  // set_tool merges: the damping changes, the stiffness and the device stay
+  const double stiffness = doc_->scene().tool.force.force_scale;
+  ASSERT_TRUE(doc_->set_tool({{"force", {{"damping", 3.5}}}}, assets));
+  EXPECT_EQ(doc_->scene().tool.force.damping, 3.5);
+  EXPECT_EQ(doc_->scene().tool.force.force_scale, stiffness);
+  EXPECT_EQ(doc_->scene().tool.device.driver, "sim-circle");
+  ASSERT_TRUE(doc_->set_tool({{"mesh", "meshes/stylus.obj"}, {"spheres", 50}}, assets));
+  EXPECT_EQ(doc_->scene().tool.shape.mesh, assets / "meshes" / "stylus.obj");
+  EXPECT_FALSE(doc_->set_tool({{"force", {{"damping", "much"}}}}, assets).has_value());
+  EXPECT_EQ(doc_->scene().tool.force.damping, 3.5) << "a refused patch changes nothing";
+
+  ASSERT_TRUE(doc_->set_rates(2000.0, std::nullopt));
+  EXPECT_EQ(doc_->scene().haptic_hz, 2000.0);
+  EXPECT_EQ(doc_->scene().collision_hz, 500.0) << "the rate not given stays";
+  const Status too_fast = doc_->set_rates(std::nullopt, -3.0);
+  ASSERT_FALSE(too_fast.has_value());
+  EXPECT_NE(too_fast.error().message.find("rates.collision_hz"), std::string::npos)
+      << too_fast.error().message;
 }
 
 TEST_F(SceneDocumentTest, RefusedEditsLeaveTheSceneAsItWas) {

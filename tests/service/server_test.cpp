@@ -363,6 +363,11 @@ TEST_F(ServerTest, EditsTheSceneBeforeStartAndRefusesEditsWhileRunning) {
   EXPECT_EQ(added["name"], "b2");
   c.request({{"type", "set_pose"}, {"object", "b2"}, {"pose", {{"position", {0.4, 0, 0}}}}}, "pose_set");
   c.request({{"type", "set_watch"}, {"objects", {"bunny"}}}, "watch_set");
+  const json tool = c.request({{"type", "set_tool"}, {"tool", {{"force", {{"damping", 1.5}}}}}}, "tool_set");
+  EXPECT_EQ(tool["name"], "stylus");
+  const json rates = c.request({{"type", "set_rates"}, {"collision_hz", 250}}, "rates_set");
+  EXPECT_EQ(rates["collision_hz"], 250.0);
+  EXPECT_EQ(rates["haptic_hz"], 1000.0);
   const json bad_device = c.request({{"type", "set_device"}, {"device", {{"driver", 7}}}}, "error");
   EXPECT_NE(bad_device["message"].get<std::string>().find("tool.device.driver"), std::string::npos)
       << bad_device;
@@ -467,6 +472,8 @@ TEST_F(ServerTest, AnInlineMeshInABinaryFrameBecomesAnObjectThatTheSessionFeels)
   EXPECT_NE(refused["message"].get<std::string>().find("stop it before editing"), std::string::npos);
   const json stopped = c.request({{"type", "stop"}}, "stopped");
   EXPECT_GT(stopped["report"]["force"]["max_n"].get<double>(), 0.0) << stopped["report"]["force"];
+  EXPECT_EQ(stopped["state"]["force"], json::array({0.0, 0.0, 0.0})) << "zero force after the stop";
+  EXPECT_GT(stopped["state"]["haptic"]["ticks"].get<std::uint64_t>(), 0u);
   const json moved = c.request({{"type", "get_scene"}}, "scene")["scene"];
   EXPECT_EQ(moved["objects"][0]["pose"]["position"][0], 0.5);
 }
