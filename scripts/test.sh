@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite, five builds in separate directories:
 #   1. Release: every test (unit, integration, the C API, the installed-package consumer, the live
-#      view in Chromium), then the Python module's pytest suite with Debian's /usr/bin/python3;
+#      view in Chromium), then the Python module's pytest suite with Debian's /usr/bin/python3, the
+#      Godot addon's headless tests (godot3-server against uh serve) and the Unity package's
+#      console tests (UnrealHaptics.dll under mono against libuh);
 #   2. AddressSanitizer + UndefinedBehaviorSanitizer: every test (the live view's browser test once,
 #      in the Release stage, is enough);
 #   3. ThreadSanitizer: the tests labelled "threads" (cross-thread primitives, loops, sessions);
@@ -56,10 +58,31 @@ run_pytest() {
   [ $((${f:-0} + ${e:-0})) -eq 0 ] || status=1
 }
 
+# An engine's own test runner, which ends with "N passed, N failed" (Godot's and the C# tests').
+run_counted() {
+  local name=$1 log=$2; shift 2
+  echo "== $name =="
+  "$@" 2>&1 | tee "$log"
+  local line
+  line=$(grep -E "^[0-9]+ passed, [0-9]+ failed$" "$log" | tail -n 1)
+  if [ -z "$line" ]; then echo "test: no summary from $name"; status=1; failed=$((failed + 1)); return; fi
+  local p f
+  p=$(sed -E 's/^([0-9]+) passed.*/\1/' <<<"$line")
+  f=$(sed -E 's/.*passed, ([0-9]+) failed$/\1/' <<<"$line")
+  passed=$((passed + p))
+  failed=$((failed + f))
+  [ "$f" -eq 0 ] || status=1
+}
+
 echo "== build (Release) =="
 if uh_build build/release -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=ON -DUH_BUILD_BENCHMARKS=ON; then
   run_ctest release build/release
   run_pytest
+  run_counted "Godot addon (godot3-server, headless)" "$uh_root/build/release/godot-test.log" \
+    bash "$uh_root/scripts/godot-test.sh" "$uh_root/build/release"
+  run_counted "Unity package (C# under mono)" "$uh_root/build/release/unity-test.log" \
+    env UH_SOURCE_DIR="$uh_root" UH_CACHE_DIR="$uh_root/build/release/test-cache" \
+    timeout -k 5 300 mono "$uh_root/build/release/unity/UnrealHaptics.Tests.exe"
 else
   echo "test: Release build failed"; status=1; failed=$((failed + 1))
 fi

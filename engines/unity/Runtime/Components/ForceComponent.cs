@@ -1,0 +1,33 @@
+// ForceComponent (the paper's ForceComponent) for Unity: the tool's mesh, force law, limits and
+// device as inspector fields; the HapticManager sets them as the scene's tool (Scene.SetTool).
+// Not compiled in this repository (it needs UnityEngine); ToolSettings, which it fills, is.
+using UnityEngine;
+
+namespace UnrealHaptics.Components
+{
+    public sealed class ForceComponent : MonoBehaviour
+    {
+        [Tooltip("The tool's mesh (.obj, .stl, ...) or .ist file")] public string toolMeshPath = "";
+        public double metersPerUnit = 1.0;
+        public long spheres = 10000;
+        public bool threeDof = false;
+        [Tooltip("Penalty stiffness eps_c [N/m^3]")] public double forceScale = 1.0e7;
+        [Tooltip("Damping eps_d [N s/m]")] public double damping = 2.0;
+        public double massKg = 0.05;
+        public double maxForceN = 8.0;
+        public double maxTorqueNm = 0.3;
+        public string deviceDriver = "sim-raster";
+        [TextArea] public string deviceConfigJson = "";
+
+        public ToolSettings Settings()
+        {
+            return new ToolSettings
+            {
+                Name = name, MeshPath = toolMeshPath, MetersPerUnit = metersPerUnit, Spheres = spheres,
+                ThreeDof = threeDof, ForceScale = forceScale, Damping = damping, MassKg = massKg,
+                MaxForceN = maxForceN, MaxTorqueNm = maxTorqueNm, DeviceDriver = deviceDriver,
+                DeviceConfigJson = string.IsNullOrEmpty(deviceConfigJson) ? null : deviceConfigJson,
+            };
+        }
+    }
+}

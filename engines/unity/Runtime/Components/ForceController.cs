@@ -1,0 +1,24 @@
+// ForceController (the paper's ForceController) for Unity: reports the force sent to the device
+// each frame (ForceOnHapticTick, main thread); the force itself is computed by libuh on its haptic
+// thread. Not compiled in this repository (UnityEngine).
+using System;
+using UnityEngine;
+
+namespace UnrealHaptics.Components
+{
+    public sealed class ForceController : MonoBehaviour
+    {
+        public HapticManager hapticManager;
+        public ForceComponent forceComponent;
+        public event Action<Vector3> ForceOnHapticTick;
+
+        void Awake() { if (forceComponent != null) hapticManager.SetTool(forceComponent); }
+        void OnEnable() { hapticManager.MoveOnHapticTick += Forward; }
+        void OnDisable() { hapticManager.MoveOnHapticTick -= Forward; }
+
+        void Forward(Vector3 position, Quaternion rotation, Vector3 force)
+        {
+            if (ForceOnHapticTick != null) ForceOnHapticTick(force);
+        }
+    }
+}

@@ -1,0 +1,207 @@
+// UnrealHaptics.Scene: a scene built through calls before a session opens it (uh_scene_*): load a
+// scene file or the default scene, add objects from a mesh file, a .ist or vertex/index arrays (an
+// engine's own mesh), set poses, choose what is watched. Sessions copy the scene when they open.
+
+using System;
+using System.Runtime.InteropServices;
+
+namespace UnrealHaptics
+{
+    /// <summary>The tool of a scene: its shape, force law (ForceComp) and device (Haptico).</summary>
+    public sealed class ToolSettings
+    {
+        public string Name = "tool";
+        public string MeshPath;              // a closed mesh or a .ist file
+        public double MetersPerUnit = 1.0;
+        public long Spheres = 10000;
+        public bool ThreeDof = false;
+        public double ForceScale = 1.0e7;    // eps_c [N/m^3]
+        public double Damping = 2.0;         // eps_d [N s/m]
+        public double MassKg = 0.05;
+        public double MaxForceN = 8.0;
+        public double MaxTorqueNm = 0.3;
+        public string DeviceDriver = "sim-raster";  // sim-line, sim-circle, sim-raster, sim-replay, sim-hand
+        public string DeviceConfigJson;      // the driver's settings as a JSON object; null = {}
+    }
+
+    public sealed class Scene : IDisposable
+    {
+        IntPtr raw_;
+
+        Scene(IntPtr raw) { raw_ = raw; }
+
+        /// <summary>A scene file; null: the embedded default scene.</summary>
+        public static Scene Load(string scenePath = null)
+        {
+            IntPtr raw;
+            Native.Check(Native.uh_scene_load(Native.Utf8In(scenePath), out raw), "uh_scene_load");
+            return new Scene(raw);
+        }
+
+        internal IntPtr Raw
+        {
+            get
+            {
+                if (raw_ == IntPtr.Zero) throw new ObjectDisposedException("Scene");
+                return raw_;
+            }
+        }
+
+        /// <summary>Adds a closed mesh given as arrays: `vertices` x, y, z per vertex (mesh units),
+        /// `indices` three per triangle, counter-clockwise seen from outside (a mesh wound the
+        /// other way, e.g. Unity's clockwise front faces, is flipped when validated). Returns the
+        /// object's index.</summary>
+        public int AddMesh(string name, double[] vertices, int[] indices, double[] position, double[] orientation,
+                           long spheres = 10000, double metersPerUnit = 1.0, bool watch = true)
+        {
+            if (vertices == null || indices == null || vertices.Length % 3 != 0 || indices.Length % 3 != 0)
+                throw new ArgumentException("vertices and indices must hold whole triples");
+            var v = GCHandle.Alloc(vertices, GCHandleType.Pinned);
+            var i = GCHandle.Alloc(indices, GCHandleType.Pinned);
+            try
+            {
+                var shape = Shape(spheres, metersPerUnit);
+                shape.vertices = v.AddrOfPinnedObject();
+                shape.vertex_count = vertices.Length / 3;
+                shape.indices = i.AddrOfPinnedObject();
+                shape.triangle_count = indices.Length / 3;
+                return Add(name, shape, position, orientation, watch);
+            }
+            finally
+            {
+                v.Free();
+                i.Free();
+            }
+        }
+
+        /// <summary>Adds an object from a mesh file (packed on first use, cached) or a .ist file.</summary>
+        public int AddFile(string name, string path, double[] position, double[] orientation, long spheres = 10000,
+                           double metersPerUnit = 1.0, bool watch = true)
+        {
+            var bytes = Native.Utf8In(path);
+            var pin = GCHandle.Alloc(bytes, GCHandleType.Pinned);
+            try
+            {
+                var shape = Shape(spheres, metersPerUnit);
+                if (path.EndsWith(".ist", StringComparison.OrdinalIgnoreCase))
+                    shape.ist_path = pin.AddrOfPinnedObject();
+                else
+                    shape.mesh_path = pin.AddrOfPinnedObject();
+                return Add(name, shape, position, orientation, watch);
+            }
+            finally
+            {
+                pin.Free();
+            }
+        }
+
+        static Native.uh_shape_def Shape(long spheres, double metersPerUnit)
+        {
+            var shape = Native.uh_default_shape_def();
+            shape.spheres = spheres;
+            shape.meters_per_unit = metersPerUnit;
+            return shape;
+        }
+
+        int Add(string name, Native.uh_shape_def shape, double[] position, double[] orientation, bool watch)
+        {
+            var bytes = Native.Utf8In(name);
+            var pin = GCHandle.Alloc(bytes, GCHandleType.Pinned);
+            try
+            {
+                var def = new Native.uh_object_def();
+                def.struct_size = (uint)Marshal.SizeOf(typeof(Native.uh_object_def));
+                def.name = pin.AddrOfPinnedObject();
+                def.shape = shape;
+                def.position = position ?? new double[3];
+                def.orientation = orientation ?? new double[] { 1, 0, 0, 0 };
+                def.watch = watch ? 1 : 0;
+                int index;
+                Native.Check(Native.uh_scene_add_object(Raw, ref def, out index), "uh_scene_add_object");
+                return index;
+            }
+            finally
+            {
+                pin.Free();
+            }
+        }
+
+        /// <summary>Sets the tool (its mesh or .ist, force law, limits and device); see ToolSettings.</summary>
+        public void SetTool(ToolSettings t)
+        {
+            if (t == null || string.IsNullOrEmpty(t.MeshPath)) throw new ArgumentException("the tool needs a mesh or .ist file");
+            var pins = new System.Collections.Generic.List<GCHandle>();
+            Func<string, IntPtr> pin = text =>
+            {
+                if (text == null) return IntPtr.Zero;
+                var h = GCHandle.Alloc(Native.Utf8In(text), GCHandleType.Pinned);
+                pins.Add(h);
+                return h.AddrOfPinnedObject();
+            };
+            try
+            {
+                var def = Native.uh_default_tool_def();
+                def.name = pin(t.Name);
+                def.shape = Shape(t.Spheres, t.MetersPerUnit);
+                if (t.MeshPath.EndsWith(".ist", StringComparison.OrdinalIgnoreCase))
+                    def.shape.ist_path = pin(t.MeshPath);
+                else
+                    def.shape.mesh_path = pin(t.MeshPath);
+                def.mode = t.ThreeDof ? 1 : 0;
+                def.force_scale = t.ForceScale;
+                def.damping = t.Damping;
+                def.mass_kg = t.MassKg;
+                def.max_force_n = t.MaxForceN;
+                def.max_torque_nm = t.MaxTorqueNm;
+                def.device_driver = pin(t.DeviceDriver);
+                def.device_config_json = pin(t.DeviceConfigJson);
+                Native.Check(Native.uh_scene_set_tool(Raw, ref def), "uh_scene_set_tool");
+            }
+            finally
+            {
+                foreach (var h in pins) h.Free();
+            }
+        }
+
+        public void RemoveObject(string name)
+        {
+            Native.Check(Native.uh_scene_remove_object(Raw, Native.Utf8In(name)), "uh_scene_remove_object");
+        }
+
+        public void SetPose(string name, double[] position, double[] orientation)
+        {
+            Native.Check(Native.uh_scene_set_object_pose(Raw, Native.Utf8In(name), position, orientation),
+                "uh_scene_set_object_pose");
+        }
+
+        public void Watch(string name, bool watch)
+        {
+            Native.Check(Native.uh_scene_watch(Raw, Native.Utf8In(name), watch ? 1 : 0), "uh_scene_watch");
+        }
+
+        /// <summary>Haptic rate in [1, 10000] Hz; collision rate in [0, 10000] Hz (0 = free-running).</summary>
+        public void SetRates(double hapticHz, double collisionHz)
+        {
+            Native.Check(Native.uh_scene_set_rates(Raw, hapticHz, collisionHz), "uh_scene_set_rates");
+        }
+
+        public int ObjectCount
+        {
+            get
+            {
+                int n;
+                Native.Check(Native.uh_scene_object_count(Raw, out n), "uh_scene_object_count");
+                return n;
+            }
+        }
+
+        public void Dispose()
+        {
+            if (raw_ != IntPtr.Zero) Native.uh_scene_free(raw_);
+            raw_ = IntPtr.Zero;
+            GC.SuppressFinalize(this);
+        }
+
+        ~Scene() { if (raw_ != IntPtr.Zero) Native.uh_scene_free(raw_); }
+    }
+}
