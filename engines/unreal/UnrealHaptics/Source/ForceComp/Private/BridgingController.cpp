@@ -1,0 +1,20 @@
+#include "BridgingController.h"
+
+#include "HapticManager.h"
+
+void ABridgingController::BeginPlay()
+{
+	Super::BeginPlay();
+	if (HapticManager != nullptr)
+	{
+		HapticManager->OnMoveOnHapticTick.AddDynamic(this, &ABridgingController::Move);
+	}
+}
+
+void ABridgingController::Move(FVector ToolPosition, FRotator ToolOrientation)
+{
+	if (ToolActor != nullptr)
+	{
+		ToolActor->SetActorLocationAndRotation(ToolPosition, ToolOrientation);
+	}
+}

@@ -1,0 +1,20 @@
+#include "ForceComponent.h"
+
+#include "HapticManager.h"
+
+FUhToolSpec UForceComponent::ToolSpec() const
+{
+	FUhToolSpec Spec;
+	Spec.MeshPath = ToolMesh.FilePath.IsEmpty() ? FString() : FPaths::ConvertRelativePathToFull(ToolMesh.FilePath);
+	Spec.MetersPerUnit = MetersPerUnit;
+	Spec.Spheres = Spheres;
+	Spec.bThreeDof = bThreeDof;
+	Spec.ForceScale = ForceScale;
+	Spec.Damping = Damping;
+	Spec.MassKg = MassKg;
+	Spec.MaxForceN = MaxForceN;
+	Spec.MaxTorqueNm = MaxTorqueNm;
+	Spec.DeviceDriver = DeviceDriver;
+	Spec.DeviceConfigJson = DeviceConfigJson;
+	return Spec;
+}
