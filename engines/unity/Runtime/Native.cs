@@ -22,7 +22,7 @@ namespace UnrealHaptics
 
     public static class Native
     {
-        /// <summary>libuh: libuh.so (Linux), uh.dll / libuh.dll (Windows), libuh.dylib.</summary>
+        /// <summary>libuh: libuh.so (Linux), uh.dll (Windows, the mingw-w64 build), libuh.dylib.</summary>
         public const string Library = "uh";
         /// <summary>The UH_API_VERSION this binding was written for; checked at open.</summary>
         public const int ApiVersion = 1;

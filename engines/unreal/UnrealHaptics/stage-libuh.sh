@@ -2,7 +2,8 @@
 # Copies libuh and its header into the plugin's third-party module (Source/ThirdParty/UhLibrary).
 # usage: stage-libuh.sh [LINUX_BUILD_DIR] [WINDOWS_BUILD_DIR]
 #   LINUX_BUILD_DIR    default build/release (libuh.so from `cmake --build`)
-#   WINDOWS_BUILD_DIR  default build/windows (libuh.dll from the mingw-w64 build); skipped if absent
+#   WINDOWS_BUILD_DIR  default build/windows (uh.dll from the mingw-w64 build, scripts/test.sh's
+#                      Windows stage or cmake -DCMAKE_TOOLCHAIN_FILE=cmake/mingw-w64-x86_64.cmake); skipped if absent
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../../.." && pwd)
@@ -17,9 +18,9 @@ if [ -e "$linux/src/capi/libuh.so" ]; then
 else
   echo "no $linux/src/capi/libuh.so (build the Release tree first)"
 fi
-dll=$(find "$windows" -name 'libuh.dll' -o -name 'uh.dll' 2>/dev/null | head -n 1 || true)
-if [ -n "$dll" ]; then
-  cp "$dll" "$module/lib/Win64/libuh.dll"
+dll="$windows/src/capi/uh.dll"
+if [ -e "$dll" ]; then
+  cp "$dll" "$module/lib/Win64/uh.dll"
   echo "staged $dll"
 else
   echo "no Windows build in $windows (the mingw-w64 build); Win64 is not staged"

@@ -1,5 +1,5 @@
 // libuh's functions, resolved by name from the shared library staged by the UhLibrary module
-// (libuh.so / libuh.dll beside the binaries). Loaded once per process; the library's API version is
+// (libuh.so / uh.dll beside the binaries). Loaded once per process; the library's API version is
 // checked against the header's UH_API_VERSION. Every other class calls the C API through here.
 #pragma once
 
