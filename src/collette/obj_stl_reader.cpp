@@ -233,12 +233,18 @@ bool is_obj_or_stl(const std::filesystem::path& path) {
   return extension == ".obj" || extension == ".stl";
 }
 
-Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path) {
-  const std::string name = path.filename().string();
+Result<TriangleMesh> parse_obj_or_stl(std::string_view bytes, const std::string& name) {
+  const std::filesystem::path path(name);
   if (!is_obj_or_stl(path)) {
     return Error{fmt::format(
         "{}: cannot read mesh: the built-in reader reads OBJ (.obj) and STL (.stl) files only", name)};
   }
+  return lower(path.extension().string()) == ".obj" ? read_obj(bytes, name) : read_stl(bytes, name);
+}
+
+Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path) {
+  const std::string name = path.filename().string();
+  if (!is_obj_or_stl(path)) return parse_obj_or_stl({}, name);  // the error naming the formats
   std::ifstream in(path, std::ios::binary);
   if (!in) return Error{fmt::format("{}: cannot open the mesh file", name)};
   in.seekg(0, std::ios::end);
@@ -247,7 +253,7 @@ Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path) {
   std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)), '\0');
   if (size < 0 || !in.read(bytes.data(), size))
     return Error{fmt::format("{}: cannot read the mesh file", name)};
-  return lower(path.extension().string()) == ".obj" ? read_obj(bytes, name) : read_stl(bytes, name);
+  return parse_obj_or_stl(bytes, name);
 }
 
 }  // namespace uh::collette

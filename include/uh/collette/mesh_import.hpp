@@ -4,6 +4,8 @@
 /// builds without assimp, such as the Windows build, read OBJ and STL with the in-tree reader).
 
 #include <filesystem>
+#include <string>
+#include <string_view>
 
 #include "uh/collette/triangle_mesh.hpp"
 #include "uh/core/result.hpp"
@@ -49,6 +51,10 @@ Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoad
 /// rounded to float, as assimp keeps them, so both readers give the same mesh. Errors name the
 /// file and line. Not real-time safe; any thread.
 Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path);
+
+/// The same for a file's content already in memory; `name` names it in messages, and its
+/// extension (.obj or .stl) chooses the format.
+Result<TriangleMesh> parse_obj_or_stl(std::string_view bytes, const std::string& name);
 
 /// Welds, repairs, validates and orients an in-memory mesh the same way load_mesh() does (used by
 /// load_mesh() and by code that builds meshes itself). `mesh.source_name` names it in messages.
