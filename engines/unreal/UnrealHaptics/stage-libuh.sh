@@ -18,7 +18,7 @@ if [ -e "$linux/src/capi/libuh.so" ]; then
 else
   echo "no $linux/src/capi/libuh.so (build the Release tree first)"
 fi
-dll="$windows/src/capi/uh.dll"
+dll="$windows/bin/uh.dll"  # the Windows build puts its programs and uh.dll in bin/
 if [ -e "$dll" ]; then
   cp "$dll" "$module/lib/Win64/uh.dll"
   echo "staged $dll"

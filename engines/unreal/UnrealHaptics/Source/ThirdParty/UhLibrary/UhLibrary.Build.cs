@@ -1,6 +1,6 @@
 // The third-party module that stages libuh, the UnrealHaptics C API: its header (include/uh/uh.h)
 // and the shared library for each platform, copied here by stage-libuh.sh from a build of the
-// repository (Linux: build/release/src/capi/libuh.so; Windows x64: the mingw-w64 build's uh.dll, build/windows/src/capi/uh.dll).
+// repository (Linux: build/release/src/capi/libuh.so; Windows x64: the mingw-w64 build's uh.dll, build/windows/bin/uh.dll).
 // Haptico loads the library at run time and resolves its functions by name (UhApi), so no import
 // library (which MSVC and MinGW make differently) is needed; the library only has to be staged
 // beside the binaries (RuntimeDependencies).
