@@ -1,4 +1,4 @@
-// uh run [SCENE] [--seconds S] [--json] [--trace OUT.csv] [--plot OUT.png]
+// uh run [SCENE] [--seconds S] [--json] [--trace OUT.csv] [--plot OUT.png] [--device DRIVER[:SELECTOR]]
 #include <signal.h>
 #include <unistd.h>
 
@@ -17,6 +17,8 @@
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/atomic_file_writer.hpp"
+#include "uh/devices/device_probe.hpp"
+#include "uh/devices/hardware_drivers.hpp"
 #include "uh/service/server.hpp"
 #include "view_assets.hpp"
 
@@ -74,6 +76,7 @@ struct RunArgs {
   bool no_realtime = false;
   bool view = false;
   int view_port = 7770;
+  std::string device;
 };
 
 void print_summary(const controllers::SessionReport& r) {
@@ -99,6 +102,14 @@ int run_session(const RunArgs& args) {
   const std::filesystem::path cache = controllers::default_cache_dir();
   auto scene = args.scene.empty() ? controllers::default_scene(cache) : controllers::load_scene(args.scene);
   if (!scene) return fail(scene.error().message);
+  if (!args.device.empty()) {
+    auto choice = devices::parse_device_choice(args.device, devices::all_drivers());
+    if (!choice) return fail(choice.error().message);
+    // another driver does not share the scene's settings; the same one keeps them, with the selection on top
+    if (choice->driver != scene->tool.device.driver) scene->tool.device.config = {};
+    scene->tool.device.driver = choice->driver;
+    for (const auto& [key, value] : choice->selection.values()) scene->tool.device.config.set(key, value);
+  }
 
   controllers::SessionOptions options;
   if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
@@ -205,6 +216,9 @@ void add_run_command(CLI::App& app, CommandRunner& runner) {
   r->add_option("--port", args.view_port, "with --view: the port of the live view (0: any free port)")
       ->default_val(7770)->check(CLI::Range(0, 65535))->needs(view_flag);
   view_flag->excludes(r->get_option("--stepped"));
+  r->add_option("--device", args.device,
+                "the tool's device instead of the scene's: DRIVER[:SELECTOR], e.g. forcedimension:1 or "
+                "forcedimension:serial=11003 (see uh devices)");
   r->add_flag("--no-realtime", args.no_realtime,
               "do not ask for SCHED_FIFO for the haptic and collision threads (asked by default; refused without privileges)");
   r->callback([&runner] { runner = [] { return run_session(args); }; });

@@ -12,6 +12,7 @@ namespace uh::cli {
 /// Runs after parsing; returns the process exit code.
 using CommandRunner = std::function<int()>;
 
+void add_devices_command(CLI::App& app, CommandRunner& runner);
 void add_ist_commands(CLI::App& app, CommandRunner& runner);
 void add_query_command(CLI::App& app, CommandRunner& runner);
 void add_run_command(CLI::App& app, CommandRunner& runner);

@@ -15,9 +15,10 @@ int fail(const std::string& message) {
 }  // namespace uh::cli
 
 int main(int argc, char** argv) {
-  CLI::App app{"uh: build Inner Sphere Trees, query them, and run haptic sessions"};
+  CLI::App app{"uh: build Inner Sphere Trees, query them, list haptic devices and run haptic sessions"};
   app.require_subcommand(1);
   uh::cli::CommandRunner runner;
+  uh::cli::add_devices_command(app, runner);
   uh::cli::add_ist_commands(app, runner);
   uh::cli::add_query_command(app, runner);
   uh::cli::add_run_command(app, runner);

@@ -274,6 +274,8 @@ Status HapticSession::stop() {
   phase_ = Phase::kStopped;
   if (Status haptic = manager_->thread_status(); !haptic)
     stopped_ = Error{fmt::format("{}: {}", scene_.source, haptic.error().message)};
+  else if (Status device = manager_->device_status(); !device)
+    stopped_ = Error{fmt::format("{}: {}", scene_.source, device.error().message)};
   else if (!haptic_alive)
     stopped_ = Error{"the haptic thread ended before the session was stopped"};
   else if (!collision_alive)
@@ -297,9 +299,9 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
                                std::chrono::duration<double>(seconds));
   auto next_status = begin + std::chrono::milliseconds(250);
   // a stop request is seen within 20 ms; a thread that ended by itself (the haptic one has sent
-  // zero already) ends the run as well
+  // zero already), or a device fault (the device gets zero from its tick on), ends the run as well
   while (std::chrono::steady_clock::now() < end && !stop_requested_.load(std::memory_order_relaxed) &&
-         manager_->running() && world_->running()) {
+         manager_->running() && world_->running() && !manager_->faulted()) {
     const auto soon = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
     std::this_thread::sleep_until(std::min({end, next_status, soon}));
     if (on_status && std::chrono::steady_clock::now() >= next_status) {
@@ -324,7 +326,7 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   std::vector<haptico::TraceSample> buffer;
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
   std::int64_t k = 0;
-  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed); ++k) {
+  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed) && !manager_->faulted(); ++k) {
     const double t = static_cast<double>(k) / haptic_hz_;
     // the collision step sees the tool pose of the previous tick, as the threaded world would
     if (k % ticks_per_collision_step == 0) world_->step(t);
@@ -337,6 +339,8 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   collect_report(static_cast<double>(k) / haptic_hz_, true);
   report_.stopped_early = k < ticks;
   phase_ = Phase::kStopped;
+  if (Status device = manager_->device_status(); !device)
+    return Error{fmt::format("{}: {}", scene_.source, device.error().message)};
   return Ok{};
 }
 

@@ -163,6 +163,16 @@ Status HapticManager::thread_status() const {
   return Error{failure_};
 }
 
+Status HapticManager::device_status() {
+  if (!faulted()) return Ok{};
+  std::string why = device_->fault_reason();
+  if (why.empty())
+    why = fault_was_freeze_.load(std::memory_order_relaxed)
+              ? fmt::format("its state stopped advancing for {} ticks", options_.max_frozen_ticks)
+              : std::string("it reported an error without a reason");
+  return Error{fmt::format("device '{}' faulted: {}; it was sent zero force", info_.name, why)};
+}
+
 TraceSample HapticManager::step(double now_s) {
   assert(open_ && "uh::haptico::HapticManager::step(): open() the device first");
   assert(!loop_.running() && "uh::haptico::HapticManager::step(): a threaded session is running");
@@ -191,6 +201,7 @@ TraceSample HapticManager::tick(double now_s) {
   }
   if (sample.state.status != DeviceStatus::kOk || frozen) {
     device_errors_.increment();
+    if (!faulted_.load(std::memory_order_relaxed)) fault_was_freeze_.store(frozen, std::memory_order_relaxed);
     faulted_.store(true, std::memory_order_release);
     sample.flags |= kTraceDeviceError;
   } else {

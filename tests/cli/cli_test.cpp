@@ -426,5 +426,89 @@ TEST_F(CliTest, FailedWritesLeaveEarlierOutputsWhole) {
   EXPECT_EQ(read_text(results).rfind("id,volume,", 0), 0u);
 }
 
+// `uh devices` and `uh run --device` with the stand-in libdhd (tests/devices/standins/)
+std::string with_standin(const fs::path& dir) {
+  return fmt::format("UH_CACHE_DIR='{}' UH_FORCEDIMENSION_LIBRARY='{}' ", (dir / "cache").string(),
+                     UH_STANDIN_DHD);
+}
+
+// a small scene: the stylus on a simulated line through the bunny's middle
+fs::path write_small_device_scene(const fs::path& dir) {
+  const fs::path meshes = fs::path(UH_TEST_DATA_DIR) / "meshes";
+  std::ofstream(dir / "small.json") << fmt::format(R"({{
+  "name": "small",
+  "rates": {{ "haptic_hz": 1000, "collision_hz": 1000 }},
+  "seconds": 0.5,
+  "objects": [{{ "name": "bunny", "mesh": "{}", "meters_per_unit": 0.01, "spheres": 600,
+               "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
+  "tool": {{ "name": "stylus", "mesh": "{}", "meters_per_unit": 0.01, "spheres": 150,
+          "force": {{ "mode": "3dof", "force_scale": 8.0e6, "damping": 1.0, "max_force_n": 6.0 }},
+          "device": {{ "driver": "sim-line", "config": {{ "start": [0, 0, 0.1], "end": [0, 0, 0.045] }} }} }},
+  "watch": ["bunny"]
+}})",
+                                                   (meshes / "bunny_npm_3674.obj").string(),
+                                                   (meshes / "stylus.obj").string());
+  return dir / "small.json";
+}
+
+TEST_F(CliTest, DevicesListsWhereEachDriverLookedAndWhatItFound) {
+  const CommandRun r = uh("devices --json", with_standin(dir_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const nlohmann::json* fd = nullptr;
+  for (const auto& d : j["drivers"])
+    if (d["driver"] == "forcedimension") fd = &d;
+  ASSERT_NE(fd, nullptr) << r.out;
+  EXPECT_EQ((*fd)["looked_for"][0]["path"], UH_STANDIN_DHD);
+  EXPECT_EQ((*fd)["looked_for"][0]["from"], "UH_FORCEDIMENSION_LIBRARY");
+  EXPECT_EQ((*fd)["loaded_from"], UH_STANDIN_DHD);
+  ASSERT_EQ((*fd)["devices"].size(), 1u) << r.out;
+  const auto& dev = (*fd)["devices"][0];
+  EXPECT_EQ(dev["selector"], "forcedimension:0");
+  EXPECT_EQ(dev["model"], "omega.3");
+  EXPECT_EQ(dev["serial"], "11001");
+  EXPECT_EQ(dev["dof_actuated"], 3);
+  EXPECT_EQ(dev["max_force_n"], 12.0);
+  EXPECT_EQ(dev["workspace_half_extents_m"][2], 0.055);
+
+  // without the runtime: every place it looked, and why nothing was found
+  const CommandRun none = uh("devices", "UH_FORCEDIMENSION_LIBRARY=/nonexistent/libdhd.so ");
+  ASSERT_EQ(none.exit_code, 0) << none.err;
+  EXPECT_NE(none.out.find("looked for /nonexistent/libdhd.so (from UH_FORCEDIMENSION_LIBRARY)"),
+            std::string::npos)
+      << none.out;
+  EXPECT_NE(none.out.find("no device: could not load the Force Dimension DHD library"), std::string::npos)
+      << none.out;
+  EXPECT_NE(none.out.find("simulated (no hardware): sim-circle, sim-hand, sim-line, sim-raster, sim-replay"),
+            std::string::npos)
+      << none.out;
+}
+
+// the stand-in's handle rests at the origin, inside the bunny: a session with contact on it
+TEST_F(CliTest, RunOnTheDeviceNamedOnTheCommandLine) {
+  const fs::path scene = write_small_device_scene(dir_);
+  const CommandRun r = uh(fmt::format("run '{}' --device forcedimension:0 --stepped --json", scene.string()),
+                          with_standin(dir_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["haptic"]["ticks"], 500);
+  EXPECT_GT(j["force"]["max_n"].get<double>(), 0.5);
+  EXPECT_LE(j["force"]["max_n"].get<double>(), 6.0);
+
+  const CommandRun unknown =
+      uh(fmt::format("run '{}' --device nope --stepped", scene.string()), with_standin(dir_));
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_EQ(
+      unknown.err,
+      "uh: --device: unknown driver 'nope' (known drivers: forcedimension, sim-circle, sim-hand, sim-line, "
+      "sim-raster, sim-replay)\n");
+  const CommandRun missing = uh(
+      fmt::format("run '{}' --device forcedimension:serial=4 --stepped", scene.string()), with_standin(dir_));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("tool.device: forcedimension: no device with serial 4 (found: serial 11001)"),
+            std::string::npos)
+      << missing.err;
+}
+
 }  // namespace
 }  // namespace uh

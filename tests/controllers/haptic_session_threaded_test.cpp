@@ -32,6 +32,7 @@ class ThrowingDevice final : public haptico::HapticDevice {
     *last_ = command;
     inner_->command(command);
   }
+  std::string fault_reason() override { return inner_->fault_reason(); }
 
  private:
   std::unique_ptr<haptico::HapticDevice> inner_;

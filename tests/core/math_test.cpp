@@ -62,5 +62,42 @@ TEST(ClampNorm, HugeAndTinyVectorsKeepTheirDirection) {
   EXPECT_LE(std::hypot(tiny.x, tiny.y), 1e-321 * 1.01);
 }
 
+// Rodrigues' formula written out, independent of rotation_matrix(): R = I + sin(a) K + (1 - cos(a)) K^2
+Mat3 rodrigues(Vec3 axis, double angle) {
+  const Vec3 u = normalized(axis);
+  const double k[3][3] = {{0, -u.z, u.y}, {u.z, 0, -u.x}, {-u.y, u.x, 0}};
+  Mat3 r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      double k2 = 0.0;
+      for (int l = 0; l < 3; ++l) k2 += k[i][l] * k[l][j];
+      r.m[i][j] = (i == j ? 1.0 : 0.0) + std::sin(angle) * k[i][j] + (1.0 - std::cos(angle)) * k2;
+    }
+  }
+  return r;
+}
+
+TEST(QuatFromRotationMatrix, RotatesEveryBasisVectorOntoTheMatrixColumn) {
+  const Vec3 axes[] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 2, -3}, {-0.3, 0.1, 0.9}};
+  // angles include 180 degrees and its neighbours, where the trace-based formula alone fails
+  const double angles[] = {0.0, 0.3, -1.2, 2.5, kPi - 1e-9, kPi, -kPi + 1e-6, 3.0};
+  for (const Vec3& axis : axes) {
+    for (double angle : angles) {
+      const Mat3 r = rodrigues(axis, angle);
+      const Quat q = quat_from_rotation_matrix(r);
+      EXPECT_NEAR(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z, 1.0, 1e-12);
+      EXPECT_GE(q.w, 0.0);
+      const Vec3 basis[] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+      for (int j = 0; j < 3; ++j) {
+        const Vec3 v = rotate(q, basis[j]);
+        EXPECT_NEAR(v.x, r.m[0][j], 1e-9)
+            << "axis " << axis.x << "," << axis.y << "," << axis.z << " angle " << angle;
+        EXPECT_NEAR(v.y, r.m[1][j], 1e-9);
+        EXPECT_NEAR(v.z, r.m[2][j], 1e-9);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace uh

@@ -54,6 +54,9 @@ class FakeDevice final : public HapticDevice {
     last_command_thread = std::this_thread::get_id();
     ++commands;
   }
+  std::string fault_reason() override {
+    return status == DeviceStatus::kFault ? "fake: amplifier fault" : "";
+  }
 
   DeviceInfo info_{};
   bool fail_open = false;
@@ -258,6 +261,9 @@ TEST(HapticManager, DeviceErrorLatchesZeroForce) {
   EXPECT_EQ(t.flags, kTraceDeviceError | kTraceZeroed);
   EXPECT_EQ(force_calls, 0);  // delegates never see an invalid state
   EXPECT_EQ(f.device->last.force, Vec3{});
+  const Status fault = f.manager->device_status();
+  ASSERT_FALSE(fault);
+  EXPECT_EQ(fault.error().message, "device 'fake' faulted: fake: amplifier fault; it was sent zero force");
   // the device recovers, but the fault stays latched until someone clears it
   f.device->status = DeviceStatus::kOk;
   f.manager->step(0.001);
@@ -310,9 +316,13 @@ TEST(HapticManager, FrozenDeviceCountsAsDeviceError) {
   EXPECT_EQ(f.device->last.force, Vec3{});
   EXPECT_EQ(f.manager->stats().device_errors, 1u);
   EXPECT_TRUE(f.manager->stats().faulted);
+  ASSERT_FALSE(f.manager->device_status());
+  EXPECT_EQ(f.manager->device_status().error().message,
+            "device 'fake' faulted: its state stopped advancing for 3 ticks; it was sent zero force");
   // a live device again, and the fault cleared: forces come back
   f.device->frozen = false;
   f.manager->clear_fault();
+  EXPECT_TRUE(f.manager->device_status());
   EXPECT_EQ(f.manager->step(0.004).sent.force, (Vec3{1, 0, 0}));
 }
 

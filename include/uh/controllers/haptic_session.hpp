@@ -27,6 +27,7 @@
 #include "uh/core/latest_value.hpp"
 #include "uh/core/result.hpp"
 #include "uh/core/spsc_queue.hpp"
+#include "uh/devices/hardware_drivers.hpp"
 #include "uh/haptico/device_registry.hpp"
 #include "uh/haptico/haptic_manager.hpp"
 
@@ -130,9 +131,9 @@ class HapticSession {
  public:
   /// Builds everything a scene needs (loads or builds the sphere trees, creates and opens the
   /// device through the registry), without starting threads. Errors name the scene and the part.
-  static Result<std::unique_ptr<HapticSession>> create(const Scene& scene, const SessionOptions& options = {},
-                                                       const haptico::DeviceRegistry& registry =
-                                                           haptico::DeviceRegistry::with_simulated_devices());
+  static Result<std::unique_ptr<HapticSession>> create(
+      const Scene& scene, const SessionOptions& options = {},
+      const haptico::DeviceRegistry& registry = devices::all_drivers());
   ~HapticSession();
   HapticSession(const HapticSession&) = delete;
   HapticSession& operator=(const HapticSession&) = delete;

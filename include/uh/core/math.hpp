@@ -6,6 +6,7 @@
 /// cross threads through the handoff primitives and sit inside fixed-capacity result structs.
 /// Units are SI unless a name says otherwise. Every function here is real-time safe.
 
+#include <algorithm>
 #include <cmath>
 
 namespace uh {
@@ -132,6 +133,30 @@ constexpr Mat3 rotation_matrix(const Quat& q) {
   return {{{1 - 2 * (yy + zz), 2 * (xy - wz), 2 * (xz + wy)},
            {2 * (xy + wz), 1 - 2 * (xx + zz), 2 * (yz - wx)},
            {2 * (xz - wy), 2 * (yz + wx), 1 - 2 * (xx + yy)}}};
+}
+/// The unit quaternion (w >= 0) of the row-major rotation matrix `r` (the inverse of
+/// rotation_matrix). Built from the largest of the four diagonal combinations (Shepperd), so it
+/// stays accurate near 180 degrees; a matrix that is not a rotation gives the nearest unit
+/// quaternion of that estimate.
+inline Quat quat_from_rotation_matrix(const Mat3& r) {
+  const auto& m = r.m;
+  const double trace = m[0][0] + m[1][1] + m[2][2];
+  Quat q;
+  if (trace >= m[0][0] && trace >= m[1][1] && trace >= m[2][2]) {
+    const double s = 2.0 * std::sqrt(std::max(0.0, 1.0 + trace));  // 4 w
+    q = {0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s};
+  } else if (m[0][0] >= m[1][1] && m[0][0] >= m[2][2]) {
+    const double s = 2.0 * std::sqrt(std::max(0.0, 1.0 + m[0][0] - m[1][1] - m[2][2]));  // 4 x
+    q = {(m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s};
+  } else if (m[1][1] >= m[2][2]) {
+    const double s = 2.0 * std::sqrt(std::max(0.0, 1.0 - m[0][0] + m[1][1] - m[2][2]));  // 4 y
+    q = {(m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s};
+  } else {
+    const double s = 2.0 * std::sqrt(std::max(0.0, 1.0 - m[0][0] - m[1][1] + m[2][2]));  // 4 z
+    q = {(m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s};
+  }
+  if (q.w < 0.0) q = {-q.w, -q.x, -q.y, -q.z};
+  return normalized(q);
 }
 
 inline constexpr double kPi = 3.14159265358979323846;

@@ -2,6 +2,8 @@
 /// \file
 /// HapticDevice: the narrow interface every device driver implements.
 
+#include <string>
+
 #include "uh/core/result.hpp"
 #include "uh/haptico/device_command.hpp"
 #include "uh/haptico/device_info.hpp"
@@ -33,6 +35,10 @@ class HapticDevice {
   /// Renders `cmd` (device frame) until the next command. The caller has already limited it to
   /// info().max_force_n / max_torque_nm; drivers saturate again as the hardware would.
   virtual void command(const DeviceCommand& cmd) = 0;
+  /// Why the device last reported kFault, in the driver's and the vendor's words ("" when it has
+  /// not, or gave no reason), e.g. "sending the force (dhdSetForce): communication error". Cleared
+  /// by open(). Controlling thread, also while the haptic thread runs; not real-time safe.
+  virtual std::string fault_reason() = 0;
 
  protected:
   HapticDevice() = default;

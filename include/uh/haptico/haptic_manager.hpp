@@ -116,6 +116,13 @@ class HapticManager {
   /// a ForceOnHapticTick delegate (computing the force) threw: ...") once the thread ended because
   /// a tick threw; Ok while it runs, after a requested stop, and before any run. Controlling thread.
   Status thread_status() const;
+  /// Whether a device fault is latched: the device reported an error or stopped advancing, and
+  /// gets zero until clear_fault(). Any thread; real-time safe.
+  bool faulted() const { return faulted_.load(std::memory_order_acquire); }
+  /// Ok, or while a device fault is latched an Error naming the device and why, in the driver's
+  /// words (HapticDevice::fault_reason()), e.g. "device 'forcedimension omega.3' faulted: sending
+  /// the force (dhdSetForce): communication error; it was sent zero force". Controlling thread.
+  Status device_status();
   /// Runs one tick now on the calling thread, with `now_s` [s] as the tick time: the deterministic
   /// entry for stepped sessions and tests. The device must be open and no threaded session may
   /// run (asserted). Returns what happened in that tick.
@@ -207,6 +214,7 @@ class HapticManager {
   std::atomic<bool> restart_fade_{false};
   std::atomic<bool> halted_{false};
   std::atomic<bool> faulted_{false};
+  std::atomic<bool> fault_was_freeze_{false};  // the latched fault is a device time that stopped advancing
   EventCounter ticks_;
   EventCounter force_clamped_;
   EventCounter torque_clamped_;

@@ -34,6 +34,8 @@ class SimulatedDevice : public HapticDevice {
   /// Records `cmd` (saturated at the limits, like motors), lets the model react to it for one
   /// period and advances the time by 1 / rate_hz. Ignored before open().
   void command(const DeviceCommand& cmd) override;
+  /// Simulated devices do not fault: always "".
+  std::string fault_reason() override { return {}; }
 
   /// Advances the simulated time by `dt` [s] under the last command. Real-time safe.
   void advance(double dt);
