@@ -35,10 +35,16 @@ double steady_now_s() {
 }  // namespace
 
 LibrarySearch force_dimension_library_search() {
+  // the SDK's file names: dhd64.dll on Windows (found on PATH or beside the program)
+#ifdef _WIN32
+  std::vector<std::string> names{"dhd64.dll", "dhd.dll"};
+#else
+  std::vector<std::string> names{"libdhd.so", "libdhd.so.3", "/usr/local/lib/libdhd.so",
+                                 "/opt/forcedimension/lib/libdhd.so"};
+#endif
   return {.vendor = "Force Dimension DHD",
           .environment_variable = "UH_FORCEDIMENSION_LIBRARY",
-          .install_names = {"libdhd.so", "libdhd.so.3", "/usr/local/lib/libdhd.so",
-                            "/opt/forcedimension/lib/libdhd.so"}};
+          .install_names = names};
 }
 
 Result<std::unique_ptr<haptico::HapticDevice>> ForceDimensionDevice::create(
