@@ -309,7 +309,9 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
       on_status(state());
     }
   }
-  const bool early = std::chrono::steady_clock::now() < end && stop_requested_.load(std::memory_order_relaxed);
+  // a stop request or a device fault ended it before its time
+  const bool early = std::chrono::steady_clock::now() < end &&
+                     (stop_requested_.load(std::memory_order_relaxed) || manager_->faulted());
   Status stopped = stop();
   report_.stopped_early = early;
   return stopped;

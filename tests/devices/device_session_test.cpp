@@ -78,5 +78,25 @@ TEST_F(DeviceSessionTest, ForceDimensionCommunicationErrorEndsTheSession) {
   EXPECT_EQ(standin.get("force_z"), 0.0);
 }
 
+// the same on the haptic thread: the run ends long before its time, with the error and zero force
+TEST_F(DeviceSessionTest, ForceDimensionFaultEndsAThreadedRun) {
+  devices::testing::DhdStandin standin;
+  standin.set("rest_z", 0.045, 0);
+  standin.set("comm_error_after", 300);
+  auto session = make();
+  ASSERT_TRUE(session);
+  const Status ran = session->run(30.0);
+  ASSERT_FALSE(ran);
+  EXPECT_NE(
+      ran.error().message.find("device 'forcedimension omega.3' faulted: sending the force (dhdSetForce): "
+                               "communication error (USB transfer failed)"),
+      std::string::npos)
+      << ran.error().message;
+  EXPECT_TRUE(session->report().stopped_early);
+  EXPECT_EQ(standin.get("forces_enabled"), 0.0);
+  EXPECT_EQ(standin.get("force_z"), 0.0);
+  EXPECT_EQ(standin.received().size(), 300u);  // nothing reached the device after the fault
+}
+
 }  // namespace
 }  // namespace uh::controllers
