@@ -277,6 +277,8 @@ void Scene::set_tool(const py::kwargs& kwargs) {
                                       "spheres",
                                       "meters_per_unit",
                                       "mode",
+                                      "law",
+                                      "stiffness",
                                       "force_scale",
                                       "damping",
                                       "damping_full_volume",
@@ -311,9 +313,25 @@ void Scene::set_tool(const py::kwargs& kwargs) {
     if (mode != "6dof" && mode != "3dof") throw py::value_error("mode must be '6dof' or '3dof'");
     def.mode = mode == "3dof" ? UH_FORCE_3DOF : UH_FORCE_6DOF;
   }
+  if (kwargs.contains("law")) {
+    const std::string law = kwargs["law"].cast<std::string>();
+    if (law != "gradient" && law != "paper") throw py::value_error("law must be 'gradient' or 'paper'");
+    def.law = law == "paper" ? UH_FORCE_LAW_PAPER : UH_FORCE_LAW_GRADIENT;
+  }
+  // each law has its own stiffness in its own unit: a value meant for the other would be wrong by
+  // orders of magnitude, so it is refused rather than ignored
+  if (def.law == UH_FORCE_LAW_GRADIENT && kwargs.contains("force_scale"))
+    throw py::value_error(
+        "force_scale is the paper law's stiffness [N/m^3]; the gradient law (the default) takes stiffness= "
+        "[N/m^2] "
+        "(or pass law='paper')");
+  if (def.law == UH_FORCE_LAW_PAPER && kwargs.contains("stiffness"))
+    throw py::value_error(
+        "stiffness is the gradient law's [N/m^2]; the paper law takes force_scale= [N/m^3]");
   const auto number = [&](const char* key, double& out) {
     if (kwargs.contains(key)) out = kwargs[key].cast<double>();
   };
+  number("stiffness", def.stiffness);
   number("force_scale", def.force_scale);
   number("damping", def.damping);
   number("damping_full_volume", def.damping_full_volume);
@@ -507,8 +525,10 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def_readonly("volume", &QueryResult::volume, "intersection volume of the packings [m^3]")
       .def_readonly("volume_estimate", &QueryResult::volume_estimate,
                     "volume / (coverage_a * coverage_b): estimate of the meshes' overlap [m^3]")
-      .def_readonly("direction", &QueryResult::direction,
-                    "(3,) unit direction pushing B out of A; zero when apart")
+      .def_readonly(
+          "direction", &QueryResult::direction,
+          "(3,) unit direction of the force the gradient law puts on B (minus the gradient of the overlap "
+          "volume); zero when apart")
       .def_readonly("pair_count", &QueryResult::pair_count, "overlapping leaf sphere pairs")
       .def_readonly("distance", &QueryResult::distance,
                     "separation when apart (upper bound) [m]; 0 when overlapping");
@@ -551,7 +571,8 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def("set_tool", &Scene::set_tool,
            "Sets the tool: shape (mesh=/ist=/tree=/vertices=+triangles=, spheres=, meters_per_unit=), force "
            "law "
-           "(mode='6dof'|'3dof', force_scale=, damping=, damping_full_volume=, mass_kg=, center_of_mass=, "
+           "(mode='6dof'|'3dof', law='gradient'|'paper', stiffness= [N/m^2, gradient], force_scale= [N/m^3, "
+           "paper], damping=, damping_full_volume=, mass_kg=, center_of_mass=, "
            "max_force_n=, "
            "max_torque_nm=), device=driver name, config=dict or JSON text, workspace_scale=, "
            "workspace_offset=, "

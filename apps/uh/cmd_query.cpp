@@ -1,4 +1,7 @@
 // uh query A.ist B.ist --poses POSES.csv [--out RESULTS.csv] [--json] [--budget-us N]
+// Per pose: the packings' overlap volume, the direction of the force the default (gradient) law
+// puts on B, the overlapping pairs, the separation when apart, the time, and the coverage-calibrated
+// volume estimate.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -35,22 +38,27 @@ struct QueryRow {
   std::string id;
   double volume = 0.0;
   double volume_estimate = 0.0;  // volume / (coverage_a * coverage_b): estimate of the meshes' overlap
-  Vec3 normal{};
-  Vec3 gradient_direction{};      // -grad of the packing overlap volume w.r.t. B's position (exact query only)
+  Vec3
+      direction{};  // of the force the default (gradient) law puts on B: -grad of the overlap volume; 0 apart
   std::int64_t pairs = 0;
   double distance = 0.0;
   double time_us = 0.0;
 };
+
+constexpr const char* kCsvHeader = "id,volume,nx,ny,nz,pairs,distance,time_us,volume_estimate";
+
+std::string csv_line(const QueryRow& r) {
+  return fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.3f},{:.9g}", r.id, r.volume, r.direction.x,
+                     r.direction.y, r.direction.z, r.pairs, r.distance, r.time_us, r.volume_estimate);
+}
 
 // An existing results file is replaced only by a complete new one.
 Status write_results_csv(const std::filesystem::path& path, const std::vector<QueryRow>& rows) {
   auto file = AtomicFileWriter::create(path);
   if (!file) return file.error();
   std::ostream& out = file->stream();
-  out << "id,volume,nx,ny,nz,pairs,distance,time_us\n";
-  for (const QueryRow& r : rows)
-    out << fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.3f}\n", r.id, r.volume, r.normal.x, r.normal.y,
-                       r.normal.z, r.pairs, r.distance, r.time_us);
+  out << kCsvHeader << '\n';
+  for (const QueryRow& r : rows) out << csv_line(r) << '\n';
   return file->commit();
 }
 
@@ -85,13 +93,12 @@ int run_query(const QueryArgs& args) {
     if (args.budget_us > 0.0) {
       const auto& r = time_critical_query.run(a->tree, b->tree, pose.b_in_a, budget);
       row.volume = r.volume_estimate;
-      row.normal = r.restoring_direction;
+      row.direction = normalized(-r.volume_gradient);
       row.pairs = r.stats.overlapping_pairs;
     } else {
       const auto& r = volume_query.run(a->tree, b->tree, pose.b_in_a);
       row.volume = r.total_volume;
-      row.normal = r.restoring_direction;
-      row.gradient_direction = normalized(-r.volume_gradient);
+      row.direction = normalized(-r.volume_gradient);
       row.pairs = r.stats.overlapping_pairs;
       coherent_poses += r.reused_candidates ? 1 : 0;
     }
@@ -109,10 +116,15 @@ int run_query(const QueryArgs& args) {
   if (args.json) {
     nlohmann::json results = nlohmann::json::array();
     for (const QueryRow& r : rows)
-      results.push_back({{"id", r.id}, {"volume", r.volume}, {"nx", r.normal.x}, {"ny", r.normal.y}, {"nz", r.normal.z},
-                         {"pairs", r.pairs}, {"distance", r.distance}, {"time_us", r.time_us},
-                         {"volume_estimate", r.volume_estimate},
-                         {"gradient_direction", {r.gradient_direction.x, r.gradient_direction.y, r.gradient_direction.z}}});
+      results.push_back({{"id", r.id},
+                         {"volume", r.volume},
+                         {"nx", r.direction.x},
+                         {"ny", r.direction.y},
+                         {"nz", r.direction.z},
+                         {"pairs", r.pairs},
+                         {"distance", r.distance},
+                         {"time_us", r.time_us},
+                         {"volume_estimate", r.volume_estimate}});
     nlohmann::json j = {{"a", args.a},
                         {"b", args.b},
                         {"poses", rows.size()},
@@ -126,10 +138,8 @@ int run_query(const QueryArgs& args) {
     if (!args.out.empty()) j["out"] = args.out;
     std::printf("%s\n", j.dump(2).c_str());
   } else if (args.out.empty()) {
-    std::printf("id,volume,nx,ny,nz,pairs,distance,time_us\n");
-    for (const QueryRow& r : rows)
-      std::printf("%s,%.9g,%.9g,%.9g,%.9g,%lld,%.9g,%.3f\n", r.id.c_str(), r.volume, r.normal.x, r.normal.y, r.normal.z,
-                  static_cast<long long>(r.pairs), r.distance, r.time_us);
+    std::printf("%s\n", kCsvHeader);
+    for (const QueryRow& r : rows) std::printf("%s\n", csv_line(r).c_str());
   } else {
     std::printf("%zu poses -> %s; time_us median %.1f, p99 %.1f, max %.1f\n", rows.size(), args.out.c_str(),
                 percentile(times, 0.5), percentile(times, 0.99), percentile(times, 1.0));
@@ -141,11 +151,13 @@ int run_query(const QueryArgs& args) {
 
 void add_query_command(CLI::App& app, CommandRunner& runner) {
   static QueryArgs args;
-  auto* q = app.add_subcommand("query", "intersection volume, restoring direction and distance of B against A per pose");
+  auto* q = app.add_subcommand("query",
+                               "intersection volume, force direction and distance of B against A per pose");
   q->add_option("a", args.a, "A.ist")->required()->check(CLI::ExistingFile);
   q->add_option("b", args.b, "B.ist")->required()->check(CLI::ExistingFile);
   q->add_option("--poses", args.poses, "CSV id,tx,ty,tz,qw,qx,qy,qz: pose of B's mesh frame in A's")->required()->check(CLI::ExistingFile);
-  q->add_option("--out", args.out, "write id,volume,nx,ny,nz,pairs,distance,time_us to this CSV");
+  q->add_option("--out", args.out,
+                "write id,volume,nx,ny,nz,pairs,distance,time_us,volume_estimate to this CSV");
   q->add_flag("--json", args.json, "print a JSON summary (median, p99, max time_us) with the results");
   q->add_option("--budget-us", args.budget_us, "time-critical query with this budget per pose [us]")->check(CLI::PositiveNumber);
   q->add_option("--coherence-skin", args.coherence_skin,

@@ -28,7 +28,7 @@ uh_scene* small_scene() {
   tool.shape.mesh_path = UH_ASSET_DIR "/meshes/stylus.obj";
   tool.shape.spheres = 150;
   tool.shape.meters_per_unit = 0.01;
-  tool.force_scale = 8.0e6;
+  tool.stiffness = 1.6e4;
   tool.max_force_n = 6.0;
   tool.device_config_json =
       R"({"start": [0, 0, 0.10], "end": [0, 0, 0.045], "duration_s": 0.5, "bounce": true, "dof_actuated": 6, "max_force_n": 6})";
@@ -63,7 +63,7 @@ void BM_CppState(benchmark::State& state) {
     "objects": [{"name": "bunny", "mesh": "meshes/bunny_npm_3674.obj", "meters_per_unit": 0.01, "spheres": 600,
                  "pose": {"position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0]}}],
     "tool": {"name": "tool", "mesh": "meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
-             "force": {"force_scale": 8.0e6, "max_force_n": 6.0},
+             "force": {"stiffness": 1.6e4, "max_force_n": 6.0},
              "device": {"driver": "sim-line", "config": {"start": [0, 0, 0.10], "end": [0, 0, 0.045], "duration_s": 0.5,
                                                           "bounce": true, "dof_actuated": 6, "max_force_n": 6}}}})",
                            "bench", UH_ASSET_DIR);

@@ -18,7 +18,7 @@ def main():
     scene = uh.Scene.create("bench")
     scene.add_object("bunny", mesh=ASSETS / "bunny_npm_3674.obj", spheres=600, meters_per_unit=0.01,
                      orientation=(0.70710678, 0.70710678, 0, 0))
-    scene.set_tool(mesh=ASSETS / "stylus.obj", spheres=150, meters_per_unit=0.01, force_scale=8.0e6, max_force_n=6.0,
+    scene.set_tool(mesh=ASSETS / "stylus.obj", spheres=150, meters_per_unit=0.01, stiffness=1.6e4, max_force_n=6.0,
                    device="sim-line", config={"start": [0, 0, 0.10], "end": [0, 0, 0.045], "duration_s": 0.5,
                                               "bounce": True, "dof_actuated": 6, "max_force_n": 6})
     results = {}

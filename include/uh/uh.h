@@ -133,7 +133,8 @@ typedef struct uh_query_result {
   uint32_t struct_size;     /* sizeof(uh_query_result) */
   double volume;            /* intersection volume of the two packings [m^3], >= 0 */
   double volume_estimate;   /* volume / (coverage_a * coverage_b): an estimate of the meshes' overlap [m^3] */
-  double direction[3];      /* unit, A's frame: the direction that pushes B out of A; zero when apart */
+  double direction[3];      /* unit, A's frame: the direction of the force the gradient law puts on B
+                               (minus the gradient of the packings' overlap volume); zero when apart */
   int32_t pair_count;       /* overlapping leaf sphere pairs */
   double distance;          /* separation when apart (an upper bound) [m]; 0 when they overlap */
 } uh_query_result;
@@ -180,15 +181,24 @@ typedef struct uh_object_def {
 typedef int32_t uh_force_mode;
 enum { UH_FORCE_6DOF = 0, UH_FORCE_3DOF = 1 };
 
+/* Which force law (docs/forcecomp.md). GRADIENT: minus the gradient of the overlap volume, calibrated
+ * by the packings' coverages, stiffness k [N/m^2] (force per unit of contact area). PAPER: the
+ * UnrealHaptics paper's eq. 1, force_scale eps_c [N/m^3] (force per overlap volume). */
+typedef int32_t uh_force_law;
+enum { UH_FORCE_LAW_GRADIENT = 0, UH_FORCE_LAW_PAPER = 1 };
+
 /* The tool: a shape moved by a device, with its force law and limits. */
 typedef struct uh_tool_def {
   uint32_t struct_size;        /* sizeof(uh_tool_def) */
   const char* name;            /* default "tool" */
   uh_shape_def shape;
   uh_force_mode mode;          /* default UH_FORCE_6DOF */
-  double force_scale;          /* penalty stiffness eps_c [N/m^3] */
+  uh_force_law law;            /* default UH_FORCE_LAW_GRADIENT */
+  double stiffness;   /* gradient law: k [N/m^2]; a round tip of radius r is a spring of 2 pi r k N/m */
+  double force_scale; /* paper law: eps_c [N/m^3] */
   double damping;              /* eps_d [N s/m] */
-  double damping_full_volume;  /* overlap volume from which the full damping acts [m^3] (0: from the first touch) */
+  double damping_full_volume;  /* overlap volume from which the full damping acts [m^3] (default 2e-8; 0: from
+                                  the first touch) */
   double mass_kg;              /* tool mass [kg] */
   double center_of_mass[3];    /* [m, tool frame] */
   double max_force_n;          /* limit of the tool's force [N] */

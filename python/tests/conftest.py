@@ -18,7 +18,7 @@ def small_scene():
     scene.add_object("bunny", mesh=ASSETS / "bunny_npm_3674.obj", spheres=600, meters_per_unit=0.01,
                      orientation=(0.70710678, 0.70710678, 0, 0))
     scene.set_tool(name="stylus", mesh=ASSETS / "stylus.obj", spheres=150, meters_per_unit=0.01,
-                   force_scale=8.0e6, damping=1.0, center_of_mass=(0, 0, 0.025), max_force_n=6.0, max_torque_nm=0.3,
+                   stiffness=1.6e4, damping=1.0, center_of_mass=(0, 0, 0.025), max_force_n=6.0, max_torque_nm=0.3,
                    device="sim-line",
                    config={"start": [0, 0, 0.10], "end": [0, 0, 0.045], "duration_s": 0.5, "bounce": True,
                            "dof_actuated": 6, "max_force_n": 6})

@@ -127,5 +127,12 @@ def test_bad_input_raises_with_a_message(scene):
                        config={"start": {"x": 1}})
     with pytest.raises(TypeError, match="unexpected keyword"):
         scene.set_tool(meshh="x")
+    # each force law has its own stiffness, in its own unit: the other one's is refused
+    with pytest.raises(ValueError, match="paper law"):
+        scene.set_tool(vertices=CUBE_VERTICES, triangles=CUBE_TRIANGLES, spheres=50, force_scale=8e6)
+    with pytest.raises(ValueError, match="gradient law"):
+        scene.set_tool(vertices=CUBE_VERTICES, triangles=CUBE_TRIANGLES, spheres=50, law="paper", stiffness=1e4)
+    with pytest.raises(ValueError, match="'gradient' or 'paper'"):
+        scene.set_tool(vertices=CUBE_VERTICES, triangles=CUBE_TRIANGLES, spheres=50, law="volume")
     with pytest.raises(ValueError):
         uh.Session.open(scene).set_object_pose(0, (0, 0), (1, 0, 0, 0))

@@ -55,6 +55,8 @@ Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh
     const auto box = tree_table().find(handle_value(def.tree));
     if (!box) return Error{fmt::format("{}: shape.tree is not an open tree handle", what)};
     shape.tree = box->tree;
+    // 0 when unknown: the gradient law is then uncalibrated
+    if (box->meta.coverage > 0.0 && box->meta.coverage <= 1.0) shape.coverage = box->meta.coverage;
   } else {
     uh_tree* tree = nullptr;
     const uh_tree_build_def build{.struct_size = sizeof(uh_tree_build_def),
@@ -66,6 +68,7 @@ Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh
     const std::shared_ptr<TreeBox> built = tree_table().remove(handle_value(tree));
     if (!built) return Error{fmt::format("{}: the tree built from the arrays was lost", what)};
     shape.tree = built->tree;
+    if (built->meta.coverage > 0.0 && built->meta.coverage <= 1.0) shape.coverage = built->meta.coverage;
   }
   return shape;
 }
@@ -129,6 +132,8 @@ uh_tool_def uh_default_tool_def(void) {
       .name = "tool",
       .shape = uh_default_shape_def(),
       .mode = UH_FORCE_6DOF,
+      .law = UH_FORCE_LAW_GRADIENT,
+      .stiffness = f.stiffness,
       .force_scale = f.force_scale,
       .damping = f.damping,
       .damping_full_volume = f.damping_full_volume,
@@ -259,16 +264,20 @@ uh_status uh_scene_set_tool(uh_scene* scene, const uh_tool_def* def) {
     if (def->mode != UH_FORCE_6DOF && def->mode != UH_FORCE_3DOF)
       return fail(UH_ERROR_INVALID_ARGUMENT,
                   fmt::format("{}: mode {} is neither UH_FORCE_6DOF nor UH_FORCE_3DOF", what, def->mode));
-    const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
-    const auto non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
-    if (!non_negative(def->force_scale) || !non_negative(def->damping) ||
-        !non_negative(def->damping_full_volume) || !positive(def->mass_kg) || !positive(def->max_force_n) ||
-        !positive(def->max_torque_nm) || !positive(def->workspace_scale))
+    if (def->law != UH_FORCE_LAW_GRADIENT && def->law != UH_FORCE_LAW_PAPER)
       return fail(
           UH_ERROR_INVALID_ARGUMENT,
-          fmt::format("{}: force_scale, damping and damping_full_volume must be >= 0; mass_kg, max_force_n, "
-                      "max_torque_nm and workspace_scale > 0 (all finite)",
-                      what));
+          fmt::format("{}: law {} is neither UH_FORCE_LAW_GRADIENT nor UH_FORCE_LAW_PAPER", what, def->law));
+    const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+    const auto non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
+    if (!non_negative(def->stiffness) || !non_negative(def->force_scale) || !non_negative(def->damping) ||
+        !non_negative(def->damping_full_volume) || !positive(def->mass_kg) || !positive(def->max_force_n) ||
+        !positive(def->max_torque_nm) || !positive(def->workspace_scale))
+      return fail(UH_ERROR_INVALID_ARGUMENT,
+                  fmt::format("{}: stiffness, force_scale, damping and damping_full_volume must be >= 0; "
+                              "mass_kg, max_force_n, "
+                              "max_torque_nm and workspace_scale > 0 (all finite)",
+                              what));
     if (def->device_driver == nullptr || *def->device_driver == '\0')
       return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: device_driver is empty", what));
     const Vec3 com{def->center_of_mass[0], def->center_of_mass[1], def->center_of_mass[2]};
@@ -289,13 +298,16 @@ uh_status uh_scene_set_tool(uh_scene* scene, const uh_tool_def* def) {
     tool.name = def->name != nullptr ? def->name : "tool";
     tool.shape = std::move(shape).value();
     tool.mode = def->mode == UH_FORCE_3DOF ? forcecomp::ForceMode::k3Dof : forcecomp::ForceMode::k6Dof;
-    tool.force = {.mass_kg = def->mass_kg,
-                  .center_of_mass_body = com,
-                  .force_scale = def->force_scale,
-                  .damping = def->damping,
-                  .damping_full_volume = def->damping_full_volume,
-                  .max_force_n = def->max_force_n,
-                  .max_torque_nm = def->max_torque_nm};
+    tool.force = {
+        .mass_kg = def->mass_kg,
+        .center_of_mass_body = com,
+        .law = def->law == UH_FORCE_LAW_PAPER ? forcecomp::ForceLaw::kPaper : forcecomp::ForceLaw::kGradient,
+        .stiffness = def->stiffness,
+        .force_scale = def->force_scale,
+        .damping = def->damping,
+        .damping_full_volume = def->damping_full_volume,
+        .max_force_n = def->max_force_n,
+        .max_torque_nm = def->max_torque_nm};
     tool.device = {.driver = def->device_driver, .config = std::move(config).value()};
     tool.workspace = {
         .world_from_device_base = *workspace, .scale = def->workspace_scale, .handle_from_tool = {}};

@@ -178,9 +178,11 @@ uh_status uh_tree_query(const uh_tree* a, const uh_tree* b, const double positio
     // each packing fills a share (its coverage) of its mesh (docs/collette-queries.md, "Accuracy")
     const double calibration = box_a->meta.coverage * box_b->meta.coverage;
     out->volume_estimate = calibration > 0.0 ? r.total_volume / calibration : 0.0;
-    out->direction[0] = r.restoring_direction.x;
-    out->direction[1] = r.restoring_direction.y;
-    out->direction[2] = r.restoring_direction.z;
+    // the direction of the force the default (gradient) law puts on B
+    const Vec3 direction = normalized(-r.volume_gradient);
+    out->direction[0] = direction.x;
+    out->direction[1] = direction.y;
+    out->direction[2] = direction.z;
     out->pair_count = static_cast<int32_t>(r.stats.overlapping_pairs);
     out->distance =
         r.total_volume > 0.0 ? 0.0 : thread_distance_query().run(*box_a->tree, *box_b->tree, *pose).distance;

@@ -19,18 +19,26 @@ constexpr HeapLess heap_less{};
 
 struct Sums {
   double v = 0.0, nx = 0.0, ny = 0.0, nz = 0.0, cx = 0.0, cy = 0.0, cz = 0.0;
+  double gx = 0.0, gy = 0.0, gz = 0.0;  // sum of (expected) intersection disk area * normal
 
-  // adds volume v along the centre line (a -> b) at the lens centroid of the two spheres
-  void add(const SphereTreeNode& a, float bx, float by, float bz, float rb, float vol) {
+  // adds volume v along the centre line (a -> b) at the lens centroid of the two spheres, and
+  // `density` times their intersection disk area (1 for a leaf pair; the node pair's expected
+  // share of it for a waiting pair, like its volume)
+  void add(const SphereTreeNode& a, float bx, float by, float bz, float rb, float vol, float density) {
     const float dx = bx - a.x, dy = by - a.y, dz = bz - a.z;
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float inv = d > 0.f ? 1.f / d : 0.f;
-    const float off = sphere_overlap(d, a.radius, rb).centroid_offset;
+    const SphereOverlap<float> o = sphere_overlap(d, a.radius, rb);
+    const float off = o.centroid_offset;
     const double w = static_cast<double>(vol);
+    const double g = static_cast<double>(density) * static_cast<double>(o.area);
     v += w;
     nx += w * static_cast<double>(dx * inv);
     ny += w * static_cast<double>(dy * inv);
     nz += w * static_cast<double>(dz * inv);
+    gx += g * static_cast<double>(dx * inv);
+    gy += g * static_cast<double>(dy * inv);
+    gz += g * static_cast<double>(dz * inv);
     cx += w * static_cast<double>(a.x + dx * inv * off);
     cy += w * static_cast<double>(a.y + dy * inv * off);
     cz += w * static_cast<double>(a.z + dz * inv * off);
@@ -70,7 +78,7 @@ const TimeCriticalResult& TimeCriticalQuery::run(const SphereTree& a, const Sphe
     const float lens = lens_volume(std::sqrt(d2), A.radius, B.radius);
     if (leaf_pair) {
       if (lens > 0.f) {
-        exact.add(A, x, y, z, B.radius, lens);
+        exact.add(A, x, y, z, B.radius, lens, 1.f);
         ++stats.overlapping_pairs;
       }
       return;
@@ -108,13 +116,15 @@ const TimeCriticalResult& TimeCriticalQuery::run(const SphereTree& a, const Sphe
 
   // the waiting pairs' share, summed afresh (no drift from incremental add/subtract)
   Sums pending;
-  for (const HeapEntry& e : heap_) pending.add(na[e.a], e.bx, e.by, e.bz, nb[e.b].radius, e.key);
+  for (const HeapEntry& e : heap_)
+    pending.add(na[e.a], e.bx, e.by, e.bz, nb[e.b].radius, e.key, density_a[e.a] * density_b[e.b]);
   TimeCriticalResult& r = result_;
   r.exact_volume = exact.v;
   r.pending_volume = pending.v;
   r.volume_estimate = exact.v + pending.v;
   r.weighted_normal_sum = {exact.nx + pending.nx, exact.ny + pending.ny, exact.nz + pending.nz};
   r.restoring_direction = normalized(r.weighted_normal_sum);
+  r.volume_gradient = -Vec3{exact.gx + pending.gx, exact.gy + pending.gy, exact.gz + pending.gz};
   if (r.volume_estimate > 0.0)
     r.volume_centroid = Vec3{exact.cx + pending.cx, exact.cy + pending.cy, exact.cz + pending.cz} / r.volume_estimate;
   r.exact = heap_.empty();

@@ -24,9 +24,10 @@ ForceController::ForceController(collette::ObjectId tool, const forcecomp::Force
 
 ForceController::~ForceController() = default;
 
-void ForceController::add_watched(collette::ObjectId object) {
+void ForceController::add_watched(collette::ObjectId object, double coverage_product) {
   auto w = std::make_unique<Watched>();
   w->object = object;
+  w->coverage_product = coverage_product;
   watched_.push_back(std::move(w));
 }
 
@@ -78,7 +79,7 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
         w->world_from_object = frame.world_from_a;
         if (!options_.multi_rate) {
           // held-force mode: the frame's own force, kept until the next frame
-          const auto r = component_.evaluate(frame, tool_motion);
+          const auto r = component_.evaluate(frame, tool_motion, {}, w->coverage_product);
           w->held_wrench = r.wrench;
           w->held_pairs = r.pair_count;
         }
@@ -91,7 +92,8 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
     if (w->held.empty()) continue;
     oldest_data_s = std::min(oldest_data_s, w->held.time_s());
     if (options_.multi_rate) {
-      const auto r = component_.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion);
+      const auto r = component_.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
+                                         w->coverage_product);
       contact.force += r.wrench.force;
       contact.torque += r.wrench.torque;
       pairs += r.pair_count;

@@ -54,17 +54,20 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;
+  std::vector<double> object_coverages;
   for (const SceneObject& object : scene.objects) {
     auto tree = load_shape_tree(object.shape, cache, options.build_progress);
     if (!tree) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message)};
-    auto id = world.add_object({.tree = *tree, .world_from_object = object.pose, .name = object.name});
+    object_coverages.push_back(tree->coverage);
+    auto id = world.add_object({.tree = tree->tree, .world_from_object = object.pose, .name = object.name});
     if (!id) return id.error();
     object_ids.push_back(*id);
   }
   auto tool_tree = load_shape_tree(scene.tool.shape, cache, options.build_progress);
   if (!tool_tree) return Error{fmt::format("{}: tool '{}': {}", scene.source, scene.tool.name, tool_tree.error().message)};
   // the tool's pose comes from the device on the first haptic tick (BridgingController)
-  auto tool_id = world.add_object({.tree = *tool_tree, .has_initial_pose = false, .name = scene.tool.name});
+  auto tool_id =
+      world.add_object({.tree = tool_tree->tree, .has_initial_pose = false, .name = scene.tool.name});
   if (!tool_id) return tool_id.error();
   session->tool_id_ = *tool_id;
 
@@ -96,7 +99,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end()) continue;
     // the tool is B of every watched pair: the frames' forces push it out of the object
     if (auto w = world.add_collision_watcher(object_ids[i], session->tool_id_); !w) return w.error();
-    session->force_controller_->add_watched(object_ids[i]);
+    session->force_controller_->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage);
   }
   session->bridging_controller_ = std::make_unique<BridgingController>(
       world, session->tool_id_, scene.tool.workspace, session->force_controller_.get());

@@ -207,8 +207,9 @@ Status read_device(const FieldReader& r, const json& j, const std::string& path,
 
 Status read_force_params(const FieldReader& r, const json& j, const std::string& path, SceneTool& tool) {
   UH_CHECK(r.require_object(j, path));
-  UH_CHECK(r.check_keys(j, path, {"mode", "force_scale", "damping", "damping_full_volume", "mass_kg", "center_of_mass",
-                                  "max_force_n", "max_torque_nm"}));
+  UH_CHECK(r.check_keys(j, path,
+                        {"mode", "law", "stiffness", "force_scale", "damping", "damping_full_volume",
+                         "mass_kg", "center_of_mass", "max_force_n", "max_torque_nm"}));
   std::string mode = "6dof";
   UH_CHECK(r.string(j, path, "mode", mode, false));
   if (mode == "6dof") {
@@ -219,6 +220,27 @@ Status read_force_params(const FieldReader& r, const json& j, const std::string&
     return r.error(FieldReader::join(path, "mode"), fmt::format("expected \"3dof\" or \"6dof\", got \"{}\"", mode));
   }
   auto& f = tool.force;
+  std::string law = "gradient";
+  UH_CHECK(r.string(j, path, "law", law, false));
+  if (law == "gradient") {
+    f.law = forcecomp::ForceLaw::kGradient;
+  } else if (law == "paper") {
+    f.law = forcecomp::ForceLaw::kPaper;
+  } else {
+    return r.error(FieldReader::join(path, "law"),
+                   fmt::format("expected \"gradient\" or \"paper\", got \"{}\"", law));
+  }
+  // each law has its own stiffness in its own unit: a value meant for the other law would feel
+  // wrong by orders of magnitude, so it is refused rather than ignored
+  if (f.law == forcecomp::ForceLaw::kGradient && j.contains("force_scale"))
+    return r.error(
+        FieldReader::join(path, "force_scale"),
+        "is the paper law's stiffness [N/m^3]; the gradient law (the default) takes 'stiffness' [N/m^2] "
+        "(or set \"law\": \"paper\")");
+  if (f.law == forcecomp::ForceLaw::kPaper && j.contains("stiffness"))
+    return r.error(FieldReader::join(path, "stiffness"),
+                   "is the gradient law's stiffness [N/m^2]; the paper law takes 'force_scale' [N/m^3]");
+  UH_CHECK(r.number(j, path, "stiffness", f.stiffness, 0.0, 1e12));
   UH_CHECK(r.number(j, path, "force_scale", f.force_scale, 0.0, 1e15));
   UH_CHECK(r.number(j, path, "damping", f.damping, 0.0, 1e6));
   UH_CHECK(r.number(j, path, "damping_full_volume", f.damping_full_volume, 0.0, 1.0));
@@ -435,10 +457,10 @@ Result<Scene> default_scene(const std::filesystem::path& cache_dir) {
   return parse_scene(embedded::default_scene_json(), "<embedded default scene>", file->parent_path());
 }
 
-Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(
+Result<ShapeTree> load_shape_tree(
     const SceneShape& shape, const std::filesystem::path& cache_dir,
     const std::function<void(const std::string& what, double fraction)>& progress) {
-  if (shape.tree) return shape.tree;
+  if (shape.tree) return ShapeTree{shape.tree, shape.coverage};
   collette::IstAsset asset;
   if (!shape.ist.empty()) {
     auto loaded = collette::load_ist(shape.ist);
@@ -467,7 +489,9 @@ Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(
     }
   }
   const double scale = shape.ist.empty() ? shape.meters_per_unit : asset.meta.meters_per_unit;
-  return std::make_shared<const collette::SphereTree>(collette::scale_sphere_tree(asset.tree, scale));
+  return ShapeTree{
+      std::make_shared<const collette::SphereTree>(collette::scale_sphere_tree(asset.tree, scale)),
+      asset.meta.coverage};
 }
 
 }  // namespace uh::controllers

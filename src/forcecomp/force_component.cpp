@@ -14,9 +14,13 @@ BodyMotion ForceComponent::body_motion(const Pose& world_from_body, const Vec3& 
   return m;
 }
 
-PenaltyInput ForceComponent::penalty_input(const BodyMotion& self, const BodyMotion& other) const {
+PenaltyInput ForceComponent::penalty_input(const BodyMotion& self, const BodyMotion& other,
+                                           double coverage_product) const {
   PenaltyInput in;
+  in.law = options_.params.law;
+  in.stiffness = options_.params.stiffness;
   in.force_scale = options_.params.force_scale;
+  in.coverage_product = coverage_product;
   in.damping = options_.params.damping;
   in.damping_full_volume = options_.params.damping_full_volume;
   in.mode = options_.mode;
@@ -27,18 +31,19 @@ PenaltyInput ForceComponent::penalty_input(const BodyMotion& self, const BodyMot
 }
 
 PenaltyResult ForceComponent::evaluate(std::span<const SpherePairContact> pairs, const BodyMotion& self,
-                                       const BodyMotion& other) const {
-  return evaluate_penalty(pairs, penalty_input(self, other));
+                                       const BodyMotion& other, double coverage_product) const {
+  return evaluate_penalty(pairs, penalty_input(self, other, coverage_product));
 }
 
 PenaltyResult ForceComponent::evaluate(const ContactFrame& frame, const BodyMotion& self,
-                                       const BodyMotion& other) const {
-  return evaluate_penalty(frame, penalty_input(self, other));
+                                       const BodyMotion& other, double coverage_product) const {
+  return evaluate_penalty(frame, penalty_input(self, other, coverage_product));
 }
 
-PenaltyResult ForceComponent::evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
-                                       const BodyMotion& self, const BodyMotion& other) const {
-  return held.evaluate(world_from_a, world_from_b, penalty_input(self, other));
+PenaltyResult ForceComponent::evaluate(HeldContactSet& held, const Pose& world_from_a,
+                                       const Pose& world_from_b, const BodyMotion& self,
+                                       const BodyMotion& other, double coverage_product) const {
+  return held.evaluate(world_from_a, world_from_b, penalty_input(self, other, coverage_product));
 }
 
 }  // namespace uh::forcecomp

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "penalty_terms.hpp"
 #include "uh/core/sphere_overlap.hpp"
 
 namespace uh::forcecomp {
@@ -155,24 +156,17 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   };
   const BodyMotion tool = to_a(input.tool);
   const BodyMotion other = to_a(input.other);
-  const double sign = input.tool_side == ContactSide::kB ? 1.0 : -1.0;
-  const double damping_per_volume = input.damping / std::max(total, damping_full_volume(input));
-  const bool six_dof = input.mode == ForceMode::k6Dof;
-  Vec3 force{};
-  Vec3 torque{};
+  detail::PenaltySum sum(input, total, tool, other);
   for (std::int32_t k = 0; k < local_count_; ++k) {
     const LocalPair& p = local_[static_cast<std::size_t>(k)];
     ++result.pair_count;
-    const Vec3 n = sign * Vec3{static_cast<double>(p.nx), static_cast<double>(p.ny), static_cast<double>(p.nz)};
-    const Vec3 c{static_cast<double>(p.cx), static_cast<double>(p.cy), static_cast<double>(p.cz)};
-    const double volume = static_cast<double>(p.volume);
-    const double vel = dot(tool.point_velocity(c) - other.point_velocity(c), n);
-    const double f = input.force_scale * volume - damping_per_volume * vel * volume;
-    if (!(f > 0.0)) continue;  // never pull the objects together
-    ++result.pushing_pairs;
-    force += f * n;
-    if (six_dof) torque += cross(c - tool.center_of_mass_world, f * n);
+    sum.add(static_cast<double>(p.volume), static_cast<double>(p.area),
+            Vec3{static_cast<double>(p.nx), static_cast<double>(p.ny), static_cast<double>(p.nz)},
+            Vec3{static_cast<double>(p.cx), static_cast<double>(p.cy), static_cast<double>(p.cz)});
   }
+  result.pushing_pairs = sum.pushing_pairs;
+  const Vec3& force = sum.force;
+  const Vec3& torque = sum.torque;
   result.wrench.force = rotate(world_from_a.rotation, force);
   result.wrench.torque = rotate(world_from_a.rotation, torque);
   return result;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "penalty_terms.hpp"
+
 namespace uh::forcecomp {
 
 namespace {
@@ -24,23 +26,15 @@ PenaltyResult evaluate_penalty(std::span<const SpherePairContact> pairs, const P
   result.total_volume = total;
   if (!(total > 0.0)) return result;
 
-  const double sign = input.tool_side == ContactSide::kB ? 1.0 : -1.0;
-  const double damping_per_volume = input.damping / std::max(total, damping_full_volume(input));
-  const bool six_dof = input.mode == ForceMode::k6Dof;
+  detail::PenaltySum sum(input, total, input.tool, input.other);
   for (const SpherePairContact& p : pairs) {
     const double vol = static_cast<double>(p.volume);
     if (!(vol > 0.0) || !std::isfinite(vol)) continue;
     ++result.pair_count;
-    const Vec3 n = sign * to_vec3(p.normal_world);  // out of the other object, for the tool
-    const Vec3 c = to_vec3(p.centroid_world);
-    const double vel = dot(input.tool.point_velocity(c) - input.other.point_velocity(c), n);
-    const double f = input.force_scale * vol - damping_per_volume * vel * vol;
-    if (!(f > 0.0)) continue;  // never pull the objects together
-    ++result.pushing_pairs;
-    const Vec3 fij = f * n;
-    result.wrench.force += fij;
-    if (six_dof) result.wrench.torque += cross(c - input.tool.center_of_mass_world, fij);
+    sum.add(vol, static_cast<double>(p.area), to_vec3(p.normal_world), to_vec3(p.centroid_world));
   }
+  result.wrench = {sum.force, sum.torque};
+  result.pushing_pairs = sum.pushing_pairs;
   return result;
 }
 

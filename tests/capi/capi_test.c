@@ -85,7 +85,7 @@ static uh_scene* small_scene(void) {
   REQUIRE_OK(uh_scene_add_object(scene, &bunny, NULL));
   tool.name = "stylus";
   tool.shape = mesh_shape("stylus.obj", 150);
-  tool.force_scale = 8.0e6;
+  tool.stiffness = 1.6e4;
   tool.damping = 1.0;
   tool.center_of_mass[2] = 0.025;
   tool.max_force_n = 6.0;
@@ -94,6 +94,13 @@ static uh_scene* small_scene(void) {
   tool.device_config_json =
       "{\"start\": [0, 0, 0.10], \"end\": [0, 0, 0.045], \"duration_s\": 0.5, \"bounce\": true,"
       " \"dof_actuated\": 6, \"max_force_n\": 6}";
+  CHECK(tool.law == UH_FORCE_LAW_GRADIENT); /* the default law */
+  tool.law = 7;
+  CHECK_STATUS(uh_scene_set_tool(scene, &tool), UH_ERROR_INVALID_ARGUMENT);
+  tool.law = UH_FORCE_LAW_GRADIENT;
+  tool.stiffness = -1.0;
+  CHECK_STATUS(uh_scene_set_tool(scene, &tool), UH_ERROR_INVALID_ARGUMENT);
+  tool.stiffness = 1.6e4;
   REQUIRE_OK(uh_scene_set_tool(scene, &tool));
   return scene;
 }

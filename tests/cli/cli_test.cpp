@@ -112,6 +112,21 @@ double brute_volume(const collette::SphereTree& a, const collette::SphereTree& b
   return v;
 }
 
+// d(brute_volume)/d(translation of B) by central differences
+Vec3 brute_volume_gradient(const collette::SphereTree& a, const collette::SphereTree& b, const Pose& b_in_a,
+                           double h) {
+  Vec3 g;
+  for (int axis = 0; axis < 3; ++axis) {
+    Vec3 e{};
+    (axis == 0 ? e.x : axis == 1 ? e.y : e.z) = h;
+    const double d = (brute_volume(a, b, {b_in_a.rotation, b_in_a.position + e}) -
+                      brute_volume(a, b, {b_in_a.rotation, b_in_a.position - e})) /
+                     (2 * h);
+    (axis == 0 ? g.x : axis == 1 ? g.y : g.z) = d;
+  }
+  return g;
+}
+
 TEST_F(CliTest, IstBuildPrintsTheDocumentedFieldsAndInfoAgrees) {
   const fs::path ist = dir_ / "build.ist", png = dir_ / "build.png";
   const CommandRun r = uh(fmt::format("ist build '{}' -o '{}' --spheres 400 --preview '{}' --json",
@@ -157,7 +172,7 @@ TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
   std::ifstream in(csv);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "id,volume,nx,ny,nz,pairs,distance,time_us");
+  EXPECT_EQ(line, "id,volume,nx,ny,nz,pairs,distance,time_us,volume_estimate");
   const auto asset = collette::load_ist(ist);
   ASSERT_TRUE(asset.has_value());
   std::vector<std::string> ids;
@@ -165,7 +180,7 @@ TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
     std::vector<std::string> f;
     std::stringstream s(line);
     for (std::string cell; std::getline(s, cell, ',');) f.push_back(cell);
-    ASSERT_EQ(f.size(), 8u) << line;
+    ASSERT_EQ(f.size(), 9u) << line;
     ids.push_back(f[0]);
     const double volume = std::stod(f[1]);
     const Vec3 n{std::stod(f[2]), std::stod(f[3]), std::stod(f[4])};
@@ -173,6 +188,7 @@ TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
     if (f[0] == "far") {
       EXPECT_EQ(volume, 0.0);
       EXPECT_EQ(norm(n), 0.0);
+      EXPECT_EQ(std::stod(f[8]), 0.0);
       EXPECT_GT(distance, 35.0);  // 50 apart, the bunny is about 10 units wide
       continue;
     }
@@ -185,10 +201,16 @@ TEST_F(CliTest, QueryMatchesBruteForceAndWritesTheDocumentedCsv) {
     EXPECT_NEAR(norm(n), 1.0, 1e-6) << line;
     EXPECT_EQ(distance, 0.0) << line;
     EXPECT_GT(std::stoll(f[5]), 0) << line;
-    // B's copy is shifted along x: the restoring direction pushes it further that way
+    // nx, ny, nz: the direction of the gradient law's force on B, minus the volume's gradient
+    const Vec3 expected_direction = normalized(-brute_volume_gradient(asset->tree, asset->tree, pose, 1e-3));
+    EXPECT_GT(dot(n, expected_direction), std::cos(0.5 * kPi / 180.0)) << line;
+    // B's copy is shifted along x: the force pushes it further that way
     if (std::abs(x) > 1.0) {
       EXPECT_GT(n.x * x, 0.0) << line;
     }
+    // the coverage-calibrated estimate of the meshes' overlap
+    EXPECT_NEAR(std::stod(f[8]), volume / (asset->meta.coverage * asset->meta.coverage), 1e-6 * volume)
+        << line;
   }
   EXPECT_EQ(ids, (std::vector<std::string>{"p0", "p1", "p2", "p3", "p4", "far"}));
 }
@@ -210,6 +232,7 @@ TEST_F(CliTest, QueryJsonSummaryAndCoherentPathGiveTheSameResults) {
     const auto& a = jp["results"][i];
     const auto& b = jc["results"][i];
     EXPECT_EQ(a["pairs"], b["pairs"]) << i;
+    for (const char* key : {"nx", "ny", "nz", "volume_estimate"}) EXPECT_TRUE(a.contains(key)) << key;
     EXPECT_NEAR(a["volume"].get<double>(), b["volume"].get<double>(),
                 1e-12 + 1e-9 * a["volume"].get<double>())
         << i;

@@ -43,7 +43,7 @@ std::string long_scene_json(const fs::path& assets) {
                 "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
   "tool": {{
     "name": "stylus", "mesh": "{0}/meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
-    "force": {{ "mode": "6dof", "force_scale": 8.0e6, "damping": 1.0, "center_of_mass": [0, 0, 0.025],
+    "force": {{ "mode": "6dof", "stiffness": 1.6e4, "damping": 1.0, "center_of_mass": [0, 0, 0.025],
                "max_force_n": 6.0, "max_torque_nm": 0.3 }},
     "device": {{ "driver": "sim-line",
                 "config": {{ "start": [0.0, 0.0, 0.07], "end": [0.0, 0.0, 0.045], "duration_s": 0.3, "bounce": true,

@@ -32,6 +32,7 @@ TEST(TimeCriticalQuery, UnboundedEqualsVolumeQuery) {
     EXPECT_NEAR(r.volume_estimate, e.total_volume, 1e-5 * e.total_volume + 1e-12) << "pose " << k;
     EXPECT_EQ(r.stats.overlapping_pairs, e.stats.overlapping_pairs);
     EXPECT_LT(norm(r.weighted_normal_sum - e.weighted_normal_sum), 1e-4 * e.total_volume + 1e-12);
+    EXPECT_LT(norm(r.volume_gradient - e.volume_gradient), 1e-4 * norm(e.volume_gradient) + 1e-12);
     if (e.total_volume > 0.0) {
       EXPECT_LT(norm(r.volume_centroid - e.volume_centroid), 1e-4);
     }
@@ -78,6 +79,9 @@ TEST(TimeCriticalQuery, ConvergesAsTheBudgetGrows) {
   // the direction converges too
   const TimeCriticalResult& r = tc.run(*ta, *ta, pose, {.max_expansions = full / 4});
   EXPECT_GT(dot(r.restoring_direction, e.restoring_direction), std::cos(10.0 * kPi / 180.0));
+  // and so does the direction of the gradient law's force
+  EXPECT_GT(dot(normalized(-r.volume_gradient), normalized(-e.volume_gradient)),
+            std::cos(10.0 * kPi / 180.0));
 }
 
 TEST(TimeCriticalQuery, TimeBudgetStopsEarly) {

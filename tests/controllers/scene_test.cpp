@@ -33,10 +33,21 @@ TEST(Scene, ParsesTheSmallTestScene) {
   EXPECT_NEAR(scene->objects[0].pose.rotation.x, std::sqrt(0.5), 1e-6);
   EXPECT_EQ(scene->tool.device.driver, "sim-line");
   EXPECT_EQ(scene->tool.device.config.text("end", ""), "0,0,0.045");
-  EXPECT_DOUBLE_EQ(scene->tool.force.force_scale, 8.0e6);
+  EXPECT_EQ(scene->tool.force.law, forcecomp::ForceLaw::kGradient) << "the gradient law is the default";
+  EXPECT_DOUBLE_EQ(scene->tool.force.stiffness, 1.6e4);
   EXPECT_EQ(scene->watch, std::vector<std::string>{"bunny"});
   EXPECT_TRUE(scene->force.multi_rate);
   EXPECT_DOUBLE_EQ(scene->coherence_skin, 0.0) << "coherence is off unless a scene asks for it";
+}
+
+TEST(Scene, ReadsThePaperLawWithItsForceScale) {
+  const auto scene =
+      parse_scene(replaced(replaced(small_scene_json(), R"("stiffness": 1.6e4)", R"("force_scale": 8.0e6)"),
+                           R"("mode": "6dof")", R"("mode": "6dof", "law": "paper")"),
+                  "small.json", test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  EXPECT_EQ(scene->tool.force.law, forcecomp::ForceLaw::kPaper);
+  EXPECT_DOUBLE_EQ(scene->tool.force.force_scale, 8.0e6);
 }
 
 TEST(Scene, ReadsTheCollisionSection) {
@@ -70,6 +81,18 @@ TEST(Scene, ReportsFileFieldAndExpectation) {
   with_base(replaced(good, R"("rotation": [0.70710678, 0.70710678, 0, 0])", R"("rotation": [0, 0, 0, 0])"),
             "field 'objects[0].pose.rotation': expected a non-zero quaternion");
   with_base(replaced(good, R"("mode": "6dof")", R"("mode": "7dof")"), "field 'tool.force.mode': expected \"3dof\" or \"6dof\"");
+  with_base(replaced(good, R"("mode": "6dof")", R"("mode": "6dof", "law": "volume")"),
+            "field 'tool.force.law': expected \"gradient\" or \"paper\", got \"volume\"");
+  // a stiffness meant for the other law is refused, not ignored (its unit differs)
+  with_base(
+      replaced(good, R"("stiffness": 1.6e4)", R"("force_scale": 8.0e6)"),
+      "field 'tool.force.force_scale': is the paper law's stiffness [N/m^3]; the gradient law (the default) "
+      "takes 'stiffness' [N/m^2]");
+  with_base(replaced(good, R"("mode": "6dof")", R"("mode": "6dof", "law": "paper")"),
+            "field 'tool.force.stiffness': is the gradient law's stiffness [N/m^2]; the paper law takes "
+            "'force_scale'");
+  with_base(replaced(good, R"("stiffness": 1.6e4)", R"("stiffness": -1)"),
+            "field 'tool.force.stiffness': expected a number in [0,");
   with_base(replaced(good, R"("watch": ["bunny"])", R"("watch": ["dragon"])"), "field 'watch[0]': no object is named 'dragon'");
   with_base(replaced(good, R"("driver": "sim-line",)", R"("driver": 7,)"), "field 'tool.device.driver': expected a non-empty string");
   with_base(replaced(good, R"("mesh": "meshes/stylus.obj",)", R"("mesh": "meshes/stylus.obj", "ist": "x.ist",)"),
@@ -143,13 +166,17 @@ TEST(Scene, ShapeTreesAreBuiltOnceThenLoadedFromTheCacheInMetres) {
   for (const auto& entry : std::filesystem::directory_iterator(cache)) files += entry.path().extension() == ".ist";
   EXPECT_EQ(files, 1);
   // stylus: 5 cm long capsule of radius 4 mm; the root sphere encloses it
-  EXPECT_NEAR((*first)->root().radius, 0.025, 0.003);
+  EXPECT_NEAR(first->tree->root().radius, 0.025, 0.003);
+  // the packing's coverage travels with the tree (the gradient force law is calibrated by it)
+  EXPECT_GT(first->coverage, 0.3);
+  EXPECT_LT(first->coverage, 1.0);
 
   progress_calls = 0;
   const auto second = load_shape_tree(shape, cache, [&](const std::string&, double) { ++progress_calls; });
   ASSERT_TRUE(second.has_value());
   EXPECT_EQ(progress_calls, 0) << "the cached .ist is loaded, not rebuilt";
-  EXPECT_EQ((*second)->leaf_count(), (*first)->leaf_count());
+  EXPECT_EQ(second->tree->leaf_count(), first->tree->leaf_count());
+  EXPECT_EQ(second->coverage, first->coverage);
 
   // a corrupted cache file is rebuilt, not trusted
   for (const auto& entry : std::filesystem::directory_iterator(cache)) {

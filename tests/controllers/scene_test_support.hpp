@@ -45,7 +45,7 @@ inline std::string small_scene_json(bool multi_rate = true, bool coupling = fals
     "mesh": "meshes/stylus.obj",
     "meters_per_unit": 0.01,
     "spheres": 150,
-    "force": {{ "mode": "6dof", "force_scale": 8.0e6, "damping": 1.0, "center_of_mass": [0, 0, 0.025],
+    "force": {{ "mode": "6dof", "stiffness": 1.6e4, "damping": 1.0, "center_of_mass": [0, 0, 0.025],
                "max_force_n": 6.0, "max_torque_nm": 0.3 }},
     "device": {{ "driver": "sim-line",
                 "config": {{ "start": [0.0, 0.0, 0.10], "end": [0.0, 0.0, 0.045], "duration_s": 0.5, "bounce": true,
@@ -54,7 +54,8 @@ inline std::string small_scene_json(bool multi_rate = true, bool coupling = fals
   "watch": ["bunny"],
   "force": {{ "multi_rate": {multi_rate}, "coupling": {{ "enabled": {coupling}, "stiffness": 800, "damping": 0.2 }} }}
 }})",
-                     fmt::arg("collision_hz", collision_hz), fmt::arg("multi_rate", multi_rate ? "true" : "false"),
+                     fmt::arg("collision_hz", collision_hz),
+                     fmt::arg("multi_rate", multi_rate ? "true" : "false"),
                      fmt::arg("coupling", coupling ? "true" : "false"));
 }
 

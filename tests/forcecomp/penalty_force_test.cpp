@@ -29,6 +29,7 @@ TEST(PenaltyForce, SphereSphereForceMatchesHandComputedValue) {
   const SpherePairContact pair = unit_pair();
   ASSERT_NEAR(pair.volume, kHandVolume, 1e-6);
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   in.tool.center_of_mass_world = {1.5, 0, 0};
   const PenaltyResult r = evaluate_penalty(std::span(&pair, 1), in);
@@ -48,6 +49,7 @@ TEST(PenaltyForce, TorqueMatchesHandComputedLever) {
   // below the centre of mass turns the tool about +z with torque f * 1
   ASSERT_NEAR(pair.centroid_world[0], 0.75, 1e-6);
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   in.tool.center_of_mass_world = {1.5, 1.0, 0};
   const PenaltyResult r6 = evaluate_penalty(std::span(&pair, 1), in);
@@ -65,6 +67,7 @@ TEST(PenaltyForce, TorqueMatchesHandComputedLever) {
 TEST(PenaltyForce, ToolOnSideAGetsTheOppositeForce) {
   const SpherePairContact pair = unit_pair();
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   in.tool_side = ContactSide::kA;
   const PenaltyResult r = evaluate_penalty(std::span(&pair, 1), in);
@@ -77,6 +80,7 @@ TEST(PenaltyForce, DampingTermIsVolumeWeightedShareOfEpsD) {
   const SpherePairContact p2 = make_pair(sphere(0, 5, 0, 1), Pose{}, sphere(1.8, 5, 0, 1), Pose{});
   const std::vector<SpherePairContact> pairs{p1, p2};
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   in.damping = 50.0;
   in.tool.linear_velocity_world = {-0.1, 0, 0};  // pushing further in
@@ -99,6 +103,7 @@ TEST(PenaltyForce, DampingFullVolumeRampsTheDampingUpFromContact) {
   // one unit sphere pushed into another along x at 0.1 per second, deeper and deeper: the
   // damping part of the force against the overlap volume
   PenaltyInput paper;
+  paper.law = ForceLaw::kPaper;
   paper.force_scale = 100.0;
   paper.damping = 50.0;
   paper.tool.linear_velocity_world = {-0.1, 0, 0};
@@ -135,6 +140,7 @@ TEST(PenaltyForce, DampingFullVolumeRampsTheDampingUpFromContact) {
 TEST(PenaltyForce, NeverPullsWhenSeparatingFast) {
   const SpherePairContact pair = unit_pair();
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   in.damping = 1000.0;
   in.tool.linear_velocity_world = {10.0, 0, 0};
@@ -156,6 +162,7 @@ TEST(PenaltyForce, ForcePushesObjectsApart) {
     if (!(p.volume > 0.f) || norm(test::centre_of(b) - test::centre_of(a)) < 1e-3) continue;
     ++tested;
     PenaltyInput in;
+    in.law = ForceLaw::kPaper;
     in.force_scale = 10.0;
     const Vec3 a_to_b = test::centre_of(b) - test::centre_of(a);
     EXPECT_GT(dot(evaluate_penalty(std::span(&p, 1), in).wrench.force, a_to_b), 0.0);
@@ -170,6 +177,7 @@ TEST(PenaltyForce, SkipsNonFiniteAndEmptyPairs) {
   pairs[1].volume = std::numeric_limits<float>::quiet_NaN();
   pairs[2].volume = 0.f;
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   const PenaltyResult r = evaluate_penalty(pairs, in);
   EXPECT_EQ(r.pair_count, 1);
@@ -183,13 +191,14 @@ TEST(PenaltyForce, ContactFrameOverloadUsesValidPairsOnly) {
   frame->pairs[1] = unit_pair();  // present in storage but beyond pair_count
   frame->pair_count = 1;
   PenaltyInput in;
+  in.law = ForceLaw::kPaper;
   in.force_scale = 100.0;
   EXPECT_NEAR(evaluate_penalty(*frame, in).wrench.force.x, 100.0 * kHandVolume, 1e-4);
 }
 
 // A small sphere dropped under gravity on a large static sphere, integrated with the penalty force:
 // returns the apex height after the first bounce.
-double bounce_apex(double damping) {
+double bounce_apex(double damping, ForceLaw law = ForceLaw::kPaper) {
   const Sphere ground = sphere(0, -1, 0, 1);  // top at y = 0
   const double r = 0.05;
   const double mass = 0.1;
@@ -201,7 +210,9 @@ double bounce_apex(double damping) {
   bool left = false;
   double apex = -1.0;
   ForceComponentOptions options;
+  options.params.law = law;
   options.params.force_scale = 1e7;
+  options.params.stiffness = 3e4;  // a spring of about 2 pi r_eff k = 9 N/mm at this sphere pair
   options.params.damping = damping;
   options.mode = ForceMode::k3Dof;
   const ForceComponent tool(options);
@@ -233,6 +244,13 @@ TEST(PenaltyForce, DampingRemovesEnergyInBouncingSphere) {
   // damping loses energy: m g h falls
   EXPECT_GT(damped, 0.0);
   EXPECT_LT(damped, 0.9 * undamped);
+  // the same with the gradient law (minus the gradient of k * overlap volume: conservative too)
+  const double undamped_gradient = bounce_apex(0.0, ForceLaw::kGradient);
+  const double damped_gradient = bounce_apex(3.0, ForceLaw::kGradient);
+  EXPECT_GT(undamped_gradient, 0.97 * start);
+  EXPECT_LT(undamped_gradient, 1.01 * start);
+  EXPECT_GT(damped_gradient, 0.0);
+  EXPECT_LT(damped_gradient, 0.9 * undamped_gradient);
 }
 
 TEST(ForceComponent, BodyMotionShiftsVelocityToCentreOfMass) {

@@ -33,7 +33,7 @@ inline std::filesystem::path write_small_scene(const std::filesystem::path& dir)
                 "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
   "tool": {{
     "name": "stylus", "mesh": "{stylus}", "meters_per_unit": 0.01, "spheres": 120,
-    "force": {{ "mode": "6dof", "force_scale": 8.0e6, "damping": 1.0, "max_force_n": 6.0, "max_torque_nm": 0.3 }},
+    "force": {{ "mode": "6dof", "stiffness": 1.6e4, "damping": 1.0, "max_force_n": 6.0, "max_torque_nm": 0.3 }},
     "device": {{ "driver": "sim-line",
                 "config": {{ "start": [0.0, 0.0, 0.10], "end": [0.0, 0.0, 0.045], "duration_s": 0.5, "bounce": true }} }}
   }}

@@ -8,8 +8,9 @@
 /// with the largest expected overlap first (splitting the larger sphere, like VolumeQuery); leaf
 /// pairs are resolved exactly at once. When the budget ends the estimate is
 /// `exact part + sum of the waiting pairs' expected overlaps`; when the heap drains (unbounded
-/// budget) the estimate is the exact VolumeQuery result. The direction and centroid are estimated
-/// the same way (waiting pairs along their centre line, at their bounding-sphere lens centroid).
+/// budget) the estimate is the exact VolumeQuery result. The direction, the volume gradient and the
+/// centroid are estimated the same way (waiting pairs along their centre line, at their
+/// bounding-sphere lens centroid).
 
 #include <cstdint>
 #include <limits>
@@ -40,6 +41,11 @@ struct TimeCriticalResult {
   double pending_volume = 0.0;    ///< expected overlap of the pairs still waiting [length^3]
   Vec3 weighted_normal_sum{};     ///< estimate of sum(volume * normal), A frame [length^3]
   Vec3 restoring_direction{};     ///< unit weighted_normal_sum; zero if none
+  /// Estimate of d(volume)/d(translation of B), A frame [length^2]: -sum(pi a^2 normal) over the
+  /// resolved leaf pairs plus, for each waiting node pair, density(a) density(b) times its bounding
+  /// spheres' disk area along their centre line. Equals VolumeQuery's volume_gradient when exact;
+  /// its negation is the direction of the gradient force law.
+  Vec3 volume_gradient{};
   Vec3 volume_centroid{};         ///< estimate of the volume centroid, A frame [length]; zero if none
   bool exact = false;             ///< the heap drained: the estimate is the exact result
   std::int64_t pending_pairs = 0; ///< node pairs left in the heap

@@ -51,7 +51,7 @@ struct ForceControllerStats {
 ///
 /// On the collision thread, on_collision() copies each frame about the tool into a lock-free
 /// LatestValue per watched pair. On the haptic thread, on_force() takes the newest frame, holds its
-/// pairs, evaluates the volumetric penalty force and torque on the tool (ForceComponent, eq. 1-2),
+/// pairs, evaluates the volumetric penalty force and torque on the tool (ForceComponent, its law),
 /// optionally through a virtual coupling, applies ForceSafety (NaN guard, watchdog on the age of
 /// the contact data) and adds the result, in the device frame, to the command; the manager's
 /// limit chain bounds the sum.
@@ -67,8 +67,10 @@ class ForceController {
   ForceController(const ForceController&) = delete;
   ForceController& operator=(const ForceController&) = delete;
 
-  /// Takes forces from the watched pair (object, tool) of the world. Controlling thread, before bind().
-  void add_watched(collette::ObjectId object);
+  /// Takes forces from the watched pair (object, tool) of the world. `coverage_product` is the
+  /// product of the object's and the tool's packing coverages (forcecomp::PenaltyInput), by which
+  /// the gradient law is calibrated. Controlling thread, before bind().
+  void add_watched(collette::ObjectId object, double coverage_product = 1.0);
 
   /// Connects to the world's OnCollision and the manager's ForceOnHapticTick. The coupling's proxy
   /// is placed at the handle on the first tick. Controlling thread, before the threads start.
@@ -93,6 +95,7 @@ class ForceController {
  private:
   struct Watched {
     collette::ObjectId object = -1;
+    double coverage_product = 1.0;             // c_object * c_tool
     LatestValue<ContactFrame> inbox;           // collision thread -> haptic thread
     forcecomp::HeldContactSet held;            // haptic thread
     Pose world_from_object{};                  // object pose used by the held frame's query

@@ -28,6 +28,9 @@ struct SceneShape {
   std::filesystem::path mesh{};      ///< mesh file (absolute after loading), or empty when `ist` or `tree` is set
   std::filesystem::path ist{};       ///< prebuilt .ist file, or empty
   std::shared_ptr<const collette::SphereTree> tree{};  ///< a tree in metres, shared; used as it is when set
+  /// With `tree`: its packing's coverage (sphere volume / mesh volume, (0, 1]), which calibrates the
+  /// gradient force law; 1 when unknown. Meshes and .ist files bring their own.
+  double coverage = 1.0;
   std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
   double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
 };
@@ -103,10 +106,17 @@ Result<std::filesystem::path> write_default_scene(const std::filesystem::path& c
 /// system temp directory.
 std::filesystem::path default_cache_dir();
 
+/// A shape's tree in metres with its packing's coverage (sphere volume / mesh volume, (0, 1]).
+struct ShapeTree {
+  std::shared_ptr<const collette::SphereTree> tree;
+  double coverage = 1.0;
+};
+
 /// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the
-/// mesh file's hash and the sphere count), building and caching it on first use. `progress` gets
+/// mesh file's hash and the sphere count), building and caching it on first use; the coverage
+/// comes from the .ist metadata (SceneShape::coverage for a tree in memory). `progress` gets
 /// the packing progress when a build is needed. Setup only.
-Result<std::shared_ptr<const collette::SphereTree>> load_shape_tree(
+Result<ShapeTree> load_shape_tree(
     const SceneShape& shape, const std::filesystem::path& cache_dir,
     const std::function<void(const std::string& what, double fraction)>& progress = {});
 

@@ -41,18 +41,22 @@ class ForceComponent {
                          const Vec3& angular_velocity_world) const;
 
   /// Force and torque on this object from a pair list with world-frame normals and centroids.
-  /// `other` is the other object's motion (default: static).
+  /// `other` is the other object's motion (default: static). `coverage_product` is c_A c_B of the
+  /// two packings (PenaltyInput::coverage_product; 1: uncalibrated), which the gradient law divides by.
   PenaltyResult evaluate(std::span<const SpherePairContact> pairs, const BodyMotion& self,
-                         const BodyMotion& other = {}) const;
+                         const BodyMotion& other = {}, double coverage_product = 1.0) const;
   /// Same from a whole ContactFrame (at the poses the query used).
-  PenaltyResult evaluate(const ContactFrame& frame, const BodyMotion& self, const BodyMotion& other = {}) const;
+  PenaltyResult evaluate(const ContactFrame& frame, const BodyMotion& self, const BodyMotion& other = {},
+                         double coverage_product = 1.0) const;
   /// Multi-rate: re-evaluates a held pair set at the current poses of A and B and computes the
   /// force (HeldContactSet::evaluate). `held` is not const: it writes its preallocated scratch.
   PenaltyResult evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
-                         const BodyMotion& self, const BodyMotion& other = {}) const;
+                         const BodyMotion& self, const BodyMotion& other = {},
+                         double coverage_product = 1.0) const;
 
-  /// The PenaltyInput this component uses for the given motions.
-  PenaltyInput penalty_input(const BodyMotion& self, const BodyMotion& other) const;
+  /// The PenaltyInput this component uses for the given motions and packings.
+  PenaltyInput penalty_input(const BodyMotion& self, const BodyMotion& other,
+                             double coverage_product = 1.0) const;
 
  private:
   ForceComponentOptions options_{};
