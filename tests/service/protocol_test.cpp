@@ -164,10 +164,10 @@ TEST_F(SceneDocumentTest, EditsGoThroughTheSceneParser) {
   EXPECT_EQ(doc_->scene().tool.device.driver, "sim-circle");
 
   // set_tool merges: the damping changes, the stiffness and the device stay
-  const double stiffness = doc_->scene().tool.force.force_scale;
+  const double stiffness = doc_->scene().tool.force.stiffness;
   ASSERT_TRUE(doc_->set_tool({{"force", {{"damping", 3.5}}}}, assets));
   EXPECT_EQ(doc_->scene().tool.force.damping, 3.5);
-  EXPECT_EQ(doc_->scene().tool.force.force_scale, stiffness);
+  EXPECT_EQ(doc_->scene().tool.force.stiffness, stiffness);
   EXPECT_EQ(doc_->scene().tool.device.driver, "sim-circle");
   ASSERT_TRUE(doc_->set_tool({{"mesh", "meshes/stylus.obj"}, {"spheres", 50}}, assets));
   EXPECT_EQ(doc_->scene().tool.shape.mesh, assets / "meshes" / "stylus.obj");

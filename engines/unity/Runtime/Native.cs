@@ -99,7 +99,9 @@ namespace UnrealHaptics
             public IntPtr name;
             public uh_shape_def shape;
             public int mode;
-            public double force_scale;
+            public int law;                     // 0 gradient (default), 1 paper
+            public double stiffness;            // gradient law: k [N/m^2]
+            public double force_scale;          // paper law: eps_c [N/m^3]
             public double damping;
             public double damping_full_volume;
             public double mass_kg;

@@ -7,6 +7,9 @@ using System.Runtime.InteropServices;
 
 namespace UnrealHaptics
 {
+    /// <summary>The force law (docs/forcecomp.md): minus the gradient of the overlap volume, or the paper's eq. 1.</summary>
+    public enum ForceLaw { Gradient = 0, Paper = 1 }
+
     /// <summary>The tool of a scene: its shape, force law (ForceComp) and device (Haptico).</summary>
     public sealed class ToolSettings
     {
@@ -15,7 +18,9 @@ namespace UnrealHaptics
         public double MetersPerUnit = 1.0;
         public long Spheres = 10000;
         public bool ThreeDof = false;
-        public double ForceScale = 1.0e7;    // eps_c [N/m^3]
+        public ForceLaw Law = ForceLaw.Gradient;
+        public double Stiffness = 2.0e4;     // gradient law: k [N/m^2] (a 4 mm tip: a 0.5 N/mm spring)
+        public double ForceScale = 1.0e7;    // paper law: eps_c [N/m^3]
         public double Damping = 2.0;         // eps_d [N s/m]
         public double MassKg = 0.05;
         public double MaxForceN = 8.0;
@@ -148,6 +153,8 @@ namespace UnrealHaptics
                 else
                     def.shape.mesh_path = pin(t.MeshPath);
                 def.mode = t.ThreeDof ? 1 : 0;
+                def.law = (int)t.Law;
+                def.stiffness = t.Stiffness;
                 def.force_scale = t.ForceScale;
                 def.damping = t.Damping;
                 def.mass_kg = t.MassKg;

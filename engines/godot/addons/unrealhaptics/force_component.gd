@@ -3,7 +3,11 @@ extends Node
 # uh serve as the scene tool's `force` (docs/scenes.md); and optionally the tool's own mesh.
 
 export(String, "6dof", "3dof") var mode = "6dof"
-# Penalty stiffness eps_c [N/m^3] and damping eps_d [N s/m] of the volumetric force law.
+# The force law (docs/forcecomp.md): "gradient" (minus the gradient of the overlap volume) with its
+# stiffness k [N/m^2] (force per unit of contact area), or "paper" (eq. 1) with eps_c [N/m^3];
+# damping eps_d [N s/m].
+export(String, "gradient", "paper") var law = "gradient"
+export var stiffness = 2.0e4
 export var force_scale = 1.0e7
 export var damping = 2.0
 # The tool's mass [kg] and the limits of its force [N] and torque [N m].
@@ -21,7 +25,10 @@ func tool_patch():
 	var patch = {
 		"force": {
 			"mode": mode,
-			"force_scale": force_scale,
+			"law": law,
+			# each law has its own stiffness; the other one is removed (null in a merge patch)
+			"stiffness": stiffness if law == "gradient" else null,
+			"force_scale": force_scale if law == "paper" else null,
 			"damping": damping,
 			"mass_kg": mass_kg,
 			"max_force_n": max_force_n,

@@ -11,7 +11,9 @@ namespace UnrealHaptics.Components
         public double metersPerUnit = 1.0;
         public long spheres = 10000;
         public bool threeDof = false;
-        [Tooltip("Penalty stiffness eps_c [N/m^3]")] public double forceScale = 1.0e7;
+        [Tooltip("Force law: Gradient (default) or Paper (eq. 1)")] public ForceLaw law = ForceLaw.Gradient;
+        [Tooltip("Gradient law: stiffness k [N/m^2], force per unit of contact area")] public double stiffness = 2.0e4;
+        [Tooltip("Paper law: penalty stiffness eps_c [N/m^3]")] public double forceScale = 1.0e7;
         [Tooltip("Damping eps_d [N s/m]")] public double damping = 2.0;
         public double massKg = 0.05;
         public double maxForceN = 8.0;
@@ -24,8 +26,8 @@ namespace UnrealHaptics.Components
             return new ToolSettings
             {
                 Name = name, MeshPath = toolMeshPath, MetersPerUnit = metersPerUnit, Spheres = spheres,
-                ThreeDof = threeDof, ForceScale = forceScale, Damping = damping, MassKg = massKg,
-                MaxForceN = maxForceN, MaxTorqueNm = maxTorqueNm, DeviceDriver = deviceDriver,
+                ThreeDof = threeDof, Law = law, Stiffness = stiffness, ForceScale = forceScale, Damping = damping,
+                MassKg = massKg, MaxForceN = maxForceN, MaxTorqueNm = maxTorqueNm, DeviceDriver = deviceDriver,
                 DeviceConfigJson = string.IsNullOrEmpty(deviceConfigJson) ? null : deviceConfigJson,
             };
         }

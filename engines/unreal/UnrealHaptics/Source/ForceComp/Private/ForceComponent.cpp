@@ -9,6 +9,8 @@ FUhToolSpec UForceComponent::ToolSpec() const
 	Spec.MetersPerUnit = MetersPerUnit;
 	Spec.Spheres = Spheres;
 	Spec.bThreeDof = bThreeDof;
+	Spec.bPaperLaw = bPaperLaw;
+	Spec.Stiffness = Stiffness;
 	Spec.ForceScale = ForceScale;
 	Spec.Damping = Damping;
 	Spec.MassKg = MassKg;

@@ -21,7 +21,10 @@ public:
 	UPROPERTY(EditAnywhere, Category = "Force") int64 Spheres = 10000;
 	/** 3-DOF (force only) instead of 6-DOF (force and torque). */
 	UPROPERTY(EditAnywhere, Category = "Force") bool bThreeDof = false;
-	/** Penalty stiffness eps_c [N/m^3] and damping eps_d [N s/m]. */
+	/** The force law: minus the gradient of the overlap volume (default) or the paper's eq. 1 (docs/forcecomp.md). */
+	UPROPERTY(EditAnywhere, Category = "Force") bool bPaperLaw = false;
+	/** Gradient law: stiffness k [N/m^2] (force per unit of contact area); paper law: eps_c [N/m^3]; damping eps_d [N s/m]. */
+	UPROPERTY(EditAnywhere, Category = "Force") double Stiffness = 2.0e4;
 	UPROPERTY(EditAnywhere, Category = "Force") double ForceScale = 1.0e7;
 	UPROPERTY(EditAnywhere, Category = "Force") double Damping = 2.0;
 	UPROPERTY(EditAnywhere, Category = "Force") double MassKg = 0.05;

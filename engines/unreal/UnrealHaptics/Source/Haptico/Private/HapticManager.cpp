@@ -131,6 +131,8 @@ bool AHapticManager::StartSession()
 		Def.shape.meters_per_unit = Tool.MetersPerUnit;
 		Def.shape.spheres = Tool.Spheres;
 		Def.mode = Tool.bThreeDof ? UH_FORCE_3DOF : UH_FORCE_6DOF;
+		Def.law = Tool.bPaperLaw ? UH_FORCE_LAW_PAPER : UH_FORCE_LAW_GRADIENT;
+		Def.stiffness = Tool.Stiffness;
 		Def.force_scale = Tool.ForceScale;
 		Def.damping = Tool.Damping;
 		Def.mass_kg = Tool.MassKg;

@@ -53,7 +53,8 @@ struct HAPTICO_API FUhToolSpec
 	double MetersPerUnit = 1.0;
 	int64 Spheres = 10000;
 	bool bThreeDof = false;
-	double ForceScale = 1.0e7, Damping = 2.0, MassKg = 0.05, MaxForceN = 8.0, MaxTorqueNm = 0.3;
+	bool bPaperLaw = false;   // the force law: gradient (false) or the paper's eq. 1
+	double Stiffness = 2.0e4, ForceScale = 1.0e7, Damping = 2.0, MassKg = 0.05, MaxForceN = 8.0, MaxTorqueNm = 0.3;
 	FString DeviceDriver;     // empty: "sim-raster" (the default scene's)
 	FString DeviceConfigJson;
 };
