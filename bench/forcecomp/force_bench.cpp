@@ -56,7 +56,7 @@ std::vector<SpherePairContact> make_pairs(int count, const Pose& world_from_a, c
 
 ForceComponent make_tool(ForceMode mode) {
   ForceComponentOptions o;
-  o.params.force_scale = 2e5;
+  o.params.stiffness = 2e4;  // the default (gradient) law
   o.params.damping = 2.0;
   o.mode = mode;
   return ForceComponent(o);

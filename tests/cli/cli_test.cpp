@@ -465,7 +465,7 @@ fs::path write_small_device_scene(const fs::path& dir) {
   "objects": [{{ "name": "bunny", "mesh": "{}", "meters_per_unit": 0.01, "spheres": 600,
                "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
   "tool": {{ "name": "stylus", "mesh": "{}", "meters_per_unit": 0.01, "spheres": 150,
-          "force": {{ "mode": "3dof", "force_scale": 8.0e6, "damping": 1.0, "max_force_n": 6.0 }},
+          "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "max_force_n": 6.0 }},
           "device": {{ "driver": "sim-line", "config": {{ "start": [0, 0, 0.1], "end": [0, 0, 0.045] }} }} }},
   "watch": ["bunny"]
 }})",
