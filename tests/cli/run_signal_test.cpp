@@ -88,11 +88,15 @@ Finished wait_for_exit(pid_t pid, std::chrono::seconds limit) {
 struct Interrupt {
   int signal_number;
   bool view;  // uh run --view: the live view's server shows the session meanwhile
+  // uh run --device forcedimension:0 on the stand-in DHD library (its handle rests at the origin,
+  // inside the bunny): the driver's path from the signal to the zero, not only the simulated one's
+  bool force_dimension = false;
 };
 
 // names the case in test output (instead of the struct's bytes)
 void PrintTo(const Interrupt& i, std::ostream* out) {
-  *out << (i.signal_number == SIGINT ? "SIGINT" : "SIGTERM") << (i.view ? " with --view" : "");
+  *out << (i.signal_number == SIGINT ? "SIGINT" : "SIGTERM") << (i.view ? " with --view" : "")
+       << (i.force_dimension ? " on forcedimension" : "");
 }
 
 class RunSignalTest : public ::testing::TestWithParam<Interrupt> {};
@@ -100,9 +104,10 @@ class RunSignalTest : public ::testing::TestWithParam<Interrupt> {};
 TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   const int signal_number = GetParam().signal_number;
   const bool view = GetParam().view;
+  const bool force_dimension = GetParam().force_dimension;
   const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
-  const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}", ::getpid(),
-                                                               signal_number, view ? "_view" : "");
+  const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}{}", ::getpid(), signal_number,
+                                                               view ? "_view" : "", force_dimension ? "_dhd" : "");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.json", trace = dir / "trace.csv", out = dir / "stdout.txt",
@@ -114,13 +119,17 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   std::vector<std::string> args = {UH_CLI_PATH, "run",          scene.string(),
                                    "--trace",   trace.string(), "--no-realtime"};
   if (view) args.insert(args.end(), {"--view", "--port", "0"});
+  if (force_dimension) args.insert(args.end(), {"--device", "forcedimension:0"});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   std::vector<std::string> env_storage = {cache_env, "CI=1"};
+  if (force_dimension) env_storage.push_back(std::string("UH_FORCEDIMENSION_LIBRARY=") + UH_STANDIN_DHD);
   for (char** e = environ; *e != nullptr; ++e) {
     const std::string entry(*e);
-    if (entry.rfind("UH_CACHE_DIR=", 0) != 0 && entry.rfind("CI=", 0) != 0) env_storage.push_back(entry);
+    if (entry.rfind("UH_CACHE_DIR=", 0) != 0 && entry.rfind("CI=", 0) != 0 &&
+        entry.rfind("UH_FORCEDIMENSION_LIBRARY=", 0) != 0)
+      env_storage.push_back(entry);
   }
   std::vector<char*> envp;
   for (auto& e : env_storage) envp.push_back(e.data());
@@ -212,10 +221,12 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
 
 INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest,
                          ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false},
-                                           Interrupt{SIGINT, true}, Interrupt{SIGTERM, true}),
+                                           Interrupt{SIGINT, true}, Interrupt{SIGTERM, true},
+                                           Interrupt{SIGINT, false, true}, Interrupt{SIGTERM, false, true}),
                          [](const ::testing::TestParamInfo<Interrupt>& p) {
                            return std::string(p.param.signal_number == SIGINT ? "Sigint" : "Sigterm") +
-                                  (p.param.view ? "WithView" : "");
+                                  (p.param.view ? "WithView" : "") +
+                                  (p.param.force_dimension ? "OnForceDimension" : "");
                          });
 
 }  // namespace
