@@ -371,6 +371,7 @@ struct State {
   int contact_pairs = 0;
   std::uint64_t haptic_ticks = 0, missed_deadlines = 0;
   double haptic_rate_hz = 0.0, collision_rate_hz = 0.0;
+  std::uint32_t buttons = 0;
 };
 
 struct ContactEvent {
@@ -442,7 +443,8 @@ class Session {
                  st.haptic_ticks,
                  st.missed_deadlines,
                  st.haptic_rate_hz,
-                 st.collision_rate_hz};
+                 st.collision_rate_hz,
+                 st.buttons};
   }
 
   std::vector<ContactEvent> events() {
@@ -590,7 +592,8 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def_readonly("haptic_ticks", &State::haptic_ticks)
       .def_readonly("missed_deadlines", &State::missed_deadlines)
       .def_readonly("haptic_rate_hz", &State::haptic_rate_hz)
-      .def_readonly("collision_rate_hz", &State::collision_rate_hz);
+      .def_readonly("collision_rate_hz", &State::collision_rate_hz)
+      .def_readonly("buttons", &State::buttons, "the device's buttons (bit i: button i)");
 
   py::class_<ContactEvent>(m, "ContactEvent",
                            "A contact between the tool and a watched object began or ended.")

@@ -272,6 +272,7 @@ typedef struct uh_state {
   uint64_t missed_deadlines;   /* ticks that started more than a period late */
   double haptic_rate_hz;       /* haptic ticks per second over the last ~100 ms [Hz] */
   double collision_rate_hz;    /* collision steps per second over the last ~100 ms [Hz] */
+  uint32_t buttons;            /* the device's buttons as read that tick (bit i: button i) */
 } uh_state;
 
 /* A contact between the tool and a watched object began or ended. */

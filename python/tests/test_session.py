@@ -44,6 +44,7 @@ def test_threaded_session_polls_state_and_stop_returns_the_report(scene):
             st = s.state()
             max_force = max(max_force, float(np.linalg.norm(st.force)))
             max_pairs = max(max_pairs, st.contact_pairs)
+            assert st.buttons == 0  # the scene's scripted device presses none
             ticks.append(st.haptic_ticks)
             begins += sum(e.kind == "begin" for e in s.events())
             time.sleep(0.002)

@@ -49,6 +49,7 @@ void fill_state(const controllers::SessionState& s, uh_state& out) {
   out.missed_deadlines = s.missed_deadlines;
   out.haptic_rate_hz = s.haptic_rate_hz;
   out.collision_rate_hz = s.collision_rate_hz;
+  out.buttons = s.buttons;
 }
 
 // haptic thread: hands each tick's state to the program's callback (real-time; no allocation)

@@ -143,6 +143,7 @@ void HapticSession::on_tick_sent(const haptico::TraceSample& sample) {
   s.missed_deadlines = manager_->missed_deadlines();
   s.haptic_rate_hz = haptic_rate_hz_.load(std::memory_order_relaxed);
   s.collision_rate_hz = collision_rate_hz_.load(std::memory_order_relaxed);
+  s.buttons = sample.state.buttons;
   tick_event_.broadcast(s);
   state_out_.publish();
 }

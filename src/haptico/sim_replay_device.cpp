@@ -27,6 +27,8 @@ Result<std::vector<TrajectorySample>> read_trajectory(CsvReader& csv) {
     if (!found) return csv.column(kNames[k], kColumns).error();
     column[k] = *found;
   }
+  // optional: a `uh run --trace` file carries the buttons the device reported
+  const auto buttons_column = csv.find_column("buttons");
   std::vector<TrajectorySample> samples;
   while (true) {
     auto row = csv.next_row();
@@ -46,7 +48,18 @@ Result<std::vector<TrajectorySample>> read_trajectory(CsvReader& csv) {
       return csv.error(fmt::format("time {} s is not after the previous sample's {} s (times must increase)", v[0],
                                    samples.back().time_s));
     }
-    samples.push_back({v[0], Pose{Quat{v[4] / qn, v[5] / qn, v[6] / qn, v[7] / qn}, Vec3{v[1], v[2], v[3]}}});
+    std::uint32_t buttons = 0;
+    if (buttons_column) {
+      auto mask = csv.number(*buttons_column);
+      if (!mask) return mask.error();
+      if (!(*mask >= 0.0 && *mask <= 4294967295.0 && std::floor(*mask) == *mask)) {
+        return csv.error(
+            fmt::format("buttons {} is not a bit mask (a whole number from 0 to 4294967295)", *mask));
+      }
+      buttons = static_cast<std::uint32_t>(*mask);
+    }
+    samples.push_back(
+        {v[0], Pose{Quat{v[4] / qn, v[5] / qn, v[6] / qn, v[7] / qn}, Vec3{v[1], v[2], v[3]}}, buttons});
   }
   if (samples.empty()) {
     return Error{fmt::format("{}: no samples (expected lines of '{}')", csv.source_name(), kColumns)};
@@ -69,6 +82,16 @@ Result<std::vector<TrajectorySample>> SimReplayDevice::load_csv(const std::strin
 
 SimReplayDevice::SimReplayDevice(std::vector<TrajectorySample> samples, const SimReplayOptions& options)
     : ScriptedDevice("sim-replay", options.device), samples_(std::move(samples)), options_(options) {}
+
+std::uint32_t SimReplayDevice::buttons_at(double t) const {
+  const double duration = duration_s();
+  if (options_.loop && duration > 0.0) t = std::fmod(t, duration);
+  const double when = samples_.front().time_s + t;
+  // held from a sample until the next one (a press is an event, not a quantity to interpolate)
+  const auto it = std::upper_bound(samples_.begin(), samples_.end(), when,
+                                   [](double value, const TrajectorySample& s) { return value < s.time_s; });
+  return it == samples_.begin() ? samples_.front().buttons : (it - 1)->buttons;
+}
 
 Pose SimReplayDevice::pose_at(double t) const {
   const double duration = duration_s();

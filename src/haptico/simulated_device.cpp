@@ -75,6 +75,7 @@ DeviceState ScriptedDevice::sample(double t) const {
   Quat dq = after.rotation * conjugate(before.rotation);
   if (dq.w < 0.0) dq = {-dq.w, -dq.x, -dq.y, -dq.z};
   s.angular_velocity = Vec3{dq.x, dq.y, dq.z} * (2.0 / span);
+  s.buttons = buttons_at(t);
   return s;
 }
 

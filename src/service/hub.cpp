@@ -30,6 +30,7 @@ json state_json(const controllers::SessionState& s) {
       {"force", vec3_json(s.force_world)},
       {"torque", vec3_json(s.torque_world)},
       {"contact_pairs", s.contact_pairs},
+      {"buttons", s.buttons},
       {"haptic",
        {{"rate_hz", s.haptic_rate_hz}, {"ticks", s.haptic_ticks}, {"missed_deadlines", s.missed_deadlines}}},
       {"collision", {{"rate_hz", s.collision_rate_hz}}}};

@@ -199,6 +199,7 @@ static void test_threaded_session(void) {
     last_ticks = st.haptic_ticks;
     if (norm3(st.force) > max_force) max_force = norm3(st.force);
     if (st.contact_pairs > max_pairs) max_pairs = st.contact_pairs;
+    CHECK(st.buttons == 0); /* the scene's scripted device presses none */
     while (uh_session_poll_event(s, &e, &has_event) == UH_OK && has_event) begins += e.kind == UH_CONTACT_BEGIN;
     sleep_ms(2);
   }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <fstream>
 
 #include <sstream>
 
@@ -159,6 +160,35 @@ TEST_F(SessionFixture, StateAfterASteppedRunIsTheZeroItEndedWith) {
   EXPECT_GT(tick.contact_pairs, 0);
   EXPECT_EQ(tick.missed_deadlines, 0u);
   EXPECT_EQ(s.tool_position_world, tick.tool_position_world) << "the tool has not moved since";
+}
+
+TEST_F(SessionFixture, StatesCarryTheDeviceButtons) {
+  // a replayed trajectory presses button 0 at 0.1 s and buttons 1+2 at 0.2 s
+  const auto file = *cache_ / "pressing.csv";
+  {
+    std::ofstream out(file);
+    out << "time_s,x,y,z,qw,qx,qy,qz,buttons\n0,0,0,0.1,1,0,0,0,0\n0.1,0,0,0.09,1,0,0,0,1\n0.2,0,0,0.08,1,0,"
+           "0,0,6\n";
+  }
+  const std::string scene =
+      replaced(small_scene_json(), R"("driver": "sim-line",
+                "config": { "start": [0.0, 0.0, 0.10], "end": [0.0, 0.0, 0.045], "duration_s": 0.5, "bounce": true,)",
+               fmt::format(R"("driver": "sim-replay", "config": {{ "file": "{}",)", file.string()));
+  auto session = make(scene);
+  ASSERT_TRUE(session);
+  std::vector<SessionState> published;
+  auto seen = session->on_haptic_tick().connect([&](const SessionState& s) { published.push_back(s); });
+  ASSERT_TRUE(session->run_stepped(0.3, 4).has_value());
+  ASSERT_GE(published.size(), 300u);
+  std::uint32_t union_of_masks = 0;
+  for (const SessionState& s : published) {
+    if (std::abs(s.time_s - 0.1) < 2e-3 || std::abs(s.time_s - 0.2) < 2e-3)
+      continue;  // either side of a press
+    const std::uint32_t expected = s.time_s < 0.1 ? 0u : (s.time_s < 0.2 ? 1u : 6u);
+    EXPECT_EQ(s.buttons, expected) << "at " << s.time_s << " s";
+    union_of_masks |= s.buttons;
+  }
+  EXPECT_EQ(union_of_masks, 7u);
 }
 
 TEST_F(SessionFixture, ContactEventsAlternateAndMatchTheForceOnsets) {

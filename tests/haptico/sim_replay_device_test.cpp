@@ -107,6 +107,44 @@ TEST(SimReplayDevice, InterpolatesAndHoldsLastPose) {
   EXPECT_EQ(end.position, (Vec3{0.01, 0.02, 0.03}));
 }
 
+TEST(SimReplayDevice, ScriptsButtonsHeldFromSampleToSample) {
+  // a trace's buttons column is read by name; each mask holds until the next sample (no blending)
+  std::ostringstream trace;
+  write_trace_header(trace);
+  const std::uint32_t masks[3] = {0, 1, 6};
+  for (int k = 0; k < 3; ++k) {
+    TraceSample s;
+    s.state.time_s = 0.1 * k;
+    s.state.orientation = Quat{};
+    s.state.buttons = masks[k];
+    write_trace_row(trace, s);
+  }
+  auto r = parse(trace.str());
+  ASSERT_TRUE(r.has_value()) << r.error().message;
+  ASSERT_EQ(r->size(), 3u);
+  EXPECT_EQ((*r)[2].buttons, 6u);
+  SimReplayDevice d(*r, {});
+  ASSERT_TRUE(d.open());
+  std::uint32_t seen[3] = {};
+  for (int i = 0; i < 250; ++i) {  // 1 ms steps: 0.0 .. 0.249 s
+    d.command({});
+    const double t = 0.001 * (i + 1);
+    if (std::abs(t - 0.1) < 1e-6 || std::abs(t - 0.2) < 1e-6) continue;  // either side of a step
+    const std::uint32_t b = d.read_state().buttons;
+    const int expected = t < 0.1 - 1e-9 ? 0 : (t < 0.2 - 1e-9 ? 1 : 2);
+    EXPECT_EQ(b, masks[expected]) << "at " << t << " s";
+    seen[expected] = b;
+  }
+  EXPECT_EQ(seen[1], 1u);
+  EXPECT_EQ(seen[2], 6u);
+  // a file without the column holds no buttons; a bad mask is refused with the line named
+  EXPECT_EQ((*parse("0,0,0,0,1,0,0,0\n"))[0].buttons, 0u);
+  EXPECT_EQ(error_of("time_s,x,y,z,qw,qx,qy,qz,buttons\n0,0,0,0,1,0,0,0,2.5\n"),
+            "demo.csv:2: buttons 2.5 is not a bit mask (a whole number from 0 to 4294967295)");
+  EXPECT_EQ(error_of("time_s,x,y,z,qw,qx,qy,qz,buttons\n0,0,0,0,1,0,0,0,-1\n"),
+            "demo.csv:2: buttons -1 is not a bit mask (a whole number from 0 to 4294967295)");
+}
+
 TEST(SimReplayDevice, LoopsWhenAsked) {
   auto r = parse("0,0,0,0,1,0,0,0\n0.1,0.01,0,0,1,0,0,0\n");
   ASSERT_TRUE(r);

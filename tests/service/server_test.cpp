@@ -278,6 +278,7 @@ TEST_F(ServerTest, DefaultSessionRunsStreamsStateAndStopsWithTheReport) {
     ASSERT_EQ(s["force"].size(), 3u);
     ASSERT_EQ(s["torque"].size(), 3u);
     EXPECT_TRUE(s["contact_pairs"].is_number_integer());
+    EXPECT_EQ(s["buttons"], 0) << "the raster script presses none";
     EXPECT_TRUE(s["haptic"]["ticks"].is_number_unsigned());
     EXPECT_TRUE(s["haptic"]["missed_deadlines"].is_number_unsigned());
     EXPECT_TRUE(s["haptic"]["rate_hz"].is_number());

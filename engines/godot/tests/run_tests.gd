@@ -12,6 +12,7 @@ var started = false
 var collisions = []
 var stopped = []
 var moves = 0
+var bad_buttons = 0  # the demo's raster script presses none: anything but int 0 is wrong
 
 
 func _init():
@@ -65,6 +66,7 @@ func _run():
 	yield(create_timer(0.5), "timeout")
 	var second = stylus.global_transform.origin
 	check(moves > moves_before, "move_on_haptic_tick comes every frame with a newer state (%d in 0.5 s)" % (moves - moves_before))
+	check(bad_buttons == 0, "move_on_haptic_tick carries the device's buttons as an int (0 here, %d otherwise)" % bad_buttons)
 	check(first.distance_to(second) > 1e-4, "the stylus moves with the device (%s -> %s)" % [first, second])
 	check(second.distance_to(manager.tool_position()) < 1e-9, "the stylus is at the newest state's tool position")
 
@@ -104,8 +106,10 @@ func _on_stopped(report, state):
 	stopped.append([report, state])
 
 
-func _on_move(_position, _orientation, _buttons):
+func _on_move(_position, _orientation, buttons):
 	moves += 1
+	if typeof(buttons) != TYPE_INT or buttons != 0:
+		bad_buttons += 1
 
 
 func _on_collision(_a, _b, data):

@@ -51,6 +51,7 @@ namespace UnrealHaptics
             public ulong missed_deadlines;
             public double haptic_rate_hz;
             public double collision_rate_hz;
+            public uint buttons;
         }
 
         [StructLayout(LayoutKind.Sequential)]

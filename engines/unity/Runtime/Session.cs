@@ -22,6 +22,7 @@ namespace UnrealHaptics
         public ulong MissedDeadlines;
         public double HapticRateHz;                          // over the last ~100 ms
         public double CollisionRateHz;
+        public uint Buttons;  // the device's buttons (bit i: button i)
     }
 
     public enum ContactKind { Begin = Native.UH_CONTACT_BEGIN, End = Native.UH_CONTACT_END }
@@ -170,6 +171,7 @@ namespace UnrealHaptics
             o.MissedDeadlines = s.missed_deadlines;
             o.HapticRateHz = s.haptic_rate_hz;
             o.CollisionRateHz = s.collision_rate_hz;
+            o.Buttons = s.buttons;
             return o;
         }
 

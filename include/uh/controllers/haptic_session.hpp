@@ -110,6 +110,7 @@ struct SessionState {
   std::uint64_t missed_deadlines = 0;  ///< haptic ticks that started more than a period late
   double haptic_rate_hz = 0.0;         ///< haptic ticks per second over the last ~100 ms [Hz]
   double collision_rate_hz = 0.0;      ///< collision steps per second over the last ~100 ms [Hz]
+  std::uint32_t buttons = 0;           ///< the device's buttons as read that tick (bit i: button i)
 };
 
 /// Whether a contact began or ended.

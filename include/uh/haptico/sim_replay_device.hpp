@@ -16,6 +16,7 @@ namespace uh::haptico {
 struct TrajectorySample {
   double time_s = 0.0;  ///< [s]
   Pose pose{};          ///< [m], unit quaternion
+  std::uint32_t buttons = 0;  ///< button bit mask from this sample on (optional column `buttons`)
 };
 
 /// Options of a SimReplayDevice. Config keys: file (required), loop (0/1), plus the
@@ -43,6 +44,7 @@ class SimReplayDevice final : public ScriptedDevice {
 
  private:
   Pose pose_at(double t) const override;
+  std::uint32_t buttons_at(double t) const override;
   std::vector<TrajectorySample> samples_;
   SimReplayOptions options_;
 };

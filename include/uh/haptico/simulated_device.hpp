@@ -69,6 +69,8 @@ class ScriptedDevice : public SimulatedDevice {
   using SimulatedDevice::SimulatedDevice;
   /// The handle pose at time t [s].
   virtual Pose pose_at(double t) const = 0;
+  /// The buttons held at time t (bit i: button i); scripts without buttons hold none.
+  virtual std::uint32_t buttons_at(double) const { return 0; }
   DeviceState sample(double t) const override;
   void integrate(double, double, const DeviceCommand&) override {}
 };

@@ -16,7 +16,7 @@ const Paths = preload("paths.gd")
 const PROTOCOL = 1
 
 # Every frame with a newer haptic state: the tool's position (Vector3, world [m]), orientation
-# (Quat) and the device's buttons (int bit mask; 0: the service's state carries none yet).
+# (Quat) and the device's buttons (int bit mask, bit i: button i).
 signal move_on_haptic_tick(position, orientation, buttons)
 signal session_started(scene_name)
 # report: the `uh run --json` object; final_state: the state after the stop (zero force).
@@ -75,7 +75,7 @@ func _process(_delta):
 		_ws.poll()
 	if _new_state:
 		_new_state = false
-		emit_signal("move_on_haptic_tick", tool_position(), tool_orientation(), 0)
+		emit_signal("move_on_haptic_tick", tool_position(), tool_orientation(), int(state.get("buttons", 0)))
 	if running:
 		_send_moved_poses()
 
