@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config ccache
   libgtest-dev libgmock-dev libbenchmark-dev
   libeigen3-dev libassimp-dev libpng-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libreaderwriterqueue-dev
