@@ -291,7 +291,7 @@ Status HapticSession::stop() {
 
 Status HapticSession::run(double seconds, const std::function<void(const SessionState&)>& on_status,
                           std::ostream* trace) {
-  if (!(seconds > 0.0)) return Error{"HapticSession::run: the duration must be positive"};
+  if (!(seconds > 0.0)) return Error{fmt::format("the run's duration must be positive (got {} s)", seconds)};
   if (auto started = start(trace); !started) return started;
   // an exception from on_status must not leave the threads running: stop() (idempotent) either way
   struct StopOnExit {
@@ -322,8 +322,11 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
 }
 
 Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, std::ostream* trace) {
-  if (!(seconds > 0.0)) return Error{"HapticSession::run_stepped: the duration must be positive"};
-  if (ticks_per_collision_step < 1) return Error{"HapticSession::run_stepped: ticks per collision step must be >= 1"};
+  if (!(seconds > 0.0))
+    return Error{fmt::format("the stepped run's duration must be positive (got {} s)", seconds)};
+  if (ticks_per_collision_step < 1)
+    return Error{
+        fmt::format("ticks per collision step must be at least 1 (got {})", ticks_per_collision_step)};
   if (auto ready = begin_run(); !ready) return ready;
   t0_s_ = 0.0;
   haptic_rate_hz_.store(haptic_hz_, std::memory_order_relaxed);

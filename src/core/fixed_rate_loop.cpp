@@ -40,19 +40,19 @@ FixedRateLoop::~FixedRateLoop() { stop(); }
 
 Status FixedRateLoop::start(Callback callback, ExitCallback on_exit) {
   if (running_.load(std::memory_order_acquire)) {
-    return Error{"FixedRateLoop::start(): loop '" + options_.name + "' is already running"};
+    return Error{"loop '" + options_.name + "': already running"};
   }
-  if (!callback) return Error{"FixedRateLoop::start(): the callback is empty"};
+  if (!callback) return Error{"loop '" + options_.name + "': no callback to run"};
   if (!std::isfinite(options_.rate_hz) || options_.rate_hz <= 0.0 || options_.rate_hz > 100'000.0) {
-    return Error{"FixedRateLoop::start(): rate_hz = " + std::to_string(options_.rate_hz) +
+    return Error{"loop '" + options_.name + "': rate_hz = " + std::to_string(options_.rate_hz) +
                  " is out of range (expected 0 < rate_hz <= 100000)"};
   }
   if (!std::isfinite(options_.spin_us) || options_.spin_us < 0.0) {
-    return Error{"FixedRateLoop::start(): spin_us = " + std::to_string(options_.spin_us) +
+    return Error{"loop '" + options_.name + "': spin_us = " + std::to_string(options_.spin_us) +
                  " is invalid (expected a finite value >= 0)"};
   }
   if (options_.raise_priority && (options_.fifo_priority < 1 || options_.fifo_priority > 99)) {
-    return Error{"FixedRateLoop::start(): fifo_priority = " + std::to_string(options_.fifo_priority) +
+    return Error{"loop '" + options_.name + "': fifo_priority = " + std::to_string(options_.fifo_priority) +
                  " is out of range (expected 1..99)"};
   }
   // a loop that ended through request_stop() still has a thread to join
@@ -77,7 +77,7 @@ Status FixedRateLoop::start(Callback callback, ExitCallback on_exit) {
     });
   } catch (const std::exception& e) {
     running_.store(false, std::memory_order_release);
-    return Error{std::string("FixedRateLoop::start(): cannot create the loop thread: ") + e.what()};
+    return Error{"loop '" + options_.name + "': cannot create its thread: " + e.what()};
   }
   return Ok{};
 }

@@ -148,6 +148,12 @@ static void test_default_session_stepped(void) {
   const char* report = NULL;
   REQUIRE_OK(uh_session_open(NULL, &s));
   REQUIRE_OK(uh_session_set_tick_callback(s, record_tick, &rec));
+  /* bad arguments are refused before anything runs, in the caller's terms (no C++ names) */
+  CHECK(uh_session_run_stepped(s, -1.0, 4) != UH_OK);
+  CHECK(strstr(uh_last_error(), "uh_session_run_stepped: seconds must be in (0, 86400]") != NULL);
+  CHECK(strstr(uh_last_error(), "::") == NULL);
+  CHECK(uh_session_run_stepped(s, 1.0, 0) != UH_OK);
+  CHECK(strstr(uh_last_error(), "(got 1 and 0)") != NULL);
   REQUIRE_OK(uh_session_run_stepped(s, 3.0, 4));
   memset(&st, 0, sizeof st);
   st.struct_size = sizeof st;
