@@ -11,7 +11,7 @@ void ABridgingController::BeginPlay()
 	}
 }
 
-void ABridgingController::Move(FVector ToolPosition, FRotator ToolOrientation)
+void ABridgingController::Move(FVector ToolPosition, FRotator ToolOrientation, int32 /*Buttons: the tool follows the pose only*/)
 {
 	if (ToolActor != nullptr)
 	{

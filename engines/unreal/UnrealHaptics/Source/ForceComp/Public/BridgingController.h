@@ -23,5 +23,5 @@ protected:
 	virtual void BeginPlay() override;
 
 private:
-	UFUNCTION() void Move(FVector ToolPosition, FRotator ToolOrientation);
+	UFUNCTION() void Move(FVector ToolPosition, FRotator ToolOrientation, int32 Buttons);
 };

@@ -215,7 +215,8 @@ void AHapticManager::Tick(float DeltaSeconds)
 		Newest.ContactPairs = S.contact_pairs;
 		Newest.HapticTicks = static_cast<int64>(S.haptic_ticks);
 		Newest.MissedDeadlines = static_cast<int64>(S.missed_deadlines);
-		OnMoveOnHapticTick.Broadcast(Newest.ToolPosition, Newest.ToolOrientation);
+		Newest.Buttons = static_cast<int32>(S.buttons);
+		OnMoveOnHapticTick.Broadcast(Newest.ToolPosition, Newest.ToolOrientation, Newest.Buttons);
 		OnForceOnHapticTick.Broadcast(Newest.Force, Newest.Torque);
 	}
 	uh_contact_event E{};

@@ -30,6 +30,7 @@ struct HAPTICO_API FUhHapticState
 	UPROPERTY(BlueprintReadOnly, Category = "Haptics") int32 ContactPairs = 0;
 	UPROPERTY(BlueprintReadOnly, Category = "Haptics") int64 HapticTicks = 0;
 	UPROPERTY(BlueprintReadOnly, Category = "Haptics") int64 MissedDeadlines = 0;
+	UPROPERTY(BlueprintReadOnly, Category = "Haptics") int32 Buttons = 0;  // bit i: button i
 };
 
 /** A static object as registered by a ColletteStaticMeshActor, already in libuh's frame (metres). */
@@ -61,7 +62,7 @@ struct HAPTICO_API FUhToolSpec
 
 DECLARE_MULTICAST_DELEGATE_OneParam(FUhNativeTick, const uh_state&);
 DECLARE_MULTICAST_DELEGATE_OneParam(FUhNativeContact, const uh_contact_event&);
-DECLARE_DYNAMIC_MULTICAST_DELEGATE_TwoParams(FUhMoveOnHapticTick, FVector, ToolPosition, FRotator, ToolOrientation);
+DECLARE_DYNAMIC_MULTICAST_DELEGATE_ThreeParams(FUhMoveOnHapticTick, FVector, ToolPosition, FRotator, ToolOrientation, int32, Buttons);
 DECLARE_DYNAMIC_MULTICAST_DELEGATE_TwoParams(FUhForceOnHapticTick, FVector, Force, FVector, Torque);
 
 UCLASS()
