@@ -24,11 +24,54 @@ ForceController::ForceController(collette::ObjectId tool, const forcecomp::Force
 
 ForceController::~ForceController() = default;
 
-void ForceController::add_watched(collette::ObjectId object, double coverage_product) {
+void ForceController::add_watched(collette::ObjectId object, double coverage_product,
+                                  const forcecomp::ContactMaterial* material,
+                                  const forcecomp::SurfaceStageOptions& surface) {
   auto w = std::make_unique<Watched>();
   w->object = object;
   w->coverage_product = coverage_product;
+  w->component = component_;
+  if (material != nullptr) {
+    forcecomp::ForceComponentOptions options = component_.options();
+    options.params.stiffness = material->stiffness;
+    options.params.damping = material->damping;
+    w->component = forcecomp::ForceComponent(options);
+    forcecomp::SurfaceStageOptions stage = surface;
+    stage.mode = options.mode;
+    w->surface = forcecomp::SurfaceStage(*material, stage);
+  }
   watched_.push_back(std::move(w));
+}
+
+void ForceController::hold_contact_geometry(Watched& w, const ContactFrame& frame,
+                                            const Pose& world_from_tool) {
+  if (!w.surface.active()) return;
+  // the contact point: the overlap's volume centroid, fixed on the tool until the next frame
+  const Vec3 point_tool = transform_point(inverse(frame.world_from_b), frame.volume_centroid_world);
+  const Vec3 moved =
+      transform_point(world_from_tool, point_tool) - transform_point(world_from_tool, w.contact_point_tool);
+  w.surface.shift_contact_point(moved, frame.world_from_a);
+  w.contact_point_tool = point_tool;
+  w.contact_point_world_at_frame = frame.volume_centroid_world;
+  // depth: a round tip of radius r pressed d in overlaps pi r d^2 through a disk of 2 pi r d, so
+  // d = 2 V / |dV/dx| (a flat face gives V / |dV/dx|, half of it: the texture then reads deeper)
+  const double gradient = norm(frame.volume_gradient_world);
+  w.depth_at_frame_m = gradient > 0.0 ? 2.0 * frame.total_volume / gradient : 0.0;
+}
+
+forcecomp::Wrench ForceController::add_surface(Watched& w, const forcecomp::Wrench& penalty,
+                                               const Pose& world_from_tool,
+                                               const forcecomp::BodyMotion& tool_motion) {
+  if (!w.surface.active()) return penalty;
+  forcecomp::ContactGeometry contact;
+  contact.normal_world = normalized(penalty.force);
+  contact.point_world = transform_point(world_from_tool, w.contact_point_tool);
+  // the depth follows the tool between frames: moving along -n goes deeper
+  contact.depth_m =
+      w.depth_at_frame_m - dot(contact.normal_world, contact.point_world - w.contact_point_world_at_frame);
+  contact.world_from_object = w.world_from_object;
+  contact.world_from_tool = world_from_tool;
+  return w.surface.apply(penalty, contact, tool_motion.center_of_mass_world).wrench;
 }
 
 void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManager& manager) {
@@ -77,9 +120,10 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
       if (frame.pair_count > 0) {
         w->held.hold(frame);
         w->world_from_object = frame.world_from_a;
+        hold_contact_geometry(*w, frame, world_from_tool);
         if (!options_.multi_rate) {
           // held-force mode: the frame's own force, kept until the next frame
-          const auto r = component_.evaluate(frame, tool_motion, {}, w->coverage_product);
+          const auto r = w->component.evaluate(frame, tool_motion, {}, w->coverage_product);
           w->held_wrench = r.wrench;
           w->held_pairs = r.pair_count;
         }
@@ -87,19 +131,22 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
         w->held.clear();
         w->held_wrench = {};
         w->held_pairs = 0;
+        w->surface.reset();
       }
     }
     if (w->held.empty()) continue;
     oldest_data_s = std::min(oldest_data_s, w->held.time_s());
     if (options_.multi_rate) {
-      const auto r = component_.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
-                                         w->coverage_product);
-      contact.force += r.wrench.force;
-      contact.torque += r.wrench.torque;
+      const auto r = w->component.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
+                                           w->coverage_product);
+      const forcecomp::Wrench felt = add_surface(*w, r.wrench, world_from_tool, tool_motion);
+      contact.force += felt.force;
+      contact.torque += felt.torque;
       pairs += r.pair_count;
     } else {
-      contact.force += w->held_wrench.force;
-      contact.torque += w->held_wrench.torque;
+      const forcecomp::Wrench felt = add_surface(*w, w->held_wrench, world_from_tool, tool_motion);
+      contact.force += felt.force;
+      contact.torque += felt.torque;
       pairs += w->held_pairs;
     }
   }

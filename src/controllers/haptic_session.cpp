@@ -99,7 +99,10 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end()) continue;
     // the tool is B of every watched pair: the frames' forces push it out of the object
     if (auto w = world.add_collision_watcher(object_ids[i], session->tool_id_); !w) return w.error();
-    session->force_controller_->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage);
+    const forcecomp::ContactMaterial material =
+        forcecomp::combine_materials(scene.objects[i].material, scene.tool.material, scene.tool.force);
+    session->force_controller_->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage,
+                                            &material);
   }
   session->bridging_controller_ = std::make_unique<BridgingController>(
       world, session->tool_id_, scene.tool.workspace, session->force_controller_.get());

@@ -300,6 +300,116 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
   return Ok{};
 }
 
+// A material: an inline object or the name of an entry of the scene's top-level `materials` table
+// (read first, each entry checked under its own path `materials.NAME`).
+Status read_material_fields(const FieldReader& r, const json& j, const std::string& path,
+                            forcecomp::Material& m) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(j, path, {"stiffness", "damping", "friction", "texture"}));
+  if (j.contains("stiffness")) {
+    UH_CHECK(r.number(j, path, "stiffness", m.stiffness, 1e-6, 1e12));
+    m.has_stiffness = true;
+  }
+  if (j.contains("damping")) {
+    UH_CHECK(r.number(j, path, "damping", m.damping, 0.0, 1e6));
+    m.has_damping = true;
+  }
+  if (const auto it = j.find("friction"); it != j.end()) {
+    const std::string p = FieldReader::join(path, "friction");
+    UH_CHECK(r.require_object(*it, p));
+    UH_CHECK(r.check_keys(*it, p, {"static", "dynamic"}));
+    if (!it->contains("static") || !it->contains("dynamic"))
+      return r.error(p,
+                     "expected both 'static' (the coefficient at breakaway) and 'dynamic' (while sliding)");
+    UH_CHECK(r.number(*it, p, "static", m.friction_static, 0.0, 10.0));
+    UH_CHECK(r.number(*it, p, "dynamic", m.friction_dynamic, 0.0, 10.0));
+    if (m.friction_dynamic > m.friction_static)
+      return r.error(
+          FieldReader::join(p, "dynamic"),
+          fmt::format("is above 'static' ({} > {}): a sliding contact cannot hold more than a sticking one",
+                      m.friction_dynamic, m.friction_static));
+    m.has_friction = true;
+  }
+  if (const auto it = j.find("texture"); it != j.end()) {
+    const std::string p = FieldReader::join(path, "texture");
+    UH_CHECK(r.require_object(*it, p));
+    std::string type;
+    UH_CHECK(r.string(*it, p, "type", type, true));
+    if (type == "grating") {
+      UH_CHECK(r.check_keys(*it, p, {"type", "period", "amplitude", "direction"}));
+      if (!it->contains("period") || !it->contains("amplitude"))
+        return r.error(p, "a grating needs 'period' [m] and 'amplitude' [m]");
+      double period = 0.0, amplitude = 0.0;
+      Vec3 direction{1.0, 0.0, 0.0};
+      UH_CHECK(r.number(*it, p, "period", period, 1e-5, 1.0));
+      UH_CHECK(r.number(*it, p, "amplitude", amplitude, 0.0, 0.01));
+      UH_CHECK(r.vec3(*it, p, "direction", direction));
+      if (!(norm(direction) > 1e-9))
+        return r.error(FieldReader::join(p, "direction"), "expected a non-zero [x, y, z]");
+      m.texture = forcecomp::make_grating(period, amplitude, direction);
+    } else if (type == "random") {
+      UH_CHECK(r.check_keys(*it, p, {"type", "roughness", "correlation_length", "seed"}));
+      if (!it->contains("roughness") || !it->contains("correlation_length"))
+        return r.error(p, "a random texture needs 'roughness' [m] and 'correlation_length' [m]");
+      double roughness = 0.0, length = 0.0;
+      std::int64_t seed = 1;
+      UH_CHECK(r.number(*it, p, "roughness", roughness, 0.0, 0.01));
+      UH_CHECK(r.number(*it, p, "correlation_length", length, 1e-5, 1.0));
+      UH_CHECK(r.integer(*it, p, "seed", seed, 0, std::int64_t{1} << 53));
+      m.texture = forcecomp::make_random_texture(roughness, length, static_cast<std::uint64_t>(seed));
+    } else {
+      return r.error(FieldReader::join(p, "type"),
+                     fmt::format("expected \"grating\" or \"random\", got \"{}\"", type));
+    }
+  }
+  return Ok{};
+}
+
+using MaterialTable = std::vector<std::pair<std::string, forcecomp::Material>>;
+
+Status read_material_table(const FieldReader& r, const json& root, MaterialTable& table) {
+  const auto it = root.find("materials");
+  if (it == root.end()) return Ok{};
+  if (!it->is_object())
+    return r.error("materials",
+                   fmt::format("expected an object of named materials, got {}", it->type_name()));
+  for (const auto& [name, value] : it->items()) {
+    forcecomp::Material m;
+    UH_CHECK(read_material_fields(r, value, FieldReader::join("materials", name), m));
+    table.emplace_back(name, m);
+  }
+  return Ok{};
+}
+
+// `material` of an object or the tool: a name from the table or an inline object
+Status read_material(const FieldReader& r, const json& parent, const std::string& path,
+                     const MaterialTable& table, forcecomp::Material& out) {
+  const auto it = parent.find("material");
+  if (it == parent.end()) return Ok{};
+  const std::string p = FieldReader::join(path, "material");
+  if (it->is_string()) {
+    for (const auto& [name, m] : table) {
+      if (name != it->get<std::string>()) continue;
+      out = m;
+      return Ok{};
+    }
+    std::string known;
+    for (const auto& entry : table) known += fmt::format("{}'{}'", known.empty() ? "" : ", ", entry.first);
+    return r.error(p, fmt::format("no material is named '{}' (the scene's 'materials' has {})",
+                                  it->get<std::string>(), known.empty() ? "none" : known));
+  }
+  return read_material_fields(r, *it, p, out);
+}
+
+// a material stiffness is the gradient law's k [N/m^2]: meaningless under the paper law
+Status check_material_law(const FieldReader& r, const Scene& scene, const std::string& path,
+                          const forcecomp::Material& m) {
+  if (scene.tool.force.law == forcecomp::ForceLaw::kPaper && m.has_stiffness)
+    return r.error(FieldReader::join(path, "material.stiffness"),
+                   "is the gradient law's stiffness [N/m^2]; this scene uses the paper law (tool.force.law)");
+  return Ok{};
+}
+
 Result<json> parse_json(std::string_view json_text, const std::string& source) {
   try {
     return json::parse(json_text);
@@ -318,8 +428,11 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
   const json& root = *parsed;
   const FieldReader r(source);
   if (!root.is_object()) return Error{fmt::format("{}: expected a JSON object at the top level", source)};
-  UH_CHECK(r.check_keys(root, "", {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force",
-                                   "collision"}));
+  UH_CHECK(r.check_keys(root, "",
+                        {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force",
+                         "collision", "materials"}));
+  MaterialTable materials;
+  UH_CHECK(read_material_table(r, root, materials));
 
   Scene scene;
   scene.source = source;
@@ -347,23 +460,31 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
     const json& o = (*objects)[i];
     const std::string path = fmt::format("objects[{}]", i);
     UH_CHECK(r.require_object(o, path));
-    UH_CHECK(r.check_keys(o, path, {"name", "mesh", "ist", "spheres", "meters_per_unit", "pose"}));
+    UH_CHECK(
+        r.check_keys(o, path, {"name", "mesh", "ist", "spheres", "meters_per_unit", "pose", "material"}));
     SceneObject object;
     UH_CHECK(r.string(o, path, "name", object.name, true));
     for (const auto& existing : scene.objects)
       if (existing.name == object.name) return r.error(path + ".name", fmt::format("duplicate object name '{}'", object.name));
     UH_CHECK(read_shape(r, o, path, base_dir, object.shape));
     UH_CHECK(r.pose(o, path, "pose", object.pose));
+    UH_CHECK(read_material(r, o, path, materials, object.material));
     scene.objects.push_back(std::move(object));
   }
 
   const auto tool = root.find("tool");
   if (tool == root.end()) return r.error("tool", "missing (expected the tool object)");
   UH_CHECK(r.require_object(*tool, "tool"));
-  UH_CHECK(r.check_keys(*tool, "tool", {"name", "mesh", "ist", "spheres", "meters_per_unit", "force", "device", "workspace"}));
+  UH_CHECK(r.check_keys(
+      *tool, "tool",
+      {"name", "mesh", "ist", "spheres", "meters_per_unit", "force", "device", "workspace", "material"}));
   UH_CHECK(r.string(*tool, "tool", "name", scene.tool.name, false));
   UH_CHECK(read_shape(r, *tool, "tool", base_dir, scene.tool.shape));
   if (const auto it = tool->find("force"); it != tool->end()) UH_CHECK(read_force_params(r, *it, "tool.force", scene.tool));
+  UH_CHECK(read_material(r, *tool, "tool", materials, scene.tool.material));
+  UH_CHECK(check_material_law(r, scene, "tool", scene.tool.material));
+  for (std::size_t i = 0; i < scene.objects.size(); ++i)
+    UH_CHECK(check_material_law(r, scene, fmt::format("objects[{}]", i), scene.objects[i].material));
   const auto device = tool->find("device");
   if (device == tool->end()) return r.error("tool.device", "missing (expected {\"driver\": ..., \"config\": {...}})");
   UH_CHECK(read_device(r, *device, "tool.device", base_dir, scene.tool.device));

@@ -16,6 +16,8 @@
 #include "uh/forcecomp/force_component.hpp"
 #include "uh/forcecomp/force_safety.hpp"
 #include "uh/forcecomp/held_contact_set.hpp"
+#include "uh/forcecomp/material.hpp"
+#include "uh/forcecomp/surface_stage.hpp"
 #include "uh/forcecomp/virtual_coupling.hpp"
 #include "uh/haptico/haptic_manager.hpp"
 
@@ -69,8 +71,13 @@ class ForceController {
 
   /// Takes forces from the watched pair (object, tool) of the world. `coverage_product` is the
   /// product of the object's and the tool's packing coverages (forcecomp::PenaltyInput), by which
-  /// the gradient law is calibrated. Controlling thread, before bind().
-  void add_watched(collette::ObjectId object, double coverage_product = 1.0);
+  /// the gradient law is calibrated. `material` is the pair's combined material
+  /// (forcecomp::combine_materials): its stiffness and damping replace the tool's for this pair,
+  /// its friction and texture are rendered by a SurfaceStage after the penalty wrench; without
+  /// one the pair feels as the tool's force parameters say. Controlling thread, before bind().
+  void add_watched(collette::ObjectId object, double coverage_product = 1.0,
+                   const forcecomp::ContactMaterial* material = nullptr,
+                   const forcecomp::SurfaceStageOptions& surface = {});
 
   /// Connects to the world's OnCollision and the manager's ForceOnHapticTick. The coupling's proxy
   /// is placed at the handle on the first tick. Controlling thread, before the threads start.
@@ -96,6 +103,11 @@ class ForceController {
   struct Watched {
     collette::ObjectId object = -1;
     double coverage_product = 1.0;             // c_object * c_tool
+    forcecomp::ForceComponent component;       // the tool's, with the pair's material stiffness and damping
+    forcecomp::SurfaceStage surface;           // friction and texture after the penalty (haptic thread)
+    Vec3 contact_point_tool{};                 // the held frame's contact point, tool frame [m]
+    Vec3 contact_point_world_at_frame{};       // where that point was when the frame was queried [m]
+    double depth_at_frame_m = 0.0;             // the held frame's penetration estimate [m]
     LatestValue<ContactFrame> inbox;           // collision thread -> haptic thread
     forcecomp::HeldContactSet held;            // haptic thread
     Pose world_from_object{};                  // object pose used by the held frame's query
@@ -120,6 +132,11 @@ class ForceController {
   bool have_last_tick_ = false;
   bool proxy_placed_ = false;
   Vec3 last_contact_force_{};
+
+  // the one place where materials come in: friction and texture on the pair's penalty wrench
+  forcecomp::Wrench add_surface(Watched& w, const forcecomp::Wrench& penalty, const Pose& world_from_tool,
+                                const forcecomp::BodyMotion& tool_motion);
+  void hold_contact_geometry(Watched& w, const ContactFrame& frame, const Pose& world_from_tool);
 
   // published to stats() readers
   std::atomic<std::uint64_t> ticks_{0};

@@ -18,6 +18,7 @@
 #include "uh/core/math.hpp"
 #include "uh/core/result.hpp"
 #include "uh/forcecomp/force_params.hpp"
+#include "uh/forcecomp/material.hpp"
 #include "uh/haptico/device_config.hpp"
 
 namespace uh::controllers {
@@ -40,6 +41,9 @@ struct SceneObject {
   std::string name;
   SceneShape shape;
   Pose pose{};                       ///< world_from_object [m]
+  /// `objects[].material`: what the surface feels like (stiffness, damping, friction, texture);
+  /// nothing set = as the tool's force parameters say (docs/scenes.md, "Materials").
+  forcecomp::Material material{};
 };
 
 /// The device a tool is bound to: a registered driver name and its settings.
@@ -53,6 +57,8 @@ struct SceneTool {
   std::string name = "tool";
   SceneShape shape;
   forcecomp::ForceParams force{};
+  /// `tool.material`: the tool's own surface, combined with each object's (forcecomp::combine_materials).
+  forcecomp::Material material{};
   forcecomp::ForceMode mode = forcecomp::ForceMode::k6Dof;
   SceneDevice device;
   WorkspaceMapping workspace{};
