@@ -71,6 +71,8 @@ struct RunArgs {
   double collision_hz = -1.0;
   double coherence_skin = -1.0;
   bool held_forces = false;
+  bool exact_tick = false;
+  bool check_model = false;
   bool stepped = false;
   int ticks_per_collision = 4;
   bool no_realtime = false;
@@ -88,9 +90,23 @@ void print_summary(const controllers::SessionReport& r) {
   std::printf("  collision median %.0f Hz, min %.0f Hz (target %.0f); query median %.1f us, p99 %.1f us, max %.1f us; up to %lld pairs\n",
               r.collision_rate_median_hz, r.collision_rate_min_hz, r.collision_target_hz, r.query_median_us, r.query_p99_us,
               r.query_max_us, static_cast<long long>(r.max_pairs));
-  std::printf("  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu non-finite\n",
-              r.force_max_n, r.torque_max_nm, r.force_max_step_n, r.multi_rate ? "multi-rate" : "held forces",
-              static_cast<unsigned long long>(r.force_nonfinite));
+  std::printf(
+      "  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu non-finite\n",
+      r.force_max_n, r.torque_max_nm, r.force_max_step_n,
+      !r.multi_rate ? "held forces" : (r.tick_force == "model" ? "local model" : "every pair re-evaluated"),
+      static_cast<unsigned long long>(r.force_nonfinite));
+  if (!r.stepped)
+    std::printf("  tick      p50 %.1f us, p99 %.1f us, max %.1f us\n", r.tick_p50_us, r.tick_p99_us,
+                r.tick_max_us);
+  if (r.multi_rate && r.tick_force == "model")
+    std::printf("  model     %llu ticks beyond the trust range, %llu holding%s\n",
+                static_cast<unsigned long long>(r.model_clamped_ticks),
+                static_cast<unsigned long long>(r.model_held_ticks),
+                r.model_checked_ticks > 0
+                    ? fmt::format("; force error against every pair re-evaluated: RMS {:.4f} N, max {:.4f} N",
+                                  r.model_error_rms_n, r.model_error_max_n)
+                          .c_str()
+                    : "");
   std::printf("  limits    ticks limited by the device %llu, the tool %llu, the safety limit %llu, the rate limit %llu\n",
               static_cast<unsigned long long>(r.limits.device), static_cast<unsigned long long>(r.limits.tool),
               static_cast<unsigned long long>(r.limits.safety), static_cast<unsigned long long>(r.limits.rate));
@@ -116,6 +132,8 @@ int run_session(const RunArgs& args) {
   if (args.collision_hz >= 0.0) options.collision_hz = args.collision_hz;
   if (args.coherence_skin >= 0.0) options.coherence_skin = args.coherence_skin;
   if (args.held_forces) options.multi_rate = false;
+  if (args.exact_tick) options.tick_force = controllers::TickForce::kExact;
+  options.check_model = args.check_model;
   options.raise_priority = !args.no_realtime;
   options.cache_dir = cache;
   std::unique_ptr<ProgressBar> bar;
@@ -208,7 +226,17 @@ void add_run_command(CLI::App& app, CommandRunner& runner) {
   r->add_option("--coherence-skin", args.coherence_skin,
                 "override the volume query's frame-to-frame coherence skin [m] (0 = traverse every step)")
       ->check(CLI::Range(0.0, 1.0));
-  r->add_flag("--held-forces", args.held_forces, "hold each collision frame's force instead of re-evaluating every tick");
+  auto* held_flag = r->add_flag("--held-forces", args.held_forces,
+                                "hold each collision frame's force until the next frame");
+  auto* exact_flag =
+      r->add_flag("--exact-tick", args.exact_tick,
+                  "re-evaluate every held sphere pair each tick instead of the frame's local force model");
+  r->add_flag(
+       "--check-model", args.check_model,
+       "measure: also re-evaluate every held pair each tick and report how far the model's force is from it")
+      ->excludes(exact_flag)
+      ->excludes(held_flag);
+  exact_flag->excludes(held_flag);
   r->add_flag("--stepped", args.stepped, "deterministic run on one thread in simulated time");
   r->add_option("--ticks-per-collision", args.ticks_per_collision, "with --stepped: haptic ticks per collision step")
       ->default_val(4)->check(CLI::Range(1, 1000));

@@ -27,7 +27,7 @@ ForceController::~ForceController() = default;
 void ForceController::add_watched(collette::ObjectId object, double coverage_product,
                                   const forcecomp::ContactMaterial* material,
                                   const forcecomp::SurfaceStageOptions& surface) {
-  auto w = std::make_unique<Watched>();
+  auto w = std::make_unique<Watched>(options_.model);
   w->object = object;
   w->coverage_product = coverage_product;
   w->component = component_;
@@ -43,14 +43,14 @@ void ForceController::add_watched(collette::ObjectId object, double coverage_pro
   watched_.push_back(std::move(w));
 }
 
-void ForceController::hold_contact_geometry(Watched& w, const ContactFrame& frame,
+void ForceController::hold_contact_geometry(Watched& w, const FrameContact& frame,
                                             const Pose& world_from_tool) {
   if (!w.surface.active()) return;
   // the contact point: the overlap's volume centroid, fixed on the tool until the next frame
-  const Vec3 point_tool = transform_point(inverse(frame.world_from_b), frame.volume_centroid_world);
+  const Vec3 point_tool = transform_point(inverse(frame.world_from_tool), frame.volume_centroid_world);
   const Vec3 moved =
       transform_point(world_from_tool, point_tool) - transform_point(world_from_tool, w.contact_point_tool);
-  w.surface.shift_contact_point(moved, frame.world_from_a);
+  w.surface.shift_contact_point(moved, frame.world_from_object);
   w.contact_point_tool = point_tool;
   w.contact_point_world_at_frame = frame.volume_centroid_world;
   // depth: a round tip of radius r pressed d in overlaps pi r d^2 through a disk of 2 pi r d, so
@@ -82,10 +82,22 @@ void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManag
 
 void ForceController::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
   if (b != tool_) return;  // the tool is always B of its watched pairs: forces push B out of A
+  const bool model = uses_model();
   for (auto& w : watched_) {
     if (w->object != a) continue;
-    copy_contact_frame(frame, w->inbox.write_buffer());
-    w->inbox.publish();
+    if (model) {
+      // the model is built here, on the collision thread, around the tool pose the query used
+      const Pose& world_from_tool =
+          component_.options().side == forcecomp::ContactSide::kB ? frame.world_from_b : frame.world_from_a;
+      const forcecomp::BodyMotion at_frame = w->component.body_motion(world_from_tool, {}, {});
+      w->models.write_buffer() = forcecomp::build_wrench_model(
+          frame, w->component.penalty_input(at_frame, {}, w->coverage_product), options_.model);
+      w->models.publish();
+    }
+    if (!model || options_.check_model) {
+      copy_contact_frame(frame, w->inbox.write_buffer());
+      w->inbox.publish();
+    }
     return;
   }
 }
@@ -113,14 +125,21 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   forcecomp::Wrench contact{};
   std::int32_t pairs = 0;
   double oldest_data_s = now;
+  const bool model = uses_model();
+  Vec3 exact_force{};  // check_model: the exact re-evaluation's force, beside the model's
+  std::uint64_t clamped = 0, held = 0;
   for (auto& w : watched_) {
     if (w->inbox.update()) {
       const ContactFrame& frame = w->inbox.read_buffer();
-      frames_received_.fetch_add(1, std::memory_order_relaxed);
+      if (!model) frames_received_.fetch_add(1, std::memory_order_relaxed);
       if (frame.pair_count > 0) {
         w->held.hold(frame);
         w->world_from_object = frame.world_from_a;
-        hold_contact_geometry(*w, frame, world_from_tool);
+        if (!model)
+          hold_contact_geometry(*w,
+                                {frame.world_from_b, frame.world_from_a, frame.volume_centroid_world,
+                                 frame.volume_gradient_world, frame.total_volume},
+                                world_from_tool);
         if (!options_.multi_rate) {
           // held-force mode: the frame's own force, kept until the next frame
           const auto r = w->component.evaluate(frame, tool_motion, {}, w->coverage_product);
@@ -131,8 +150,40 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
         w->held.clear();
         w->held_wrench = {};
         w->held_pairs = 0;
-        w->surface.reset();
+        if (!model) w->surface.reset();
       }
+    }
+    if (model) {
+      if (w->models.update()) {
+        const forcecomp::WrenchModel& m = w->models.read_buffer();
+        frames_received_.fetch_add(1, std::memory_order_relaxed);
+        w->renderer.take(m);
+        if (m.contact) {
+          w->world_from_object = m.world_from_other;
+          hold_contact_geometry(*w,
+                                {m.world_from_tool, m.world_from_other, m.volume_centroid_world,
+                                 m.volume_gradient_world, m.total_volume},
+                                world_from_tool);
+        } else {
+          w->surface.reset();
+        }
+      }
+      if (options_.check_model && !w->held.empty())
+        exact_force += w->component
+                           .evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
+                                     w->coverage_product)
+                           .wrench.force;
+      clamped += w->renderer.clamped_ticks();
+      held += w->renderer.held_ticks();
+      if (!w->renderer.active(now)) continue;
+      const forcecomp::Wrench r = w->renderer.render(now, world_from_tool.rotation, tool_motion);
+      const forcecomp::WrenchModel& m = w->renderer.model();
+      const forcecomp::Wrench felt = m.contact ? add_surface(*w, r, world_from_tool, tool_motion) : r;
+      contact.force += felt.force;
+      contact.torque += felt.torque;
+      pairs += m.pair_count;
+      if (m.contact) oldest_data_s = std::min(oldest_data_s, m.time_s);
+      continue;
     }
     if (w->held.empty()) continue;
     oldest_data_s = std::min(oldest_data_s, w->held.time_s());
@@ -148,6 +199,18 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
       contact.force += felt.force;
       contact.torque += felt.torque;
       pairs += w->held_pairs;
+    }
+  }
+
+  if (model) {
+    model_clamped_ticks_.store(clamped, std::memory_order_relaxed);
+    model_held_ticks_.store(held, std::memory_order_relaxed);
+    if (options_.check_model) {
+      const double error = norm(contact.force - exact_force);
+      model_checked_ticks_.fetch_add(1, std::memory_order_relaxed);
+      model_error_sum_sq_.store(model_error_sum_sq_.load(std::memory_order_relaxed) + error * error,
+                                std::memory_order_relaxed);
+      raise_max(model_error_max_n_, error);
     }
   }
 
@@ -188,6 +251,13 @@ ForceControllerStats ForceController::stats() const {
   s.max_force_step_n = max_force_step_n_.load(std::memory_order_relaxed);
   s.last_force_n = last_force_n_.load(std::memory_order_relaxed);
   s.last_pairs = last_pairs_.load(std::memory_order_relaxed);
+  s.model_clamped_ticks = model_clamped_ticks_.load(std::memory_order_relaxed);
+  s.model_held_ticks = model_held_ticks_.load(std::memory_order_relaxed);
+  s.model_checked_ticks = model_checked_ticks_.load(std::memory_order_relaxed);
+  if (s.model_checked_ticks > 0)
+    s.model_error_rms_n =
+        std::sqrt(model_error_sum_sq_.load(std::memory_order_relaxed) / static_cast<double>(s.model_checked_ticks));
+  s.model_error_max_n = model_error_max_n_.load(std::memory_order_relaxed);
   s.safety = safety_.counters();
   return s;
 }

@@ -44,6 +44,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     return Error{fmt::format("{}: collision rate {} Hz is outside [0, 10000]", scene.source, session->collision_hz_)};
   ForceControllerOptions force_options = scene.force;
   if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
+  if (options.tick_force) force_options.tick_force = *options.tick_force;
+  force_options.check_model = options.check_model;
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
 
@@ -372,6 +374,7 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     r.jitter_p99_us = hs.loop.period_error.p99_ns * 1e-3;
     r.jitter_p999_us = hs.loop.period_error.p999_ns * 1e-3;
     r.jitter_max_us = hs.loop.period_error.max_ns * 1e-3;
+    r.tick_p50_us = hs.loop.callback_duration.p50_ns * 1e-3;
     r.tick_p99_us = hs.loop.callback_duration.p99_ns * 1e-3;
     r.tick_max_us = hs.loop.callback_duration.max_ns * 1e-3;
     r.haptic_priority_raised = hs.loop.priority_raised;
@@ -406,6 +409,12 @@ void HapticSession::collect_report(double seconds, bool stepped) {
   r.stale_ticks = fc.safety.stale_ticks;
   r.contact_ticks = fc.contact_ticks;
   r.multi_rate = force_controller_->options().multi_rate;
+  r.tick_force = force_controller_->options().tick_force == TickForce::kModel ? "model" : "exact";
+  r.model_clamped_ticks = fc.model_clamped_ticks;
+  r.model_held_ticks = fc.model_held_ticks;
+  r.model_checked_ticks = fc.model_checked_ticks;
+  r.model_error_rms_n = fc.model_error_rms_n;
+  r.model_error_max_n = fc.model_error_max_n;
   r.coupling = force_controller_->options().use_coupling;
 }
 
@@ -421,11 +430,18 @@ std::string session_report_json(const SessionReport& r) {
         {"ticks", r.haptic_ticks},
         {"missed_deadlines", r.haptic_missed_deadlines},
         {"priority_raised", r.haptic_priority_raised},
-        {"jitter_us", {{"p50", r.jitter_p50_us}, {"p99", r.jitter_p99_us}, {"p999", r.jitter_p999_us}, {"max", r.jitter_max_us}}},
-        {"tick_us", {{"p99", r.tick_p99_us}, {"max", r.tick_max_us}}}}},
+        {"jitter_us",
+         {{"p50", r.jitter_p50_us},
+          {"p99", r.jitter_p99_us},
+          {"p999", r.jitter_p999_us},
+          {"max", r.jitter_max_us}}},
+        {"tick_us", {{"p50", r.tick_p50_us}, {"p99", r.tick_p99_us}, {"max", r.tick_max_us}}}}},
       {"collision",
        {{"target_hz", r.collision_target_hz},
-        {"rate_hz", {{"min", r.collision_rate_min_hz}, {"median", r.collision_rate_median_hz}, {"mean", r.collision_rate_mean_hz}}},
+        {"rate_hz",
+         {{"min", r.collision_rate_min_hz},
+          {"median", r.collision_rate_median_hz},
+          {"mean", r.collision_rate_mean_hz}}},
         {"steps", r.collision_steps},
         {"query_us", {{"median", r.query_median_us}, {"p99", r.query_p99_us}, {"max", r.query_max_us}}},
         {"max_pairs", r.max_pairs},
@@ -446,6 +462,13 @@ std::string session_report_json(const SessionReport& r) {
           {"rate", r.limits.rate}}},
         {"stale_ticks", r.stale_ticks},
         {"multi_rate", r.multi_rate},
+        {"tick_force", r.tick_force},
+        {"model",
+         {{"clamped_ticks", r.model_clamped_ticks},
+          {"held_ticks", r.model_held_ticks},
+          {"checked_ticks", r.model_checked_ticks},
+          {"error_rms_n", r.model_error_rms_n},
+          {"error_max_n", r.model_error_max_n}}},
         {"coupling", r.coupling}}},
       {"contact", {{"ticks", r.contact_ticks}}},
       {"energy", {{"work_on_hand_j", r.work_on_hand_j}}}};

@@ -264,8 +264,18 @@ Status read_workspace(const FieldReader& r, const json& j, const std::string& pa
 Status read_force_options(const FieldReader& r, const json& j, const std::string& path, Scene& scene) {
   ForceControllerOptions& o = scene.force;
   UH_CHECK(r.require_object(j, path));
-  UH_CHECK(r.check_keys(j, path, {"multi_rate", "safety", "coupling"}));
+  UH_CHECK(r.check_keys(j, path, {"multi_rate", "tick_force", "safety", "coupling"}));
   UH_CHECK(r.boolean(j, path, "multi_rate", o.multi_rate));
+  std::string tick_force = "model";
+  UH_CHECK(r.string(j, path, "tick_force", tick_force, false));
+  if (tick_force == "model") {
+    o.tick_force = TickForce::kModel;
+  } else if (tick_force == "exact") {
+    o.tick_force = TickForce::kExact;
+  } else {
+    return r.error(FieldReader::join(path, "tick_force"),
+                   fmt::format("expected \"model\" or \"exact\", got \"{}\"", tick_force));
+  }
   if (const auto it = j.find("safety"); it != j.end()) {
     const std::string p = FieldReader::join(path, "safety");
     UH_CHECK(r.require_object(*it, p));

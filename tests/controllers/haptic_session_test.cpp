@@ -93,6 +93,31 @@ TEST_F(SessionFixture, MultiRateReevaluationSmoothsTheForceOfASlowCollisionThrea
       << "multi-rate " << multi->report().force_max_step_n << " N vs held " << held->report().force_max_step_n << " N";
 }
 
+TEST_F(SessionFixture, LocalModelFollowsTheExactReevaluationOfEveryPair) {
+  // collision every 4 ticks: the model (default) rendered, the exact re-evaluation run beside it
+  SessionOptions check;
+  check.check_model = true;
+  SessionOptions reference;
+  reference.tick_force = TickForce::kExact;
+  auto checked = make(small_scene_json(), check);
+  auto exact = make(small_scene_json(), reference);
+  ASSERT_TRUE(checked && exact);
+  ASSERT_TRUE(checked->run_stepped(1.0, 4).has_value());
+  ASSERT_TRUE(exact->run_stepped(1.0, 4).has_value());
+  const SessionReport& m = checked->report();
+  const SessionReport& e = exact->report();
+  EXPECT_EQ(m.tick_force, "model");
+  EXPECT_EQ(e.tick_force, "exact");
+  EXPECT_EQ(m.model_checked_ticks, 1000u);
+  EXPECT_EQ(e.model_checked_ticks, 0u);
+  ASSERT_GT(m.force_max_n, 0.5);
+  EXPECT_GT(m.model_error_max_n, 0.0) << "a model is not the exact law";
+  EXPECT_LT(m.model_error_rms_n, 0.02 * m.force_max_n);
+  EXPECT_LT(m.model_error_max_n, 0.1 * m.force_max_n);
+  EXPECT_NEAR(m.force_max_n, e.force_max_n, 0.05 * e.force_max_n);
+  EXPECT_EQ(m.force_nonfinite, 0u);
+}
+
 TEST_F(SessionFixture, DampingFullVolumeRemovesTheKnockAtContactOnset) {
   // the stylus strikes the bunny at 0.11 m/s and keeps going in (the run ends before the line
   // does, so no turn-around changes the velocity); collision every tick, so that every force step
@@ -321,11 +346,12 @@ TEST_F(SessionFixture, ReportJsonHasTheDocumentedFields) {
   ASSERT_TRUE(session);
   ASSERT_TRUE(session->run_stepped(0.2, 4).has_value());
   const std::string json = session_report_json(session->report());
-  for (const char* key : {"\"target_hz\"",     "\"rate_hz\"",   "\"ticks\"",    "\"missed_deadlines\"",
-                          "\"jitter_us\"",     "\"p50\"",       "\"p99\"",      "\"max\"",
-                          "\"min\"",           "\"median\"",    "\"query_us\"", "\"max_n\"",
-                          "\"max_torque_nm\"", "\"nonfinite\"", "\"clamped\"",  "\"limited\"",
-                          "\"device\"",        "\"tool\"",      "\"safety\"",   "\"contact\""})
+  for (const char* key : {"\"target_hz\"",     "\"rate_hz\"",    "\"ticks\"",       "\"missed_deadlines\"",
+                          "\"jitter_us\"",     "\"p50\"",        "\"p99\"",         "\"max\"",
+                          "\"min\"",           "\"median\"",     "\"query_us\"",    "\"max_n\"",
+                          "\"max_torque_nm\"", "\"nonfinite\"",  "\"clamped\"",     "\"limited\"",
+                          "\"device\"",        "\"tool\"",       "\"safety\"",      "\"contact\"",
+                          "\"tick_us\"",       "\"tick_force\"", "\"error_rms_n\"", "\"held_ticks\""})
     EXPECT_NE(json.find(key), std::string::npos) << key;
 }
 

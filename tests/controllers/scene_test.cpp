@@ -103,6 +103,24 @@ TEST(Scene, ReportsFileFieldAndExpectation) {
   with_base(R"({ "tool": {} })", "field 'objects': missing");
 }
 
+TEST(Scene, ReadsHowTheTickComputesTheForce) {
+  const auto defaults = parse_scene(small_scene_json(), "small.json", test_assets());
+  ASSERT_TRUE(defaults.has_value()) << defaults.error().message;
+  EXPECT_EQ(defaults->force.tick_force, TickForce::kModel);
+  const auto with = [](const char* value) {
+    return replaced(small_scene_json(), R"("force": { "multi_rate")",
+                    fmt::format(R"("force": {{ "tick_force": {}, "multi_rate")", value));
+  };
+  const auto exact = parse_scene(with("\"exact\""), "small.json", test_assets());
+  ASSERT_TRUE(exact.has_value()) << exact.error().message;
+  EXPECT_EQ(exact->force.tick_force, TickForce::kExact);
+  const auto bad = parse_scene(with("\"pairs\""), "small.json", test_assets());
+  ASSERT_FALSE(bad.has_value());
+  EXPECT_NE(bad.error().message.find(R"(field 'force.tick_force': expected "model" or "exact", got "pairs")"),
+            std::string::npos)
+      << bad.error().message;
+}
+
 TEST(Scene, ReadsTheSafetyLimitsAndTheRateLimit) {
   const auto defaults = parse_scene(small_scene_json(), "small.json", test_assets());
   ASSERT_TRUE(defaults.has_value()) << defaults.error().message;

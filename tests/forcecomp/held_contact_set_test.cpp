@@ -16,15 +16,8 @@ namespace uh::forcecomp {
 namespace {
 
 using test::brute_force_pairs;
+using test::random_spheres;
 using test::sphere;
-
-std::vector<Sphere> random_spheres(std::mt19937& rng, int count) {
-  std::uniform_real_distribution<double> pos(-0.5, 0.5);
-  std::uniform_real_distribution<double> rad(0.08, 0.2);
-  std::vector<Sphere> out;
-  for (int i = 0; i < count; ++i) out.push_back(sphere(pos(rng), pos(rng), pos(rng), rad(rng)));
-  return out;
-}
 
 Pose pose_of(const Vec3& position, const Vec3& axis, double angle) {
   return Pose{quat_from_axis_angle(axis, angle), position};

@@ -3,6 +3,7 @@
 // overlap geometry, the way a collision query would, without any tree, with the independent lens
 // reference (tests/support/lens_reference.hpp) rather than the kernel under test.
 
+#include <random>
 #include <vector>
 
 #include "lens_reference.hpp"
@@ -17,6 +18,15 @@ inline Vec3 centre_of(const Sphere& s) {
 
 inline Sphere sphere(double x, double y, double z, double r) {
   return {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z), static_cast<float>(r)};
+}
+
+/// `count` spheres with centres in [-0.5, 0.5]^3 and radii in [0.08, 0.2]: packings that overlap deeply.
+inline std::vector<Sphere> random_spheres(std::mt19937& rng, int count) {
+  std::uniform_real_distribution<double> pos(-0.5, 0.5);
+  std::uniform_real_distribution<double> rad(0.08, 0.2);
+  std::vector<Sphere> out;
+  for (int i = 0; i < count; ++i) out.push_back(sphere(pos(rng), pos(rng), pos(rng), rad(rng)));
+  return out;
 }
 
 /// The pair record of spheres a (in A) and b (in B) at the given poses; volume 0 when apart.

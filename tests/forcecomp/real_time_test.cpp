@@ -11,6 +11,7 @@
 #include "uh/forcecomp/force_safety.hpp"
 #include "uh/forcecomp/held_contact_set.hpp"
 #include "uh/forcecomp/virtual_coupling.hpp"
+#include "uh/forcecomp/wrench_model.hpp"
 
 namespace uh::forcecomp {
 namespace {
@@ -36,6 +37,7 @@ TEST(RealTime, TickPathsDoNotAllocate) {
   VirtualCoupling coupling;
   coupling.reset(Pose{});
   const Pose moved{Quat{}, {0.001, 0, 0}};
+  WrenchModelRenderer renderer;
 
   uh::test::AllocationCounter counter;
   double sink = 0.0;
@@ -46,6 +48,9 @@ TEST(RealTime, TickPathsDoNotAllocate) {
     const PenaltyResult fused = tool.evaluate(held, Pose{}, moved, self);
     const auto pairs = held.reevaluate(Pose{}, moved);
     const PenaltyResult two_step = evaluate_penalty(pairs, tool.penalty_input(self, {}));
+    if (tick % 5 == 0) renderer.take(build_wrench_model(*frame, tool.penalty_input(self, {})));
+    const Wrench modelled = renderer.render(0.001 * tick, moved.rotation, self);
+    sink += modelled.force.x;
     const Wrench safe = safety.apply(fused.wrench, 0.001 * tick, 0.0);
     const CouplingOutput out = coupling.step(moved, {}, {}, safe, 0.001);
     sink += direct.wrench.force.x + two_step.wrench.force.x + out.device_wrench.force.x;

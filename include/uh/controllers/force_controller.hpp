@@ -19,15 +19,31 @@
 #include "uh/forcecomp/material.hpp"
 #include "uh/forcecomp/surface_stage.hpp"
 #include "uh/forcecomp/virtual_coupling.hpp"
+#include "uh/forcecomp/wrench_model.hpp"
 #include "uh/haptico/haptic_manager.hpp"
 
 namespace uh::controllers {
 
+/// How a multi-rate tick computes the contact wrench from the newest collision frame.
+enum class TickForce {
+  /// Default. The frame's local wrench model (forcecomp/wrench_model.hpp), built on the collision
+  /// thread, evaluated at the current pose in constant time and blended between frames.
+  kModel,
+  /// Every held sphere pair re-evaluated at the current pose (HeldContactSet): O(pairs) per tick,
+  /// the reference the model is measured against.
+  kExact,
+};
+
 /// Options of a ForceController (aggregate; designated initialisers).
 struct ForceControllerOptions {
-  /// Re-evaluate the held pair set at the current tool pose every haptic tick (multi-rate). When
-  /// false, the force computed from the newest collision frame is held until the next frame.
+  /// Follow the tool between collision frames (multi-rate), as `tick_force` says. When false,
+  /// the force computed from the newest collision frame is held until the next frame.
   bool multi_rate = true;
+  TickForce tick_force = TickForce::kModel;
+  forcecomp::WrenchModelOptions model{};  ///< trust range, fallback and blend of kModel
+  /// Measurement only: with kModel, also re-evaluate the held pairs every tick and record how far
+  /// the model's force is from it (ForceControllerStats::model_error_*). The tick is then O(pairs).
+  bool check_model = false;
   /// NaN guard and contact-age watchdog applied before the command leaves the controller (the
   /// limits are the haptic manager's limit chain, applied to the summed command).
   forcecomp::ForceSafetyOptions safety{};
@@ -46,14 +62,21 @@ struct ForceControllerStats {
   double max_force_step_n = 0.0;        ///< largest tick-to-tick change of the contact force before limits [N]
   double last_force_n = 0.0;            ///< |force| of the last tick [N]
   std::int32_t last_pairs = 0;          ///< pairs used in the last tick
+  std::uint64_t model_clamped_ticks = 0;  ///< kModel: ticks beyond a model's trust range (clamped)
+  std::uint64_t model_held_ticks = 0;     ///< kModel: ticks that held the last wrench (far beyond it)
+  std::uint64_t model_checked_ticks = 0;  ///< check_model: ticks compared with the exact re-evaluation
+  double model_error_rms_n = 0.0;         ///< check_model: RMS of |model force - exact force| [N]
+  double model_error_max_n = 0.0;         ///< check_model: largest |model force - exact force| [N]
   forcecomp::ForceSafetyCounters safety{};
 };
 
 /// Binds OnCollision (collision thread) and ForceOnHapticTick (haptic thread).
 ///
-/// On the collision thread, on_collision() copies each frame about the tool into a lock-free
-/// LatestValue per watched pair. On the haptic thread, on_force() takes the newest frame, holds its
-/// pairs, evaluates the volumetric penalty force and torque on the tool (ForceComponent, its law),
+/// On the collision thread, on_collision() builds each frame's wrench model (TickForce::kModel) or
+/// copies the frame (kExact, held forces) into a lock-free LatestValue per watched pair. On the
+/// haptic thread, on_force() takes the newest model and renders it (WrenchModelRenderer), or holds
+/// the newest frame's pairs and evaluates the volumetric penalty force and torque on the tool
+/// (ForceComponent, its law),
 /// optionally through a virtual coupling, applies ForceSafety (NaN guard, watchdog on the age of
 /// the contact data) and adds the result, in the device frame, to the command; the manager's
 /// limit chain bounds the sum.
@@ -100,6 +123,7 @@ class ForceController {
   const ForceControllerOptions& options() const { return options_; }
 
  private:
+  bool uses_model() const { return options_.multi_rate && options_.tick_force == TickForce::kModel; }
   struct Watched {
     collette::ObjectId object = -1;
     double coverage_product = 1.0;             // c_object * c_tool
@@ -108,12 +132,14 @@ class ForceController {
     Vec3 contact_point_tool{};                 // the held frame's contact point, tool frame [m]
     Vec3 contact_point_world_at_frame{};       // where that point was when the frame was queried [m]
     double depth_at_frame_m = 0.0;             // the held frame's penetration estimate [m]
-    LatestValue<ContactFrame> inbox;           // collision thread -> haptic thread
+    LatestValue<ContactFrame> inbox;           // collision thread -> haptic thread (kExact, held forces)
+    LatestValue<forcecomp::WrenchModel> models;  // collision thread -> haptic thread (kModel)
+    forcecomp::WrenchModelRenderer renderer;   // haptic thread
     forcecomp::HeldContactSet held;            // haptic thread
     Pose world_from_object{};                  // object pose used by the held frame's query
     forcecomp::Wrench held_wrench{};           // force of the newest frame (held-force mode)
     std::int32_t held_pairs = 0;
-    Watched() : held(ContactFrame::kMaxPairs) {}
+    explicit Watched(const forcecomp::WrenchModelOptions& model) : renderer(model), held(ContactFrame::kMaxPairs) {}
   };
 
   collette::ObjectId tool_;
@@ -136,7 +162,16 @@ class ForceController {
   // the one place where materials come in: friction and texture on the pair's penalty wrench
   forcecomp::Wrench add_surface(Watched& w, const forcecomp::Wrench& penalty, const Pose& world_from_tool,
                                 const forcecomp::BodyMotion& tool_motion);
-  void hold_contact_geometry(Watched& w, const ContactFrame& frame, const Pose& world_from_tool);
+  // where a frame was found: the tool's and the object's poses, the overlap's volume centroid and
+  // its gradient (from a ContactFrame or a WrenchModel)
+  struct FrameContact {
+    Pose world_from_tool{};
+    Pose world_from_object{};
+    Vec3 volume_centroid_world{};
+    Vec3 volume_gradient_world{};
+    double total_volume = 0.0;
+  };
+  void hold_contact_geometry(Watched& w, const FrameContact& frame, const Pose& world_from_tool);
 
   // published to stats() readers
   std::atomic<std::uint64_t> ticks_{0};
@@ -147,6 +182,11 @@ class ForceController {
   std::atomic<double> max_force_step_n_{0.0};
   std::atomic<double> last_force_n_{0.0};
   std::atomic<std::int32_t> last_pairs_{0};
+  std::atomic<std::uint64_t> model_clamped_ticks_{0};
+  std::atomic<std::uint64_t> model_held_ticks_{0};
+  std::atomic<std::uint64_t> model_checked_ticks_{0};
+  std::atomic<double> model_error_sum_sq_{0.0};
+  std::atomic<double> model_error_max_n_{0.0};
 };
 
 }  // namespace uh::controllers

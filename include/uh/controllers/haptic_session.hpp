@@ -37,7 +37,9 @@ namespace uh::controllers {
 struct SessionOptions {
   std::optional<double> haptic_hz;       ///< haptic rate [Hz]
   std::optional<double> collision_hz;    ///< collision rate [Hz]; 0 = free-running
-  std::optional<bool> multi_rate;        ///< re-evaluate held pairs every tick (else hold forces)
+  std::optional<bool> multi_rate;        ///< follow the tool between frames (else hold forces)
+  std::optional<TickForce> tick_force;   ///< the multi-rate tick's wrench: the frame's model or every pair
+  bool check_model = false;              ///< also run the exact re-evaluation and record the model's error
   std::optional<double> contact_margin;  ///< pairs delivered this far [m] before they touch
   std::optional<double> coherence_skin;  ///< volume-query coherence skin [m] (0 = off); default: the scene's
   bool raise_priority = false;           ///< ask for SCHED_FIFO for the haptic (80) and collision (70) threads
@@ -71,7 +73,7 @@ struct SessionReport {
   std::uint64_t haptic_ticks = 0;
   std::uint64_t haptic_missed_deadlines = 0;
   double jitter_p50_us = 0.0, jitter_p99_us = 0.0, jitter_p999_us = 0.0, jitter_max_us = 0.0;
-  double tick_p99_us = 0.0, tick_max_us = 0.0;  ///< haptic callback duration
+  double tick_p50_us = 0.0, tick_p99_us = 0.0, tick_max_us = 0.0;  ///< haptic callback duration
   bool haptic_priority_raised = false;
   // collision thread
   double collision_target_hz = 0.0;
@@ -93,6 +95,10 @@ struct SessionReport {
   /// closed path it is <= 0 when the rendering is passive.
   double work_on_hand_j = 0.0;
   bool multi_rate = true;
+  std::string tick_force = "model";                             ///< "model" or "exact" (with multi_rate)
+  std::uint64_t model_clamped_ticks = 0, model_held_ticks = 0;  ///< ForceControllerStats
+  std::uint64_t model_checked_ticks = 0;
+  double model_error_rms_n = 0.0, model_error_max_n = 0.0;  ///< with check_model
   bool coupling = false;
   std::vector<TimelineSample> timeline;
   std::vector<RateSample> collision_rates;
