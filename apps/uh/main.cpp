@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   uh::cli::CommandRunner runner;
   uh::cli::add_devices_command(app, runner);
+  uh::cli::add_explore_command(app, runner);
   uh::cli::add_ist_commands(app, runner);
   uh::cli::add_query_command(app, runner);
   uh::cli::add_run_command(app, runner);

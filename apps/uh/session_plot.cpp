@@ -135,6 +135,26 @@ cairo_status_t append_png_bytes(void* closure, const unsigned char* data, unsign
   return CAIRO_STATUS_SUCCESS;
 }
 
+// Draws the panels one under the other and writes the PNG atomically.
+Status write_panels(const std::vector<Panel>& panels, double t_max, const std::filesystem::path& png) {
+  constexpr int kWidth = 1200, kPanelHeight = 260;
+  cairo_surface_t* surface =
+      cairo_image_surface_create(CAIRO_FORMAT_RGB24, kWidth, kPanelHeight * static_cast<int>(panels.size()));
+  cairo_t* cr = cairo_create(surface);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  for (std::size_t i = 0; i < panels.size(); ++i)
+    draw_panel(cr, panels[i], 0, kPanelHeight * static_cast<double>(i), kWidth, kPanelHeight, t_max);
+  cairo_destroy(cr);
+  std::string bytes;
+  const cairo_status_t status = cairo_surface_write_to_png_stream(surface, append_png_bytes, &bytes);
+  cairo_surface_destroy(surface);
+  if (status != CAIRO_STATUS_SUCCESS) {
+    return Error{fmt::format("{}: cannot write the plot: {}", png.string(), cairo_status_to_string(status))};
+  }
+  return write_file_atomically(png, bytes);
+}
+
 }  // namespace
 
 Status write_session_plot(const controllers::SessionReport& report, const std::filesystem::path& png) {
@@ -162,22 +182,45 @@ Status write_session_plot(const controllers::SessionReport& report, const std::f
                   .labels = {"collision steps / s (100 ms windows)"},
                   .target = report.collision_target_hz > 0 ? report.collision_target_hz : -1.0};
 
-  constexpr int kWidth = 1200, kPanelHeight = 260;
-  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, kWidth, 3 * kPanelHeight);
-  cairo_t* cr = cairo_create(surface);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
-  draw_panel(cr, force, 0, 0, kWidth, kPanelHeight, t_max);
-  draw_panel(cr, torque, 0, kPanelHeight, kWidth, kPanelHeight, t_max);
-  draw_panel(cr, collision, 0, 2 * kPanelHeight, kWidth, kPanelHeight, t_max);
-  cairo_destroy(cr);
-  std::string bytes;
-  const cairo_status_t status = cairo_surface_write_to_png_stream(surface, append_png_bytes, &bytes);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) {
-    return Error{fmt::format("{}: cannot write the plot: {}", png.string(), cairo_status_to_string(status))};
+  return write_panels({force, torque, collision}, t_max, png);
+}
+
+Status write_exploration_plot(const std::string& scene,
+                              const std::vector<controllers::ObjectExploration>& objects,
+                              const std::filesystem::path& png) {
+  std::vector<Panel> panels;
+  double t_max = 0.0;
+  for (const auto& o : objects) {
+    // the strokes and the contour, back to back (the presses and taps between them left out)
+    std::vector<double> t, normal, friction;
+    double last = -1.0, shift = 0.0;
+    for (const auto& f : controllers::stroke_forces(o.trace)) {
+      if (last >= 0.0 && f.time_s - last > 0.01) shift += f.time_s - last - 0.01;  // close the gaps
+      last = f.time_s;
+      t.push_back(f.time_s - shift);
+      normal.push_back(f.normal_n);
+      friction.push_back(std::max(0.0, f.tangential_n));
+    }
+    if (!t.empty()) {
+      const double t0 = t.front();
+      for (double& x : t) x -= t0;
+      t_max = std::max(t_max, t.back());
+    }
+    const auto& e = o.estimate;
+    panels.push_back(Panel{
+        .title =
+            fmt::format("{}: {} (k {}, mu_s {}, mu_d {}, period {})", scene, o.object,
+                        e.stiffness_n_per_mm ? fmt::format("{:.2f} N/mm", *e.stiffness_n_per_mm) : "none",
+                        e.friction_static ? fmt::format("{:.2f}", *e.friction_static) : "none",
+                        e.friction_dynamic ? fmt::format("{:.2f}", *e.friction_dynamic) : "none",
+                        e.texture_period_m ? fmt::format("{:.2f} mm", *e.texture_period_m * 1e3) : "none"),
+        .unit = "force [N]",
+        .series = {decimate(t, normal), decimate(t, friction)},
+        .colours = {{0.80, 0.20, 0.15}, {0.15, 0.35, 0.75}},
+        .labels = {"normal force", "friction (against the motion)"}});
   }
-  return write_file_atomically(png, bytes);
+  if (panels.empty()) return Error{fmt::format("{}: nothing was explored to plot", png.string())};
+  return write_panels(panels, t_max, png);
 }
 
 }  // namespace uh::cli

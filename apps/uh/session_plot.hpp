@@ -5,6 +5,10 @@
 
 #include <filesystem>
 
+#include <string>
+#include <vector>
+
+#include "uh/controllers/exploration.hpp"
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/core/result.hpp"
 
@@ -12,5 +16,11 @@ namespace uh::cli {
 
 /// Writes the plot atomically (temporary file, then rename). Errors name the file.
 Status write_session_plot(const controllers::SessionReport& report, const std::filesystem::path& png);
+
+/// The forces felt while stroking each explored object (`uh explore --plot`): one panel per
+/// object, the normal force and the friction (against the motion) over the strokes and the contour.
+Status write_exploration_plot(const std::string& scene,
+                              const std::vector<controllers::ObjectExploration>& objects,
+                              const std::filesystem::path& png);
 
 }  // namespace uh::cli

@@ -533,5 +533,146 @@ TEST_F(CliTest, RunOnTheDeviceNamedOnTheCommandLine) {
       << missing.err;
 }
 
+// ---- uh explore: the materials of scenes/materials.json recovered from the force trace ----
+//
+// References from the scene file itself (not from the estimators) and textbook geometry: a ball
+// of radius r pressed into a sphere of radius R under the gradient law feels k times the contact
+// disk's area, pi a^2 with a^2 = 2 r_eff d - ... (r_eff = r R / (r + R)), so its stiffness at first
+// touch is 2 pi r_eff k; on a curved surface a grating of period P passes under the contact point
+// while the tool's centre travels (R + r) / R times as far.
+
+struct MaterialsScene {
+  nlohmann::json scene;
+  nlohmann::json material(const std::string& object) const {
+    for (const auto& o : scene["objects"])
+      if (o["name"] == object)
+        return o["material"].is_string() ? scene["materials"][o["material"].get<std::string>()]
+                                         : o["material"];
+    ADD_FAILURE() << "no object " << object;
+    return {};
+  }
+  double radius(const std::string& object) const {
+    for (const auto& o : scene["objects"])
+      if (o["name"] == object) return o["meters_per_unit"].get<double>();  // ball.obj has radius 1
+    return 0.0;
+  }
+  double tool_radius() const { return scene["tool"]["meters_per_unit"].get<double>(); }
+  double stiffness(const std::string& object) const {
+    const auto m = material(object);
+    return m.contains("stiffness") ? m["stiffness"].get<double>()
+                                   : scene["tool"]["force"]["stiffness"].get<double>();
+  }
+};
+
+fs::path materials_scene_path() {
+  return fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials.json";
+}
+
+MaterialsScene materials_scene() {
+  std::ifstream in(materials_scene_path());
+  return {nlohmann::json::parse(in)};
+}
+
+nlohmann::json explored(const nlohmann::json& out, const std::string& object) {
+  for (const auto& o : out["objects"])
+    if (o["name"] == object) return o;
+  ADD_FAILURE() << "not explored: " << object;
+  return {};
+}
+
+TEST_F(CliTest, ExploreRecoversEveryMaterialOfTheMaterialsScene) {
+  const MaterialsScene scene = materials_scene();
+  const CommandRun r = uh(fmt::format("explore '{}' --json", materials_scene_path().string()),
+                          fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json out = json_of(r);
+  ASSERT_EQ(out["objects"].size(), scene.scene["objects"].size());
+  const double r_tool = scene.tool_radius();
+
+  // stiffness within 5 %: flat (1 m spheres) and curved (the 4 cm dome)
+  for (const std::string object : {"stiff", "soft", "dome"}) {
+    const double big = scene.radius(object);
+    const double r_eff = r_tool * big / (r_tool + big);
+    const double reference = 2.0 * kPi * r_eff * scene.stiffness(object) * 1e-3;  // N/mm
+    EXPECT_NEAR(explored(out, object)["stiffness_n_per_mm"].get<double>(), reference, 0.05 * reference)
+        << object;
+  }
+  // the stiff one feels stiffer than the soft one, by their ratio
+  EXPECT_NEAR(explored(out, "stiff")["stiffness_n_per_mm"].get<double>() /
+                  explored(out, "soft")["stiffness_n_per_mm"].get<double>(),
+              scene.stiffness("stiff") / scene.stiffness("soft"),
+              0.05 * scene.stiffness("stiff") / scene.stiffness("soft"));
+
+  // friction within 10 % (flat and curved); frictionless surfaces read near zero
+  for (const std::string object : {"sticky", "slippery", "dome"}) {
+    const auto m = scene.material(object)["friction"];
+    const auto e = explored(out, object);
+    EXPECT_NEAR(e["friction_static"].get<double>(), m["static"].get<double>(),
+                0.1 * m["static"].get<double>())
+        << object;
+    EXPECT_NEAR(e["friction_dynamic"].get<double>(), m["dynamic"].get<double>(),
+                0.1 * m["dynamic"].get<double>())
+        << object;
+  }
+  for (const std::string object : {"stiff", "soft", "ridged", "rough"}) {
+    EXPECT_LT(explored(out, object)["friction_static"].get<double>(), 0.06) << object;
+    EXPECT_LT(explored(out, object)["friction_dynamic"].get<double>(), 0.02) << object;
+  }
+
+  // texture period within 5 % (on the curved dome: the period the tool's centre travels)
+  const double ridged_period = scene.material("ridged")["texture"]["period"].get<double>();
+  const double flat_factor = (scene.radius("ridged") + r_tool) / scene.radius("ridged");
+  EXPECT_NEAR(explored(out, "ridged")["texture_period_m"].get<double>(), ridged_period * flat_factor,
+              0.05 * ridged_period);
+  const double dome_period = scene.material("dome")["texture"]["period"].get<double>() *
+                             (scene.radius("dome") + r_tool) / scene.radius("dome");
+  EXPECT_NEAR(explored(out, "dome")["texture_period_m"].get<double>(), dome_period, 0.05 * dome_period);
+  // smooth surfaces have no period and hardly any ripple; textured ones ripple
+  for (const std::string object : {"stiff", "soft", "sticky", "slippery"}) {
+    EXPECT_TRUE(explored(out, object)["texture_period_m"].is_null()) << object;
+    EXPECT_LT(explored(out, object)["texture_ripple_n"].get<double>(), 0.002) << object;
+  }
+  for (const std::string object : {"ridged", "rough", "dome"})
+    EXPECT_GT(explored(out, object)["texture_ripple_n"].get<double>(), 0.01) << object;
+
+  // passivity over each whole (closed) exploration: friction and damping take energy out, the
+  // texture's passivity controller lets at most a tick's worth in
+  for (const auto& o : out["objects"]) {
+    EXPECT_LT(o["work_on_hand_j"].get<double>(), 1e-3) << o["name"];
+    EXPECT_LT(o["simulated_s"].get<double>(), 20.0) << o["name"] << ": the script ran to its end";
+  }
+  EXPECT_LT(explored(out, "sticky")["work_on_hand_j"].get<double>(), -0.01) << "friction dissipates";
+}
+
+TEST_F(CliTest, ExploreFindsTheTexturePeriodAtTenKilohertzToo) {
+  const MaterialsScene scene = materials_scene();
+  const CommandRun r = uh(
+      fmt::format("explore '{}' --object ridged --haptic-hz 10000 --ticks-per-collision 10 --seed 3 --json",
+                  materials_scene_path().string()),
+      fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json out = json_of(r);
+  ASSERT_EQ(out["objects"].size(), 1u);
+  const double period = scene.material("ridged")["texture"]["period"].get<double>() *
+                        (scene.radius("ridged") + scene.tool_radius()) / scene.radius("ridged");
+  EXPECT_NEAR(out["objects"][0]["texture_period_m"].get<double>(), period, 0.05 * period);
+  EXPECT_GT(out["objects"][0]["haptic_ticks"].get<double>(), 50000.0) << "10 kHz";
+  EXPECT_LT(out["objects"][0]["work_on_hand_j"].get<double>(), 1e-3);
+}
+
+TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {
+  const CommandRun bad = uh(fmt::format("explore '{}' --object marble", materials_scene_path().string()),
+                            fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("no object is named 'marble'"), std::string::npos) << bad.err;
+  const fs::path png = dir_ / "sticky.png";
+  const CommandRun r = uh(
+      fmt::format("explore '{}' --object sticky --plot '{}'", materials_scene_path().string(), png.string()),
+      fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("friction   static"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(png).substr(1, 3), "PNG");
+}
+
 }  // namespace
 }  // namespace uh

@@ -1,0 +1,123 @@
+// uh explore SCENE [--object NAME] [--json] [--plot OUT.png] [--seed N]
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "progress_bar.hpp"
+#include "session_plot.hpp"
+#include "uh/controllers/exploration.hpp"
+#include "uh/controllers/scene.hpp"
+
+namespace uh::cli {
+namespace {
+
+struct ExploreArgs {
+  std::string scene;
+  std::string object;
+  bool json = false;
+  std::string plot;
+  std::uint64_t seed = 1;
+  double haptic_hz = 0.0;
+  int ticks_per_collision = 1;
+};
+
+nlohmann::json optional_number(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+std::string shown(const std::optional<double>& v, const char* format_unit) {
+  return v ? fmt::format(fmt::runtime(format_unit), *v) : std::string("none");
+}
+
+int explore(const ExploreArgs& args) {
+  auto scene = controllers::load_scene(args.scene);
+  if (!scene) return fail(scene.error().message);
+  controllers::ExploreOptions options;
+  options.seed = args.seed;
+  if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
+  options.ticks_per_collision_step = args.ticks_per_collision;
+  controllers::SessionOptions session;
+  session.cache_dir = controllers::default_cache_dir();
+  std::unique_ptr<ProgressBar> bar;
+  std::string bar_label;
+  session.build_progress = [&](const std::string& what, double fraction) {
+    if (what != bar_label) {
+      bar = std::make_unique<ProgressBar>(what);
+      bar_label = what;
+    }
+    bar->update(fraction);
+  };
+  auto explored = controllers::explore_scene(*scene, args.object, options, session);
+  bar.reset();
+  if (!explored) return fail(explored.error().message);
+  if (!args.plot.empty())
+    if (auto plotted = write_exploration_plot(scene->name, *explored, args.plot); !plotted)
+      return fail(plotted.error().message);
+  if (args.json) {
+    nlohmann::json objects = nlohmann::json::array();
+    for (const auto& o : *explored) {
+      const auto& e = o.estimate;
+      objects.push_back(
+          {{"name", o.object},
+           {"stiffness_n_per_mm", optional_number(e.stiffness_n_per_mm)},
+           {"friction_static", optional_number(e.friction_static)},
+           {"friction_dynamic", optional_number(e.friction_dynamic)},
+           {"texture_period_m", optional_number(e.texture_period_m)},
+           {"texture_ripple_n", e.texture_ripple_n},
+           {"texture_period_along_strokes_m",
+            {e.period_axis_m[0] > 0.0 ? nlohmann::json(e.period_axis_m[0]) : nlohmann::json(nullptr),
+             e.period_axis_m[1] > 0.0 ? nlohmann::json(e.period_axis_m[1]) : nlohmann::json(nullptr)}},
+           {"work_on_hand_j", o.work_on_hand_j},
+           {"simulated_s", o.simulated_s},
+           {"haptic_ticks", o.haptic_ticks}});
+    }
+    const nlohmann::json out{{"scene", scene->name}, {"seed", args.seed}, {"objects", objects}};
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+  std::printf("scene %s: explored %zu object(s) in simulated time (seed %llu)\n", scene->name.c_str(),
+              explored->size(), static_cast<unsigned long long>(args.seed));
+  for (const auto& o : *explored) {
+    const auto& e = o.estimate;
+    std::printf("  %s\n", o.object.c_str());
+    std::printf("    stiffness  %s\n", shown(e.stiffness_n_per_mm, "{:.3f} N/mm").c_str());
+    std::printf("    friction   static %s, dynamic %s\n", shown(e.friction_static, "{:.3f}").c_str(),
+                shown(e.friction_dynamic, "{:.3f}").c_str());
+    std::printf("    texture    period %s, ripple %.3f N RMS\n",
+                shown(e.texture_period_m, "{:.5f} m").c_str(), e.texture_ripple_n);
+    std::printf("    %.1f s simulated, %llu ticks; energy into the hand %.5f J\n", o.simulated_s,
+                static_cast<unsigned long long>(o.haptic_ticks), o.work_on_hand_j);
+  }
+  if (!args.plot.empty()) std::printf("  plot -> %s\n", args.plot.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_explore_command(CLI::App& app, CommandRunner& runner) {
+  static ExploreArgs args;
+  auto* e = app.add_subcommand(
+      "explore",
+      "explore each object of a scene with a scripted hand in simulated time (press, strokes, a contour, "
+      "taps) "
+      "and estimate its material from the position and force trace: stiffness, friction, texture");
+  e->add_option("scene", args.scene, "scene file (JSON)")->required()->check(CLI::ExistingFile);
+  e->add_option("--object", args.object, "explore only the object of this name");
+  e->add_flag("--json", args.json, "print one JSON object with the estimates per object");
+  e->add_option("--plot", args.plot, "write a PNG of the forces felt while stroking each object");
+  e->add_option("--seed", args.seed, "where on each object and in which directions to stroke (default 1)");
+  e->add_option("--haptic-hz", args.haptic_hz, "override the haptic rate [Hz]")
+      ->check(CLI::Range(1.0, 10000.0));
+  e->add_option("--ticks-per-collision", args.ticks_per_collision,
+                "haptic ticks per collision step (default 1)")
+      ->check(CLI::Range(1, 1000));
+  e->callback([&runner] { runner = [] { return explore(args); }; });
+}
+
+}  // namespace uh::cli

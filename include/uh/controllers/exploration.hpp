@@ -1,0 +1,113 @@
+#pragma once
+/// \file
+/// Exploration: a scripted hand explores each object of a scene on a simulated device in
+/// simulated time (press and release, strokes in two directions at a set speed and normal force,
+/// a contour follow, taps), and the object's material is estimated back from the trace of the
+/// device's position and the force it was commanded, alone: stiffness, static and dynamic
+/// friction, texture period and ripple. What `uh explore` runs (docs/exploration.md).
+///
+/// The estimators read only the trace (ExploreTrace) and the script's own labels of its phases;
+/// they never read the scene's material values.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "uh/controllers/haptic_session.hpp"
+#include "uh/controllers/scene.hpp"
+#include "uh/core/math.hpp"
+#include "uh/core/result.hpp"
+
+namespace uh::controllers {
+
+/// Settings of the exploration script (options aggregate).
+struct ExploreOptions {
+  double press_force_n = 3.0;          ///< press to this normal force, then release [N]
+  double press_speed_m_per_s = 0.004;  ///< speed of the press and release [m/s]
+  double stroke_force_n = 2.0;         ///< normal force held while stroking [N]
+  double stroke_speed_m_per_s = 0.02;  ///< stroke speed [m/s]
+  double stroke_length_m = 0.024;      ///< length of each stroke [m]
+  double contour_radius_m = 0.005;     ///< the contour follow: one circle of this radius [m]
+  int taps = 3;                        ///< taps at the end
+  double tap_speed_m_per_s = 0.03;     ///< [m/s]
+  std::optional<double> haptic_hz;     ///< override of the scene's haptic rate [Hz]
+  int ticks_per_collision_step = 1;    ///< haptic ticks per collision step (simulated time)
+  /// Chooses where on the object the exploration happens (up to 3 mm off its top) and turns the
+  /// pair of stroke directions about the vertical; the same seed gives the same run.
+  std::uint64_t seed = 1;
+};
+
+/// The phases of the script, as labelled in the trace.
+enum class ExplorePhase : std::uint8_t {
+  kApproach,
+  kPress,
+  kRelease,
+  kSeat,
+  kHold,
+  kStroke,
+  kContour,
+  kLift,
+  kTap,
+  kReturn,
+  kDone
+};
+
+/// One haptic tick of an exploration: the device position and the force commanded (world frame,
+/// which the exploration makes the device frame).
+struct ExploreSample {
+  double time_s = 0.0;
+  Vec3 position{};  ///< handle position [m]
+  Vec3 force{};     ///< force commanded to the device [N]
+  ExplorePhase phase = ExplorePhase::kApproach;
+  std::int32_t leg = -1;  ///< which stroke (0..3: +e1, -e1, +e2, -e2), -1 outside the strokes
+};
+
+struct ExploreTrace {
+  std::vector<ExploreSample> samples;
+  ExploreOptions options{};
+  Vec3 stroke_axes[2]{};  ///< e1, e2: the stroke directions (horizontal)
+};
+
+/// What the estimators found on one object. Optional fields are empty when the trace holds no
+/// evidence (no contact, no significant ripple).
+struct MaterialEstimate {
+  std::optional<double> stiffness_n_per_mm;  ///< slope of normal force against depth while pressing
+  std::optional<double> friction_static;     ///< tangential over normal force at breakaway
+  std::optional<double> friction_dynamic;    ///< tangential over normal force while sliding
+  std::optional<double> texture_period_m;    ///< dominant spatial period of the normal force ripple
+  double texture_ripple_n = 0.0;             ///< RMS of the normal force ripple while sliding [N]
+  double period_axis_m[2] = {0.0, 0.0};      ///< dominant apparent period along each stroke axis, 0 = none
+};
+
+/// Estimates the material from a trace alone (the device's positions, the commanded forces and the
+/// script's phase labels).
+MaterialEstimate estimate_material(const ExploreTrace& trace);
+
+/// The force felt while stroking at one tick: split along the motion (for plots).
+struct StrokeForce {
+  double time_s = 0.0;
+  double normal_n = 0.0;      ///< the force across the motion [N]
+  double tangential_n = 0.0;  ///< the force against the motion [N]
+};
+
+/// The strokes' and the contour's samples of a trace as normal and tangential force.
+std::vector<StrokeForce> stroke_forces(const ExploreTrace& trace);
+
+/// One object explored.
+struct ObjectExploration {
+  std::string object;
+  MaterialEstimate estimate;
+  ExploreTrace trace;
+  double work_on_hand_j = 0.0;  ///< energy the device put into the hand over the whole (closed) script [J]
+  double simulated_s = 0.0;     ///< simulated time the script took [s]
+  std::uint64_t haptic_ticks = 0;
+};
+
+/// Explores object `object_name` of `scene` (every object when empty), each alone with the
+/// scene's tool, on a simulated hand that follows the script; stepped, in simulated time.
+Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const std::string& object_name,
+                                                     const ExploreOptions& options,
+                                                     const SessionOptions& session = {});
+
+}  // namespace uh::controllers

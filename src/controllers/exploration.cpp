@@ -1,0 +1,672 @@
+#include "uh/controllers/exploration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "uh/haptico/device_registry.hpp"
+#include "uh/haptico/simulated_device.hpp"
+
+namespace uh::controllers {
+namespace {
+
+constexpr double kTouchN = 0.05;      // a force above this means contact [N]
+constexpr double kFreeN = 0.02;       // below this the tool is free [N]
+constexpr double kForceGain = 0.015;  // normal force loop: speed per newton of error [m / (N s)]
+constexpr double kNormalTauS = 0.02;  // low-pass of the normal estimate [s]
+constexpr double kHoldS = 0.3;        // rest between strokes [s]
+constexpr double kClearM = 0.002;     // lift this far past the last contact [m]
+constexpr double kMaxSeconds = 40.0;  // the script's whole budget of simulated time [s]
+
+// Where the hand starts and how the strokes are turned (planned from the geometry before the run)
+struct ExplorePlan {
+  Vec3 start{};
+  Vec3 axes[2]{};
+};
+
+// A hand that follows the exploration script: it reads the force it is sent and moves the handle
+// as a person exploring would (press until a force is felt, hold a normal force while stroking).
+class ExplorerDevice final : public haptico::SimulatedDevice {
+ public:
+  ExplorerDevice(const haptico::SimDeviceOptions& device, const ExploreOptions& options,
+                 const ExplorePlan& plan, std::size_t capacity)
+      : SimulatedDevice("explorer", device), options_(options), plan_(plan), position_(plan.start) {
+    trace_.reserve(capacity);
+  }
+
+  void set_session(HapticSession* session) { session_ = session; }
+  std::vector<ExploreSample>& trace() { return trace_; }
+  bool touched() const { return touched_; }
+
+ private:
+  haptico::DeviceState sample(double) const override {
+    haptico::DeviceState s;
+    s.position = position_;
+    s.linear_velocity = velocity_;
+    return s;
+  }
+
+  void begin(ExplorePhase phase, double t) {
+    phase_ = phase;
+    phase_start_s_ = t;
+    travelled_m_ = 0.0;
+  }
+
+  void update_normal(const Vec3& force, const Vec3& along, double dt) {
+    // the force without its component along the motion (friction) points along the normal
+    const Vec3 pressing = force - dot(force, along) * along;
+    if (norm(pressing) < kTouchN) return;
+    normal_ = normalized(normal_ + std::min(1.0, dt / kNormalTauS) * (normalized(pressing) - normal_));
+  }
+
+  // moves along `direction` in the tangent plane at `speed` while holding `target` newtons of normal force
+  Vec3 slide(const Vec3& force, const Vec3& direction, double speed, double target, double dt,
+             bool track_normal) {
+    const Vec3 tangent = normalized(direction - dot(direction, normal_) * normal_);
+    if (track_normal) update_normal(force, tangent, dt);
+    const double pressing = dot(force, normal_);
+    return speed * tangent - kForceGain * (target - pressing) * normal_;
+  }
+
+  void integrate(double t, double dt, const haptico::DeviceCommand& cmd) override {
+    const Vec3 f = cmd.force;
+    if (trace_.size() < trace_.capacity())
+      trace_.push_back({.time_s = t, .position = position_, .force = f, .phase = phase_, .leg = leg_});
+    const double in_phase = t - phase_start_s_;
+    const double touching = norm(f);
+    Vec3 v{};
+    switch (phase_) {
+      case ExplorePhase::kApproach:
+        v = {0, 0, -0.01};
+        if (touching > kTouchN) {
+          touched_ = true;
+          normal_ = normalized(f);
+          begin(ExplorePhase::kPress, t);
+        } else if (travelled_m_ > 0.03) {
+          begin(ExplorePhase::kReturn, t);  // nothing there
+        }
+        break;
+      case ExplorePhase::kPress:
+        update_normal(f, {}, dt);
+        v = -options_.press_speed_m_per_s * normal_;
+        if (dot(f, normal_) >= options_.press_force_n || in_phase > 5.0) begin(ExplorePhase::kRelease, t);
+        break;
+      case ExplorePhase::kRelease:
+        v = options_.press_speed_m_per_s * normal_;
+        if (touching < kFreeN) begin(ExplorePhase::kSeat, t);
+        if (in_phase > 5.0) begin(ExplorePhase::kReturn, t);
+        break;
+      case ExplorePhase::kSeat:
+        update_normal(f, {}, dt);
+        v = -options_.press_speed_m_per_s * normal_;
+        if (dot(f, normal_) >= options_.stroke_force_n) begin(ExplorePhase::kHold, t);
+        if (in_phase > 5.0) begin(ExplorePhase::kReturn, t);
+        break;
+      case ExplorePhase::kHold:
+        v = -kForceGain * (options_.stroke_force_n - dot(f, normal_)) * normal_;
+        if (in_phase >= kHoldS) {
+          if (next_leg_ < 4) {
+            leg_ = next_leg_++;
+            begin(ExplorePhase::kStroke, t);
+          } else if (!contour_done_) {
+            leg_ = -1;
+            begin(ExplorePhase::kContour, t);
+          } else {
+            leg_ = -1;
+            begin(ExplorePhase::kLift, t);
+          }
+        }
+        break;
+      case ExplorePhase::kStroke: {
+        const Vec3 direction = (leg_ % 2 == 0 ? 1.0 : -1.0) * plan_.axes[leg_ / 2];
+        v = slide(f, direction, options_.stroke_speed_m_per_s, options_.stroke_force_n, dt, true);
+        if (travelled_m_ >= options_.stroke_length_m) {
+          leg_ = -1;
+          begin(ExplorePhase::kRelease, t);  // lift off between strokes, as a finger does
+        }
+        break;
+      }
+      case ExplorePhase::kContour: {
+        const double angle = options_.stroke_speed_m_per_s * in_phase / options_.contour_radius_m;
+        const Vec3 direction = std::cos(angle) * plan_.axes[0] + std::sin(angle) * plan_.axes[1];
+        // on a circle the friction pulls across the motion too, which would tilt a normal taken
+        // from the force: the hand keeps the normal it had when it sat down, the force loop does the rest
+        v = slide(f, direction, options_.stroke_speed_m_per_s, options_.stroke_force_n, dt, false);
+        if (angle >= 2.0 * kPi) {
+          contour_done_ = true;
+          begin(ExplorePhase::kLift, t);
+        }
+        break;
+      }
+      case ExplorePhase::kLift:
+        v = 2.0 * options_.press_speed_m_per_s * normal_;
+        if (touching > kFreeN) free_m_ = 0.0;
+        if (in_phase > 5.0) begin(ExplorePhase::kReturn, t);
+        if (free_m_ > kClearM) {
+          tap_ = 0;
+          tap_in_ = true;
+          begin(ExplorePhase::kTap, t);
+        }
+        break;
+      case ExplorePhase::kTap:
+        if (tap_ >= options_.taps) {
+          begin(ExplorePhase::kReturn, t);
+          break;
+        }
+        if (tap_in_) {
+          v = -options_.tap_speed_m_per_s * normal_;
+          if (dot(f, normal_) >= options_.stroke_force_n || in_phase > 2.0) {
+            tap_in_ = false;
+            free_m_ = 0.0;
+          }
+        } else {
+          v = options_.tap_speed_m_per_s * normal_;
+          if (touching > kFreeN) free_m_ = 0.0;
+          if (in_phase > 4.0) begin(ExplorePhase::kReturn, t);
+          if (free_m_ > kClearM) {
+            ++tap_;
+            tap_in_ = true;
+            phase_start_s_ = t;
+          }
+        }
+        break;
+      case ExplorePhase::kReturn: {
+        const Vec3 to_start = plan_.start - position_;
+        const double left = norm(to_start);
+        const double step = 0.02 * dt;
+        if (left <= step) {
+          v = to_start / dt;
+          begin(ExplorePhase::kDone, t);
+        } else {
+          v = to_start * (0.02 / left);
+        }
+        break;
+      }
+      case ExplorePhase::kDone:
+        if (session_ != nullptr && in_phase > 0.05) session_->request_stop();
+        break;
+    }
+    const Vec3 step = v * dt;
+    position_ += step;
+    velocity_ = v;
+    travelled_m_ += norm(step);
+    free_m_ += norm(step);
+  }
+
+  ExploreOptions options_;
+  ExplorePlan plan_;
+  std::vector<ExploreSample> trace_;
+  HapticSession* session_ = nullptr;
+  Vec3 position_{};
+  Vec3 velocity_{};
+  Vec3 normal_{0, 0, 1};
+  ExplorePhase phase_ = ExplorePhase::kApproach;
+  double phase_start_s_ = 0.0;
+  double travelled_m_ = 0.0;
+  double free_m_ = 0.0;
+  std::int32_t leg_ = -1;
+  std::int32_t next_leg_ = 0;
+  bool contour_done_ = false;
+  int tap_ = 0;
+  bool tap_in_ = true;
+  bool touched_ = false;
+};
+
+// splitmix64 for the seed's choices (the same run on every platform)
+double seeded_uniform(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
+// The start above the object's top (near the centre of its footprint, moved by the seed) and the
+// stroke axes; from the packed shapes (geometry only, never the material)
+Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const Pose& world_from_object,
+                                     const collette::SphereTree& tool, const ExploreOptions& options) {
+  const auto leaves = object.leaves();
+  if (leaves.empty()) return Error{"the object has no spheres"};
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  std::vector<std::pair<Vec3, double>> world;
+  for (const Sphere& s : leaves) {
+    const Vec3 c = transform_point(world_from_object, Vec3{s.x, s.y, s.z});
+    const double r = s.radius;
+    world.emplace_back(c, r);
+    lo = {std::min(lo.x, c.x - r), std::min(lo.y, c.y - r), std::min(lo.z, c.z - r)};
+    hi = {std::max(hi.x, c.x + r), std::max(hi.y, c.y + r), std::max(hi.z, c.z + r)};
+  }
+  std::uint64_t rng = options.seed;
+  const double dx = (seeded_uniform(rng) - 0.5) * 0.006, dy = (seeded_uniform(rng) - 0.5) * 0.006;
+  const double turn = 2.0 * kPi * seeded_uniform(rng);
+  const Vec3 target{0.5 * (lo.x + hi.x) + dx, 0.5 * (lo.y + hi.y) + dy, 0.0};
+  double top = -1e300;
+  for (const auto& [c, r] : world) {
+    const double d2 = (c.x - target.x) * (c.x - target.x) + (c.y - target.y) * (c.y - target.y);
+    if (d2 < r * r) top = std::max(top, c.z + std::sqrt(r * r - d2));
+  }
+  if (top < -1e299) top = hi.z;
+  // the tool's lowest point (the handle holds it upright: device frame = world)
+  Vec3 tip{0, 0, 1e300};
+  for (const Sphere& s : tool.leaves()) {
+    const double bottom = static_cast<double>(s.z) - static_cast<double>(s.radius);
+    if (bottom < tip.z) tip = {s.x, s.y, bottom};
+  }
+  ExplorePlan plan;
+  plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + 0.003 - tip.z};
+  plan.axes[0] = {std::cos(turn), std::sin(turn), 0.0};
+  plan.axes[1] = {-std::sin(turn), std::cos(turn), 0.0};
+  return plan;
+}
+
+// ---- estimators: the trace alone ----
+
+struct Line {
+  double slope = 0.0;
+  double intercept = 0.0;
+};
+
+Line fit_line(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  const double mx = std::accumulate(x.begin(), x.end(), 0.0) / n;
+  const double my = std::accumulate(y.begin(), y.end(), 0.0) / n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  const double slope = sxx > 0.0 ? sxy / sxx : 0.0;
+  return {slope, my - slope * mx};
+}
+
+// The slope of the least-squares parabola through (s, f) where it reaches zero force below the
+// data (the first touch); the straight line's slope when the parabola has no such root.
+double touch_slope(const std::vector<double>& s, const std::vector<double>& f) {
+  const std::size_t n = s.size();
+  const double s_mean = std::accumulate(s.begin(), s.end(), 0.0) / static_cast<double>(n);
+  // normal equations in the centred variable u = s - mean (well conditioned)
+  double m[3][4] = {};
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u = s[i] - s_mean;
+    const double p[3] = {1.0, u, u * u};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m[r][c] += p[r] * p[c];
+      m[r][3] += p[r] * f[i];
+    }
+  }
+  for (int col = 0; col < 3; ++col) {  // Gauss-Jordan with partial pivoting
+    int pivot = col;
+    for (int r = col + 1; r < 3; ++r)
+      if (std::fabs(m[r][col]) > std::fabs(m[pivot][col])) pivot = r;
+    for (int c = 0; c < 4; ++c) std::swap(m[col][c], m[pivot][c]);
+    if (m[col][col] == 0.0) return fit_line(s, f).slope;
+    for (int r = 0; r < 3; ++r) {
+      if (r == col) continue;
+      const double q = m[r][col] / m[col][col];
+      for (int c = 0; c < 4; ++c) m[r][c] -= q * m[col][c];
+    }
+  }
+  const double c0 = m[0][3] / m[0][0], c1 = m[1][3] / m[1][1], c2 = m[2][3] / m[2][2];
+  const double u_lo = *std::min_element(s.begin(), s.end()) - s_mean;
+  // the root of c0 + c1 u + c2 u^2 nearest below the shallowest sample
+  double root = 0.0;
+  if (std::fabs(c2) < 1e-12 * std::fabs(c1)) {
+    root = -c0 / c1;
+  } else {
+    const double disc = c1 * c1 - 4.0 * c2 * c0;
+    if (disc < 0.0) return fit_line(s, f).slope;
+    const double r1 = (-c1 - std::sqrt(disc)) / (2.0 * c2), r2 = (-c1 + std::sqrt(disc)) / (2.0 * c2);
+    const bool ok1 = r1 <= u_lo, ok2 = r2 <= u_lo;
+    if (!ok1 && !ok2) return fit_line(s, f).slope;
+    root = ok1 && ok2 ? std::max(r1, r2) : (ok1 ? r1 : r2);
+  }
+  const double slope = c1 + 2.0 * c2 * root;
+  return slope > 0.0 ? slope : fit_line(s, f).slope;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The samples of one sliding stretch with, for each, the distance travelled, the motion
+// direction (over about a millimetre of path) and the force split into normal and tangential parts
+struct Slide {
+  std::vector<double> time;
+  std::vector<double> travel;
+  std::vector<double> normal_n;
+  std::vector<double> friction_ratio;
+};
+
+Slide slide_of(const ExploreTrace& trace, const std::vector<std::size_t>& idx) {
+  Slide s;
+  if (idx.size() < 8) return s;
+  const auto& x = trace.samples;
+  std::vector<double> travel(idx.size(), 0.0);
+  for (std::size_t j = 1; j < idx.size(); ++j)
+    travel[j] = travel[j - 1] + norm(x[idx[j]].position - x[idx[j - 1]].position);
+  const double step = travel.back() / static_cast<double>(idx.size() - 1);
+  const auto w = static_cast<std::size_t>(std::clamp(step > 0.0 ? 0.0005 / step : 1.0, 1.0, 2000.0));
+  for (std::size_t j = 0; j < idx.size(); ++j) {
+    const std::size_t a = j >= w ? j - w : 0, b = std::min(idx.size() - 1, j + w);
+    const Vec3 moved = x[idx[b]].position - x[idx[a]].position;
+    const Vec3& f = x[idx[j]].force;
+    // the hand also moves along the normal to hold its force: only the motion in the tangent plane
+    // (across the force, once the force's part along the motion is set aside) is the slide
+    const Vec3 first = normalized(moved);
+    const Vec3 normal = normalized(f - dot(f, first) * first);
+    const Vec3 motion = normalized(moved - dot(moved, normal) * normal);
+    if (norm(motion) == 0.0) continue;
+    const double along = dot(f, motion);
+    const double pressing = norm(f - along * motion);
+    if (pressing < kTouchN) continue;
+    s.time.push_back(x[idx[j]].time_s);
+    s.travel.push_back(travel[j]);
+    s.normal_n.push_back(pressing);
+    s.friction_ratio.push_back(-along / pressing);
+  }
+  return s;
+}
+
+// Power of the detrended, Hann-windowed signal y(s) (uniformly resampled) at spatial frequency f [1/m]
+struct Spectrum {
+  std::vector<double> frequency;
+  std::vector<double> power;
+};
+
+// `grid` resampled residuals over a common length; adds the power at each frequency
+void add_spectrum(const std::vector<double>& residual, double ds, Spectrum& spectrum) {
+  const std::size_t n = residual.size();
+  for (std::size_t k = 0; k < spectrum.frequency.size(); ++k) {
+    double re = 0.0, im = 0.0;
+    const double w = 2.0 * kPi * spectrum.frequency[k] * ds;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double hann =
+          0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(i) / static_cast<double>(n - 1));
+      re += hann * residual[i] * std::cos(w * static_cast<double>(i));
+      im += hann * residual[i] * std::sin(w * static_cast<double>(i));
+    }
+    spectrum.power[k] += re * re + im * im;
+  }
+}
+
+// The normal force over the sliding part of a stroke, resampled every `ds` metres, minus its line
+std::vector<double> ripple_of(const Slide& s, double from_m, double to_m, double ds) {
+  std::vector<double> out;
+  std::size_t j = 0;
+  for (double at = from_m; at <= to_m; at += ds) {
+    while (j + 1 < s.travel.size() && s.travel[j + 1] < at) ++j;
+    if (j + 1 >= s.travel.size()) break;
+    const double span = s.travel[j + 1] - s.travel[j];
+    const double u = span > 0.0 ? std::clamp((at - s.travel[j]) / span, 0.0, 1.0) : 0.0;
+    out.push_back(s.normal_n[j] + u * (s.normal_n[j + 1] - s.normal_n[j]));
+  }
+  if (out.size() < 16) return {};
+  // minus the least-squares cubic: what the hand's force loop and the shape's curvature add
+  // varies over the whole stroke, the texture over millimetres
+  constexpr int kTerms = 4;
+  double m[kTerms][kTerms + 1] = {};
+  const double half = 0.5 * static_cast<double>(out.size() - 1);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double u = (static_cast<double>(i) - half) / half;  // in [-1, 1]
+    double p[kTerms] = {1.0, u, u * u, u * u * u};
+    for (int r = 0; r < kTerms; ++r) {
+      for (int c = 0; c < kTerms; ++c) m[r][c] += p[r] * p[c];
+      m[r][kTerms] += p[r] * out[i];
+    }
+  }
+  for (int col = 0; col < kTerms; ++col) {
+    int pivot = col;
+    for (int r = col + 1; r < kTerms; ++r)
+      if (std::fabs(m[r][col]) > std::fabs(m[pivot][col])) pivot = r;
+    for (int c = 0; c <= kTerms; ++c) std::swap(m[col][c], m[pivot][c]);
+    if (m[col][col] == 0.0) return {};
+    for (int r = 0; r < kTerms; ++r) {
+      if (r == col) continue;
+      const double q = m[r][col] / m[col][col];
+      for (int c = 0; c <= kTerms; ++c) m[r][c] -= q * m[col][c];
+    }
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double u = (static_cast<double>(i) - half) / half;
+    out[i] -= m[0][kTerms] / m[0][0] +
+              u * (m[1][kTerms] / m[1][1] + u * (m[2][kTerms] / m[2][2] + u * m[3][kTerms] / m[3][3]));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<StrokeForce> stroke_forces(const ExploreTrace& trace) {
+  std::vector<StrokeForce> out;
+  const auto& x = trace.samples;
+  std::size_t i = 0;
+  while (i < x.size()) {
+    const bool sliding = x[i].phase == ExplorePhase::kStroke || x[i].phase == ExplorePhase::kContour;
+    if (!sliding) {
+      ++i;
+      continue;
+    }
+    // one stretch: the same phase and leg
+    std::vector<std::size_t> idx;
+    const ExplorePhase phase = x[i].phase;
+    const std::int32_t leg = x[i].leg;
+    for (; i < x.size() && x[i].phase == phase && x[i].leg == leg; ++i) idx.push_back(i);
+    const Slide s = slide_of(trace, idx);
+    for (std::size_t j = 0; j < s.time.size(); ++j)
+      out.push_back({s.time[j], s.normal_n[j], s.friction_ratio[j] * s.normal_n[j]});
+  }
+  return out;
+}
+
+MaterialEstimate estimate_material(const ExploreTrace& trace) {
+  MaterialEstimate e;
+  const ExploreOptions& o = trace.options;
+  const auto& x = trace.samples;
+
+  // stiffness: normal force against depth while pressing in, between 10 % and 95 % of the press
+  // force, fitted with F = c0 + c1 s + c2 s^2 (a round contact stiffens or softens with depth:
+  // a ball on a plane is exactly quadratic, k pi (2 r d - d^2)); the stiffness reported is the
+  // slope where the fit reaches zero force, at first touch: for a round tip 2 pi r k
+  {
+    Vec3 sum{};
+    for (const auto& s : x)
+      if (s.phase == ExplorePhase::kPress && norm(s.force) > 0.2 * o.press_force_n) sum += s.force;
+    const Vec3 n = normalized(sum);
+    std::vector<double> depth, force;
+    for (const auto& s : x) {
+      if (s.phase != ExplorePhase::kPress) continue;
+      const double fn = dot(s.force, n);
+      if (fn < 0.1 * o.press_force_n || fn > 0.95 * o.press_force_n) continue;
+      depth.push_back(-dot(s.position, n));
+      force.push_back(fn);
+    }
+    if (depth.size() >= 10) e.stiffness_n_per_mm = touch_slope(depth, force) * 1e-3;
+  }
+
+  // friction: per stroke, the largest ratio before a third of the stroke (breakaway) and the
+  // median ratio over its second half (sliding); the contour's median ratio joins the sliding ones
+  std::vector<double> breakaway, sliding;
+  Slide legs[4];
+  for (int leg = 0; leg < 4; ++leg) {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (x[i].phase == ExplorePhase::kStroke && x[i].leg == leg) idx.push_back(i);
+    legs[leg] = slide_of(trace, idx);
+    const Slide& s = legs[leg];
+    if (s.travel.empty()) continue;
+    double peak = -1e300;
+    std::vector<double> slid;
+    for (std::size_t j = 0; j < s.travel.size(); ++j) {
+      if (s.travel[j] < o.stroke_length_m / 3.0) peak = std::max(peak, s.friction_ratio[j]);
+      if (s.travel[j] > 0.5 * o.stroke_length_m && s.travel[j] < 0.95 * o.stroke_length_m)
+        slid.push_back(s.friction_ratio[j]);
+    }
+    if (peak > -1e300) breakaway.push_back(peak);
+    if (!slid.empty()) sliding.push_back(median(slid));
+  }
+  {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (x[i].phase == ExplorePhase::kContour) idx.push_back(i);
+    const Slide c = slide_of(trace, idx);
+    std::vector<double> slid;
+    const double circle = 2.0 * kPi * o.contour_radius_m;
+    for (std::size_t j = 0; j < c.travel.size(); ++j)
+      if (c.travel[j] > 0.25 * circle) slid.push_back(c.friction_ratio[j]);
+    if (!slid.empty()) sliding.push_back(median(slid));
+  }
+  const auto mean = [](const std::vector<double>& v) {
+    return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  };
+  if (!breakaway.empty()) e.friction_static = std::max(0.0, mean(breakaway));
+  if (!sliding.empty()) e.friction_dynamic = std::max(0.0, mean(sliding));
+
+  // texture: the spectrum of the normal force ripple along each stroke axis (both strokes of the
+  // axis), after the breakaway (past 15 % of the stroke); the dominant spatial frequencies of the two axes
+  // are the components of the texture's wave vector in the stroke plane, so period = 1 / |(f_1, f_2)|
+  const double from = 0.15 * o.stroke_length_m, to = 0.97 * o.stroke_length_m;
+  const double ds = 2.5e-5;  // resampling step [m]: 40 samples per millimetre
+  double sum_sq = 0.0;
+  std::size_t count = 0;
+  double f_sq = 0.0;
+  for (int axis = 0; axis < 2; ++axis) {
+    Spectrum spectrum;
+    const double span = to - from;
+    for (double f = 2.0 / span; f <= 1.0 / (8.0 * ds); f += 1.0 / (16.0 * span))
+      spectrum.frequency.push_back(f);
+    spectrum.power.assign(spectrum.frequency.size(), 0.0);
+    bool any = false;
+    double axis_sq = 0.0;
+    std::size_t axis_count = 0;
+    for (int leg = 2 * axis; leg < 2 * axis + 2; ++leg) {
+      const std::vector<double> r = ripple_of(legs[leg], from, to, ds);
+      if (r.empty()) continue;
+      any = true;
+      for (double v : r) axis_sq += v * v;
+      axis_count += r.size();
+      add_spectrum(r, ds, spectrum);
+    }
+    sum_sq += axis_sq;
+    count += axis_count;
+    // a ripple under 0.5 % of the stroke force is the hand's own wobble, not a texture
+    if (axis_count == 0 || std::sqrt(axis_sq / static_cast<double>(axis_count)) < 0.005 * o.stroke_force_n)
+      continue;
+    if (!any || spectrum.power.size() < 3) continue;
+    // the strongest local maximum with at least 2.5 periods in the window (slower variation
+    // left over by the detrending leaks into the lowest frequencies and is no texture)
+    std::size_t peak = 0;
+    for (std::size_t k = 1; k + 1 < spectrum.power.size(); ++k) {
+      if (spectrum.frequency[k] * span < 2.5) continue;
+      if (spectrum.power[k] < spectrum.power[k - 1] || spectrum.power[k] < spectrum.power[k + 1]) continue;
+      if (peak == 0 || spectrum.power[k] > spectrum.power[peak]) peak = k;
+    }
+    const double background = median(spectrum.power);
+    // a texture stands out of the packing's own grain by an order of magnitude and more
+    if (!(spectrum.power[peak] > 30.0 * background) || peak == 0 || peak + 1 >= spectrum.power.size())
+      continue;
+    // the peak between the grid points: a parabola through the three around it
+    const double p0 = spectrum.power[peak - 1], p1 = spectrum.power[peak], p2 = spectrum.power[peak + 1];
+    const double denom = p0 - 2.0 * p1 + p2;
+    const double shift = denom != 0.0 ? 0.5 * (p0 - p2) / denom : 0.0;
+    const double f = spectrum.frequency[peak] + shift * (spectrum.frequency[1] - spectrum.frequency[0]);
+    e.period_axis_m[axis] = 1.0 / f;
+    f_sq += f * f;
+  }
+  if (count > 0) e.texture_ripple_n = std::sqrt(sum_sq / static_cast<double>(count));
+  if (f_sq > 0.0) e.texture_period_m = 1.0 / std::sqrt(f_sq);
+  return e;
+}
+
+Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const std::string& object_name,
+                                                     const ExploreOptions& options,
+                                                     const SessionOptions& session_options) {
+  std::vector<ObjectExploration> out;
+  const std::filesystem::path cache =
+      session_options.cache_dir.empty() ? default_cache_dir() : session_options.cache_dir;
+  const double haptic_hz = options.haptic_hz.value_or(session_options.haptic_hz.value_or(scene.haptic_hz));
+  if (!(haptic_hz >= 1.0 && haptic_hz <= 10000.0))
+    return Error{fmt::format("{}: haptic rate {} Hz is outside [1, 10000]", scene.source, haptic_hz)};
+  bool found = object_name.empty();
+  for (const SceneObject& object : scene.objects) {
+    if (!object_name.empty() && object.name != object_name) continue;
+    found = true;
+    Scene alone = scene;
+    alone.objects = {object};
+    alone.watch = {object.name};
+    alone.tool.device = {.driver = "explorer", .config = {}};
+    alone.tool.workspace = {};  // the device frame is the world frame
+
+    auto object_tree = load_shape_tree(object.shape, cache, session_options.build_progress);
+    if (!object_tree)
+      return Error{
+          fmt::format("{}: object '{}': {}", scene.source, object.name, object_tree.error().message)};
+    auto tool_tree = load_shape_tree(scene.tool.shape, cache, session_options.build_progress);
+    if (!tool_tree)
+      return Error{
+          fmt::format("{}: tool '{}': {}", scene.source, scene.tool.name, tool_tree.error().message)};
+    auto plan = plan_exploration(*object_tree->tree, object.pose, *tool_tree->tree, options);
+    if (!plan)
+      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, plan.error().message)};
+    alone.tool.shape.tree = tool_tree->tree;  // loaded once
+    alone.tool.shape.coverage = tool_tree->coverage;
+    alone.objects[0].shape.tree = object_tree->tree;
+    alone.objects[0].shape.coverage = object_tree->coverage;
+
+    const auto capacity = static_cast<std::size_t>(kMaxSeconds * haptic_hz) + 16;
+    auto device = std::make_unique<ExplorerDevice>(
+        haptico::SimDeviceOptions{.rate_hz = haptic_hz,
+                                  .max_force_n = 20.0,
+                                  .dof_actuated = 3,
+                                  .workspace_half_extents = {10.0, 10.0, 10.0}},
+        options, *plan, capacity);
+    ExplorerDevice* explorer = device.get();
+    auto holder = std::make_shared<std::unique_ptr<haptico::HapticDevice>>(std::move(device));
+    haptico::DeviceRegistry registry;
+    if (auto r = registry.register_driver(
+            "explorer",
+            [holder](const haptico::DeviceConfig&) -> Result<std::unique_ptr<haptico::HapticDevice>> {
+              if (!*holder) return Error{"the exploration's hand is used by one session only"};
+              return std::move(*holder);
+            });
+        !r)
+      return r.error();
+    SessionOptions so = session_options;
+    so.haptic_hz = haptic_hz;
+    so.collision_hz = haptic_hz / options.ticks_per_collision_step;
+    so.cache_dir = cache;
+    auto session = HapticSession::create(alone, so, registry);
+    if (!session) return session.error();
+    explorer->set_session(session->get());
+    if (auto ran = (*session)->run_stepped(kMaxSeconds, options.ticks_per_collision_step); !ran)
+      return ran.error();
+    if (!explorer->touched())
+      return Error{fmt::format("{}: object '{}': the tool never touched it going down from above its top",
+                               scene.source, object.name)};
+    ObjectExploration result;
+    result.object = object.name;
+    result.trace.samples = std::move(explorer->trace());
+    result.trace.options = options;
+    result.trace.stroke_axes[0] = plan->axes[0];
+    result.trace.stroke_axes[1] = plan->axes[1];
+    result.work_on_hand_j = (*session)->report().work_on_hand_j;
+    result.simulated_s = (*session)->report().seconds;
+    result.haptic_ticks = (*session)->report().haptic_ticks;
+    result.estimate = estimate_material(result.trace);
+    out.push_back(std::move(result));
+  }
+  if (!found) {
+    std::string names;
+    for (const auto& o : scene.objects) names += fmt::format("{}'{}'", names.empty() ? "" : ", ", o.name);
+    return Error{
+        fmt::format("{}: no object is named '{}' (the scene has {})", scene.source, object_name, names)};
+  }
+  return out;
+}
+
+}  // namespace uh::controllers
