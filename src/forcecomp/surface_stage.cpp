@@ -48,9 +48,13 @@ SurfaceResult SurfaceStage::apply(const Wrench& penalty, const ContactGeometry& 
     const double depth = std::max(contact.depth_m, options_.min_depth_m);
     const double share = std::clamp(h / depth, -options_.max_texture_share, options_.max_texture_share);
     texture_force = (normal_force * share) * n;
-    // passivity controller: once the texture has put energy in, it may only take it back
-    if (texture_work_j_ > 0.0 && dot(texture_force, motion) > 0.0) {
-      texture_force = {};
+    // passivity controller: the texture may do positive work (with the last tick's motion as the
+    // guess of this one's) only out of what it has taken out of the hand so far; beyond that
+    // credit its force is scaled down, to zero when there is none
+    const double expected = dot(texture_force, motion);
+    const double credit = -texture_work_j_;
+    if (expected > 0.0 && expected > credit) {
+      texture_force *= credit > 0.0 ? credit / expected : 0.0;
       ++texture_drops_;
     }
     if (!is_finite(texture_force)) texture_force = {};

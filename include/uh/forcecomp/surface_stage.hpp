@@ -22,9 +22,9 @@
 /// change of the contact's depth: the normal force is scaled by (depth + h) / depth, the local
 /// spring of the contact, with h / depth clamped to +-`max_texture_share` (the force never
 /// reverses). The texture's energy is observed (the work of its force, held over each period, on
-/// the contact point's motion); while that work is positive the texture force is dropped whenever
-/// it would do positive work: the texture never puts net energy into the hand (a passivity
-/// observer and controller, Hannaford and Ryu 2002).
+/// the contact point's motion); the texture may do positive work only out of the energy it has
+/// taken out of the hand before, beyond that its force is scaled down (to zero without credit): it
+/// never puts net energy into the hand (a passivity observer and controller, Hannaford and Ryu 2002).
 ///
 /// Real-time safe: no allocation, lock, throw or log; O(1) (O(Texture::kWaves) for random textures).
 
@@ -92,7 +92,7 @@ class SurfaceStage {
 
   /// Work the texture force has done on the contact point so far [J] (<= one tick's work above 0).
   double texture_work_j() const { return texture_work_j_; }
-  /// Ticks in which the passivity controller dropped the texture force.
+  /// Ticks in which the passivity controller scaled the texture force down.
   std::uint64_t texture_drops() const { return texture_drops_; }
   const ContactMaterial& material() const { return material_; }
 

@@ -1,0 +1,86 @@
+// The exploration's estimators on synthetic traces built from textbook laws (a ball pressed into
+// a plane, Coulomb friction with a breakaway, a sine grating): what they must read back is known
+// exactly, independent of the rendering that `uh explore` checks end to end (tests/cli).
+
+#include "uh/controllers/exploration.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace uh::controllers {
+namespace {
+
+struct Synthetic {
+  double k = 3e4;   // N/m^2
+  double r = 0.01;  // ball radius [m]
+  double mu_s = 0.5, mu_d = 0.3, stick = 500.0;
+  double period = 0.002, ripple = 0.1;  // grating: period [m], normal force amplitude [N]
+  Vec3 grating{std::cos(0.4), std::sin(0.4), 0.0};
+};
+
+ExploreTrace synthetic_trace(const Synthetic& m) {
+  ExploreTrace trace;
+  const ExploreOptions& o = trace.options;
+  double t = 0.0;
+  const double dt = 0.001;
+  // press: a ball into a plane, F = k pi (2 r d - d^2) (the surface at z = 0, first touch at d = 0)
+  for (double d = -0.0005;; d += o.press_speed_m_per_s * dt) {
+    const double f = d > 0.0 ? m.k * kPi * (2 * m.r * d - d * d) : 0.0;
+    trace.samples.push_back({t += dt, {0, 0, m.r - d}, {0, 0, f}, ExplorePhase::kPress, -1});
+    if (f >= o.press_force_n) break;
+  }
+  trace.stroke_axes[0] = {1, 0, 0};
+  trace.stroke_axes[1] = {0, 1, 0};
+  // strokes at the stroke force with a grating ripple; friction loads a stick spring up to
+  // mu_s N, then slides at mu_d N
+  for (int leg = 0; leg < 4; ++leg) {
+    const Vec3 dir = (leg % 2 == 0 ? 1.0 : -1.0) * trace.stroke_axes[leg / 2];
+    const Vec3 start = leg % 2 == 0 ? Vec3{0, 0, m.r} : Vec3{0, 0, m.r} - dir * o.stroke_length_m;
+    bool slipping = false;
+    for (double s = 0.0; s <= o.stroke_length_m; s += o.stroke_speed_m_per_s * dt) {
+      const Vec3 p = start + s * dir;
+      const double normal = o.stroke_force_n + m.ripple * std::sin(2 * kPi * dot(m.grating, p) / m.period);
+      double friction = m.stick * s;
+      if (friction > m.mu_s * normal) slipping = true;
+      if (slipping) friction = m.mu_d * normal;
+      trace.samples.push_back({t += dt, p, Vec3{0, 0, normal} - friction * dir, ExplorePhase::kStroke, leg});
+    }
+  }
+  return trace;
+}
+
+TEST(Exploration, EstimatorsReadBackATextbookTrace) {
+  const Synthetic m;
+  const MaterialEstimate e = estimate_material(synthetic_trace(m));
+  ASSERT_TRUE(e.stiffness_n_per_mm.has_value());
+  EXPECT_NEAR(*e.stiffness_n_per_mm, 2 * kPi * m.r * m.k * 1e-3, 0.005 * 2 * kPi * m.r * m.k * 1e-3);
+  ASSERT_TRUE(e.friction_static && e.friction_dynamic);
+  EXPECT_NEAR(*e.friction_static, m.mu_s, 0.02);  // the ripple moves the breakaway by a little
+  EXPECT_NEAR(*e.friction_dynamic, m.mu_d, 0.005);
+  ASSERT_TRUE(e.texture_period_m.has_value());
+  EXPECT_NEAR(*e.texture_period_m, m.period, 0.01 * m.period);
+  // the apparent periods along the axes: period / |cos|, period / |sin| of the grating's angle
+  EXPECT_NEAR(e.period_axis_m[0], m.period / std::cos(0.4), 0.02 * m.period / std::cos(0.4));
+  EXPECT_NEAR(e.period_axis_m[1], m.period / std::sin(0.4), 0.03 * m.period / std::sin(0.4));
+  EXPECT_NEAR(e.texture_ripple_n, m.ripple / std::sqrt(2.0), 0.1 * m.ripple / std::sqrt(2.0));
+}
+
+TEST(Exploration, ASmoothFrictionlessTraceHasNoFrictionAndNoPeriod) {
+  Synthetic m;
+  m.mu_s = m.mu_d = 0.0;
+  m.ripple = 0.0;
+  const MaterialEstimate e = estimate_material(synthetic_trace(m));
+  EXPECT_NEAR(*e.friction_static, 0.0, 1e-9);
+  EXPECT_NEAR(*e.friction_dynamic, 0.0, 1e-9);
+  EXPECT_FALSE(e.texture_period_m.has_value());
+  EXPECT_LT(e.texture_ripple_n, 1e-9);
+}
+
+TEST(Exploration, AnEmptyTraceGivesNoEstimates) {
+  const MaterialEstimate e = estimate_material(ExploreTrace{});
+  EXPECT_FALSE(e.stiffness_n_per_mm || e.friction_static || e.friction_dynamic || e.texture_period_m);
+}
+
+}  // namespace
+}  // namespace uh::controllers
