@@ -20,13 +20,7 @@ struct ServeArgs {
 };
 
 int serve(const ServeArgs& args) {
-  // SIGINT and SIGTERM are taken by sigwait below: blocked here, before the server's threads
-  // start (they inherit the mask), so no thread is interrupted by them
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  const sigset_t stop_signals = block_stop_signals();
 
   auto server = service::Server::start({.host = args.host,
                                         .port = static_cast<std::uint16_t>(args.port),
@@ -41,14 +35,28 @@ int serve(const ServeArgs& args) {
   const std::string ws = "ws" + url.substr(4) + "ws";
   std::printf("uh serve: listening on %s (live view: %s); Ctrl-C stops\n", ws.c_str(), url.c_str());
   std::fflush(stdout);
-  int signal = 0;
-  sigwait(&stop_signals, &signal);
+  wait_for_stop_signal(stop_signals);
   (*server)->stop();
   std::printf("uh serve: stopped\n");
   return 0;
 }
 
 }  // namespace
+
+sigset_t block_stop_signals() {
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  return stop_signals;
+}
+
+int wait_for_stop_signal(const sigset_t& stop_signals) {
+  int signal = 0;
+  sigwait(&stop_signals, &signal);
+  return signal;
+}
 
 void add_serve_command(CLI::App& app, CommandRunner& runner) {
   static ServeArgs args;

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <functional>
 
 namespace uh::cli {
@@ -18,6 +19,13 @@ void add_ist_commands(CLI::App& app, CommandRunner& runner);
 void add_query_command(CLI::App& app, CommandRunner& runner);
 void add_run_command(CLI::App& app, CommandRunner& runner);
 void add_serve_command(CLI::App& app, CommandRunner& runner);
+void add_museum_commands(CLI::App& app, CommandRunner& runner);
+
+/// Blocks SIGINT and SIGTERM in the calling thread, before a server's threads start (they inherit
+/// the mask, so no thread is interrupted by them); wait_for_stop_signal() then takes them.
+sigset_t block_stop_signals();
+/// Waits for SIGINT or SIGTERM (blocked by block_stop_signals()); returns which came.
+int wait_for_stop_signal(const sigset_t& stop_signals);
 
 /// Prints "uh: <message>" to stderr and returns 1.
 int fail(const std::string& message);

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   uh::cli::add_query_command(app, runner);
   uh::cli::add_run_command(app, runner);
   uh::cli::add_serve_command(app, runner);
+  uh::cli::add_museum_commands(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -36,15 +36,6 @@ json state_json(const controllers::SessionState& s) {
       {"collision", {{"rate_hz", s.collision_rate_hz}}}};
 }
 
-// Compares without stopping at the first difference (the time does not tell how much matched).
-bool same_token(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  unsigned diff = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    diff |= static_cast<unsigned>(static_cast<unsigned char>(a[i]) ^ static_cast<unsigned char>(b[i]));
-  return diff == 0;
-}
-
 // "add_object 'bunny'": names the request in messages about its binary frame.
 std::string add_object_label(const AddObject& add) {
   const auto name = add.object.find("name");

@@ -20,19 +20,9 @@
 #include "protocol.hpp"
 #include "scene_document.hpp"
 #include "uh/controllers/haptic_session.hpp"
+#include "uh/service/web_socket_host.hpp"
 
 namespace uh::service {
-
-/// One connected client as the hub sees it. Implemented by the WebSocket connection.
-class Peer {
- public:
-  virtual ~Peer() = default;
-  /// Queues a text message. `state` messages replace an unsent older one (a slow client gets the
-  /// newest state, not a growing backlog).
-  virtual void send(std::string text, bool is_state = false) = 0;
-  /// Sends a close frame with `code` (RFC 6455) after the queued messages.
-  virtual void close(std::uint16_t code, std::string_view reason) = 0;
-};
 
 struct HubOptions {
   std::string token;
@@ -41,20 +31,19 @@ struct HubOptions {
   bool raise_priority = false;
 };
 
-class Hub {
+/// `uh serve`'s endpoint (web_socket_host.hpp).
+class Hub final : public Endpoint {
  public:
-  using ClientId = std::uint64_t;
-
   Hub(boost::asio::io_context& io, HubOptions options);
-  ~Hub();
+  ~Hub() override;
 
-  ClientId connect(Peer& peer);
-  void receive(ClientId client, std::string_view text);
-  void receive_binary(ClientId client, std::span<const std::byte> bytes);
+  ClientId connect(Peer& peer) override;
+  void receive(ClientId client, std::string_view text) override;
+  void receive_binary(ClientId client, std::span<const std::byte> bytes) override;
   /// The largest message the client may send next: kMaxMessageBytes, or the size of the binary
   /// frame an `add_object` announced (up to kMaxMeshBinaryBytes).
-  std::size_t message_limit(ClientId client) const;
-  void disconnect(ClientId client);
+  std::size_t message_limit(ClientId client) const override;
+  void disconnect(ClientId client) override;
 
   /// Shows the program's own session (Server::run_session) to the clients while the program runs
   /// it on its own thread: no client controls it, clients watch its scene, state and events. The
@@ -65,7 +54,7 @@ class Hub {
   void unshow();
 
   /// Stops the session (zero force) and closes every client. Joins session builds.
-  void shutdown();
+  void shutdown() override;
 
  private:
   struct Client {

@@ -6,8 +6,8 @@
 /// the live view over HTTP (`/` is `/index.html`). At most one session is open at a time: the
 /// client that opened it controls it (edits, start, stop); every other client may watch it (its
 /// scene, meshes, the state stream, contact events). When the controlling client disconnects, its
-/// session stops (zero force at once). The server runs its own network thread; sessions run their
-/// own haptic and collision threads.
+/// session stops (zero force at once). The server runs its own network thread (a WebSocketHost,
+/// web_socket_host.hpp); sessions run their own haptic and collision threads.
 
 #include <cstdint>
 #include <filesystem>
@@ -20,15 +20,9 @@
 
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/core/result.hpp"
+#include "uh/service/web_socket_host.hpp"
 
 namespace uh::service {
-
-/// A file served over HTTP at `path` (e.g. "/index.html"). The text must outlive the server.
-struct StaticFile {
-  std::string path{};
-  std::string content_type{};
-  std::string_view body{};
-};
 
 /// How the server listens and what it serves (aggregate; Box2D-style defaults).
 struct ServerOptions {

@@ -1,0 +1,66 @@
+#pragma once
+/// \file
+/// GameServer: the museum heist's authoritative server (`uh museum serve`).
+///
+/// Runs the rules (uh/museum/rules.hpp) at their fixed tick on the network thread of a
+/// WebSocketHost (the stack of `uh serve`), takes Vive's moves and actions and Phantom's verdicts
+/// over `ws://HOST:PORT/ws` and sends every client snapshots (20-30 Hz), events and the end
+/// summary, in the versioned JSON messages of docs/museum.md. The round plays while a Vive and a
+/// Phantom are connected; when either drops out it pauses (the station zeroes Phantom's force on
+/// the paused snapshot) and a reconnect in that role resumes it. A bad message gets an error
+/// naming what is wrong and is logged; the connection stays usable.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "uh/core/result.hpp"
+#include "uh/museum/game_state.hpp"
+#include "uh/museum/level.hpp"
+#include "uh/service/web_socket_host.hpp"
+
+namespace uh::museum_service {
+
+/// The message format this build speaks (`hello.protocol`, `welcome.protocol`).
+inline constexpr int kGameProtocolVersion = 1;
+
+/// How the server listens and which round it plays (aggregate; Box2D-style defaults).
+struct GameServerOptions {
+  std::string host = "127.0.0.1";  ///< an IP address or "localhost"
+  std::uint16_t port = 7780;       ///< 0: any free port (see GameServer::port())
+  /// Clients must present it in `hello`; required when `host` is not a loopback address.
+  std::string token{};
+  museum::Level level = museum::make_level(museum::Difficulty::easy);  ///< must validate
+  std::uint64_t seed = 1;
+  double snapshot_hz = 20.0;                 ///< snapshots per second of game time, 20..30
+  std::vector<service::StaticFile> files{};  ///< the browser client's files, if any
+};
+
+class GameServer {
+ public:
+  /// Validates the level and the options, binds and starts the network thread (the round waits
+  /// for its two players). Errors name the option or the level's part that is wrong.
+  static Result<std::unique_ptr<GameServer>> start(GameServerOptions options);
+  /// stop().
+  ~GameServer();
+  GameServer(const GameServer&) = delete;
+  GameServer& operator=(const GameServer&) = delete;
+
+  std::uint16_t port() const;
+  /// "http://HOST:PORT/".
+  std::string url() const;
+  /// A copy of the round's state, taken on the network thread. Not from the network thread.
+  museum::GameState state();
+  /// Messages the server refused since it started (each also logged as a warning).
+  std::uint64_t refused_messages();
+  /// Closes every client and joins the network thread. Idempotent.
+  void stop();
+
+ private:
+  struct Impl;
+  explicit GameServer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uh::museum_service
