@@ -1,0 +1,60 @@
+#pragma once
+/// \file
+/// The museum's artifacts: six kinds, each as a genuine piece and a forgery that look the same but
+/// differ by touch in shape (a seam, a missing ridge, a dent, a different groove spacing), at a
+/// scale the sphere packing resolves. Meshes are generated (lathe profiles and relief on slabs),
+/// nothing is loaded; each piece's .ist is built and cached like a scene object's.
+///
+/// Units: metres. Frame: the piece stands on its base at z = 0, centred on the z axis (slabs:
+/// centred on the origin in x and y). Setup code, not real-time.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "uh/collette/triangle_mesh.hpp"
+#include "uh/controllers/scene.hpp"
+#include "uh/core/result.hpp"
+#include "uh/museum/level.hpp"
+
+namespace uh::museum_artifacts {
+
+/// The kinds, named as in museum::Level::artifact_kinds.
+enum class ArtifactKind : std::uint8_t { amphora, bowl, coin, tablet, scarab, goblet };
+inline constexpr std::array<ArtifactKind, 6> kArtifactKinds = {ArtifactKind::amphora, ArtifactKind::bowl,
+                                                               ArtifactKind::coin,    ArtifactKind::tablet,
+                                                               ArtifactKind::scarab,  ArtifactKind::goblet};
+const char* to_string(ArtifactKind kind);
+/// The kind named `name` ("amphora", ...), or none.
+std::optional<ArtifactKind> artifact_kind(std::string_view name);
+
+enum class Piece : std::uint8_t { genuine, forgery };
+const char* to_string(Piece piece);
+
+/// How a kind's forgery differs from its genuine piece at a difficulty.
+struct Tell {
+  std::string feature{};      ///< "seam", "missing ridge", "dent" or "groove spacing"
+  std::string description{};  ///< one sentence for the docs and the judge's report
+  double depth = 0.0;         ///< the feature's height or depth [m]
+  double width = 0.0;         ///< its width (grooves: the genuine spacing) [m]
+};
+/// Easy tells are 2-3 mm, hard ones about 1 mm: well above and near what a finger (and the
+/// packing of artifact_shape()'s default sphere count) resolves.
+Tell tell(ArtifactKind kind, museum::Difficulty difficulty);
+
+/// The piece's closed surface (counter-clockwise seen from outside). A genuine piece and its
+/// forgery share their vertex grid: vertex i of one is vertex i of the other, moved by the tell.
+collette::TriangleMesh artifact_mesh(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
+
+/// Writes the piece's mesh as an OBJ file into `cache_dir`/museum-artifacts (named by kind,
+/// difficulty, piece and a hash of its content; an existing file is kept) and returns the scene
+/// shape that packs it with `spheres`: controllers::load_shape_tree() then builds and caches its
+/// .ist as it does for any scene object.
+Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, museum::Difficulty difficulty, Piece piece,
+                                               const std::filesystem::path& cache_dir,
+                                               std::int64_t spheres = 10000);
+
+}  // namespace uh::museum_artifacts

@@ -1,0 +1,124 @@
+#include "uh/museum_artifacts/artifact.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "uh/collette/mesh_import.hpp"
+
+namespace uh::museum_artifacts {
+namespace {
+
+using museum::Difficulty;
+
+TEST(MuseumArtifacts, EveryKindOfTheLevelsIsMadeHere) {
+  for (const Difficulty d : {Difficulty::easy, Difficulty::hard}) {
+    for (const std::string& name : museum::make_level(d).artifact_kinds) {
+      const auto kind = artifact_kind(name);
+      ASSERT_TRUE(kind.has_value()) << name;
+      EXPECT_EQ(to_string(*kind), name);
+    }
+  }
+  EXPECT_FALSE(artifact_kind("teapot").has_value());
+  EXPECT_GE(kArtifactKinds.size(), 6u);
+}
+
+TEST(MuseumArtifacts, EveryPieceIsAClosedOutwardMeshAsGenerated) {
+  for (const ArtifactKind kind : kArtifactKinds) {
+    for (const Difficulty d : {Difficulty::easy, Difficulty::hard}) {
+      for (const Piece piece : {Piece::genuine, Piece::forgery}) {
+        collette::TriangleMesh mesh = artifact_mesh(kind, d, piece);
+        const std::size_t vertices = mesh.vertices.size();
+        EXPECT_GT(collette::mesh_volume(mesh), 0.0) << mesh.source_name << ": outward as generated";
+        auto valid = collette::validate_mesh(std::move(mesh), {.repair = false});
+        ASSERT_TRUE(valid.has_value()) << valid.error().message;
+        const collette::MeshReport& r = valid->report;
+        EXPECT_TRUE(r.closed_manifold()) << valid->source_name;
+        EXPECT_EQ(r.inconsistent_edges, 0) << valid->source_name;
+        EXPECT_FALSE(r.winding_flipped) << valid->source_name;
+        EXPECT_EQ(r.components, 1) << valid->source_name;
+        EXPECT_EQ(r.vertex_count, static_cast<std::int64_t>(vertices))
+            << valid->source_name << ": nothing welded";
+      }
+    }
+  }
+}
+
+TEST(MuseumArtifacts, AGenuinePieceAndItsForgeryLookAlikeButDifferByTheTell) {
+  for (const ArtifactKind kind : kArtifactKinds) {
+    for (const Difficulty d : {Difficulty::easy, Difficulty::hard}) {
+      const collette::TriangleMesh g = artifact_mesh(kind, d, Piece::genuine);
+      const collette::TriangleMesh f = artifact_mesh(kind, d, Piece::forgery);
+      ASSERT_EQ(g.vertices.size(), f.vertices.size());
+      ASSERT_EQ(g.triangles, f.triangles) << "one grid";
+      double largest = 0.0;
+      for (std::size_t i = 0; i < g.vertices.size(); ++i)
+        largest = std::max(largest, norm(g.vertices[i] - f.vertices[i]));
+      const Tell t = tell(kind, d);
+      const std::string name = fmt::format("{} ({})", to_string(kind), museum::to_string(d));
+      // the surfaces part by the tell's depth, and by no more
+      EXPECT_GT(largest, 0.8 * t.depth) << name;
+      EXPECT_LT(largest, 1.05 * t.depth) << name;
+      // same size and almost the same volume: they look alike
+      const collette::Aabb bg = collette::mesh_bounds(g);
+      const collette::Aabb bf = collette::mesh_bounds(f);
+      EXPECT_LE(norm(bg.min - bf.min), t.depth + 1e-12) << name;
+      EXPECT_LE(norm(bg.max - bf.max), t.depth + 1e-12) << name;
+      const double vg = collette::mesh_volume(g);
+      EXPECT_LT(std::fabs(vg - collette::mesh_volume(f)) / vg, 0.03) << name;
+    }
+  }
+}
+
+TEST(MuseumArtifacts, HardTellsAreSubtlerThanEasyOnesYetAboveTheMillimetre) {
+  for (const ArtifactKind kind : kArtifactKinds) {
+    const Tell easy = tell(kind, Difficulty::easy);
+    const Tell hard = tell(kind, Difficulty::hard);
+    EXPECT_LT(hard.depth, easy.depth) << to_string(kind);
+    EXPECT_GE(easy.depth, 0.0015) << to_string(kind);
+    EXPECT_GE(hard.depth, 0.0009) << to_string(kind);
+    EXPECT_FALSE(easy.description.empty());
+    EXPECT_EQ(easy.feature, hard.feature);
+  }
+}
+
+TEST(MuseumArtifacts, ShapesAreWrittenOnceAndPackedAndCachedLikeSceneObjects) {
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("uh-museum-artifacts-{}", ::getpid());
+  std::filesystem::remove_all(dir);
+  auto shape = artifact_shape(ArtifactKind::coin, Difficulty::hard, Piece::forgery, dir, 600);
+  ASSERT_TRUE(shape.has_value()) << shape.error().message;
+  EXPECT_EQ(shape->spheres, 600);
+  ASSERT_TRUE(std::filesystem::exists(shape->mesh));
+  const auto written = std::filesystem::last_write_time(shape->mesh);
+  auto again = artifact_shape(ArtifactKind::coin, Difficulty::hard, Piece::forgery, dir, 600);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->mesh, shape->mesh);
+  EXPECT_EQ(std::filesystem::last_write_time(again->mesh), written) << "kept, not written again";
+  // the genuine piece is another file
+  auto genuine = artifact_shape(ArtifactKind::coin, Difficulty::hard, Piece::genuine, dir, 600);
+  ASSERT_TRUE(genuine.has_value());
+  EXPECT_NE(genuine->mesh, shape->mesh);
+
+  const auto count_ist = [&] {
+    int n = 0;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+      n += e.path().extension() == ".ist" ? 1 : 0;
+    return n;
+  };
+  auto tree = controllers::load_shape_tree(*shape, dir);
+  ASSERT_TRUE(tree.has_value()) << tree.error().message;
+  EXPECT_GT(tree->coverage, 0.3);
+  EXPECT_EQ(count_ist(), 1);
+  auto cached = controllers::load_shape_tree(*shape, dir);
+  ASSERT_TRUE(cached.has_value());
+  EXPECT_EQ(count_ist(), 1) << "built once, then read from the cache";
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace uh::museum_artifacts
