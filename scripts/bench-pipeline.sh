@@ -7,16 +7,10 @@
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 seconds=${1:-60}
-uh_build build/main uh_cli -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF >/dev/null
-uh="$uh_root/build/main/apps/uh/uh"
+uh_release_cli
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-
-run() {  # name, args...
-  local name=$1; shift
-  echo "running: uh run $*" >&2
-  "$uh" run "$@" --json >"$out/$name.json"
-}
+run() { uh_bench_run "$@"; }
 run deep1k --seconds "$seconds"
 run deep4k --seconds "$seconds" --haptic-hz 4000
 run descent_multi "$uh_root/scenes/bunny_descent.json" --collision-hz 250

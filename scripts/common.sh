@@ -20,3 +20,18 @@ uh_build() {
   for t in "${targets[@]}"; do target_args+=(--target "$t"); done
   cmake --build "$uh_root/$dir" -j "$uh_jobs" "${target_args[@]}"
 }
+
+# The Release `uh` the benchmark scripts run, in $UH: the one given there, else a build in build/main.
+uh_release_cli() {
+  if [ -z "${UH:-}" ]; then
+    uh_build build/main uh_cli -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF >/dev/null
+    UH="$uh_root/build/main/apps/uh/uh"
+  fi
+}
+
+# uh_bench_run NAME ARGS...: `uh run ARGS --json` into $out/NAME.json (for the scripts' tables).
+uh_bench_run() {
+  local name=$1; shift
+  echo "running: uh run $*" >&2
+  "$UH" run "$@" --json >"$out/$name.json"
+}

@@ -1,5 +1,6 @@
 // Cost of the force stage per haptic tick: the penalty law over a pair list, the multi-rate
-// re-evaluation of a held pair set, and the safety stage.
+// re-evaluation of a held pair set, the local wrench model (built per frame, rendered per tick),
+// and the safety stage.
 
 #include <benchmark/benchmark.h>
 
@@ -11,6 +12,7 @@
 #include "uh/forcecomp/force_component.hpp"
 #include "uh/forcecomp/force_safety.hpp"
 #include "uh/forcecomp/held_contact_set.hpp"
+#include "uh/forcecomp/wrench_model.hpp"
 
 namespace {
 
@@ -99,7 +101,48 @@ void BM_HeldReevaluateAndForce(benchmark::State& state) {
   state.counters["pairs"] = static_cast<double>(pairs.size());
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
-BENCHMARK(BM_HeldReevaluateAndForce)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK(BM_HeldReevaluateAndForce)->Arg(100)->Arg(1000)->Arg(10000)->Arg(17000);
+
+// the local wrench model: built once per collision frame on the collision thread (O(pairs)) ...
+void BM_WrenchModelBuild(benchmark::State& state) {
+  const Pose wa{};
+  const Pose wb{quat_from_axis_angle({0, 1, 0}, 0.3), {0.01, 0, 0.02}};
+  const auto pairs = make_pairs(static_cast<int>(state.range(0)), wa, wb);
+  const ForceComponent tool = make_tool(ForceMode::k6Dof);
+  const PenaltyInput in = tool.penalty_input(tool.body_motion(wb, {}, {}), {});
+  for (auto _ : state) {
+    const WrenchModel m = build_wrench_model(pairs, wa, wb, in);
+    benchmark::DoNotOptimize(m);
+  }
+  state.counters["pairs"] = static_cast<double>(pairs.size());
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_WrenchModelBuild)->Arg(100)->Arg(1000)->Arg(10000)->Arg(17000);
+
+// ... and rendered every haptic tick (O(1): the pair count only changes the numbers in the model),
+// with a new model every fourth tick as from a 250 Hz collision thread at 1 kHz
+void BM_WrenchModelRender(benchmark::State& state) {
+  const Pose wa{};
+  const Pose wb{quat_from_axis_angle({0, 1, 0}, 0.3), {0.01, 0, 0.02}};
+  const auto pairs = make_pairs(static_cast<int>(state.range(0)), wa, wb);
+  const ForceComponent tool = make_tool(ForceMode::k6Dof);
+  WrenchModel model = build_wrench_model(pairs, wa, wb, tool.penalty_input(tool.body_motion(wb, {}, {}), {}));
+  WrenchModelRenderer renderer;
+  Pose moving = wb;
+  int k = 0;
+  for (auto _ : state) {
+    if (k % 4 == 0) {
+      model.time_s = 0.001 * k;
+      renderer.take(model);
+    }
+    moving.position.z = wb.position.z + 1e-6 * static_cast<double>(k % 100);
+    const BodyMotion self = tool.body_motion(moving, {0, 0, 0.001}, {});
+    const Wrench w = renderer.render(0.001 * k++, moving.rotation, self);
+    benchmark::DoNotOptimize(w);
+  }
+  state.counters["pairs"] = static_cast<double>(pairs.size());
+}
+BENCHMARK(BM_WrenchModelRender)->Arg(100)->Arg(17000);
 
 // the same through the two-step reference path (reevaluate() writes world-frame pairs, then the
 // law runs over them), to show what the fused evaluation saves

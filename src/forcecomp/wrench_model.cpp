@@ -9,10 +9,6 @@ namespace uh::forcecomp {
 
 namespace {
 
-Vec3 centre(const Sphere& s) {
-  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
-}
-
 struct M3 {
   double a[3][3] = {};
 };
@@ -28,30 +24,17 @@ M3 skew(const Vec3& v) {
   return m;
 }
 
-M3 mul(const M3& x, const M3& y) {
-  M3 m;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      m.a[i][j] = x.a[i][0] * y.a[0][j] + x.a[i][1] * y.a[1][j] + x.a[i][2] * y.a[2][j];
-  return m;
-}
-
-// adds `scale` * m into the 3x3 block of `out` at (row, col)
-void add_block(Matrix6& out, int row, int col, const M3& m, double scale = 1.0) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) out[row + i][col + j] += scale * m.a[i][j];
-}
-
 double component(const Vec3& v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
 
 // d(area)/dd of the lens kernel's intersection disk area pi a^2 = pi/4 (S^2 - d^2)(d^2 - delta^2) / d^2
 // (sphere_overlap.hpp); 0 apart and in containment, where the area is 0
-double area_derivative(double d, double r1, double r2) {
+// (`inv_d` = 1 / d, which the caller has)
+double area_derivative(double d, double inv_d, double r1, double r2) {
   const double sum = r1 + r2;
   const double delta = r1 - r2;
   if (!(d < sum) || !(d > std::abs(delta))) return 0.0;
-  const double q = delta * delta / (d * d);
-  return kPi / 4.0 * (-2.0 * d * (1.0 - q) + (sum * sum - d * d) * 2.0 * q / d);
+  const double q = delta * delta * inv_d * inv_d;
+  return kPi / 4.0 * (-2.0 * d * (1.0 - q) + (sum * sum - d * d) * 2.0 * q * inv_d);
 }
 
 }  // namespace
@@ -76,15 +59,34 @@ WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const P
   const double per_area = input.stiffness / calibration;
   const double per_volume = input.force_scale;
 
+  // Per pair K = a n n^T + b I (a = s' - s/d, b = s/d); the four blocks of S are sums of products
+  // of K with [r_o]x and [r_t]x, which split into these sums (with [x]x [y]x = y x^T - (x . y) I):
+  //   dF/dt = P + B I                      P = sum a n n^T,              B = sum b
+  //   dF/dtheta = -(Q + [R]x)              Q = sum a n (n x r_t)^T,      R = sum b r_t
+  //   dtau/dt = [F]x + U + [R_o]x          U = sum a (r_o x n) n^T,      R_o = sum b r_o
+  //   dtau/dtheta = -(V + W - w I)         V = sum a (r_o x n)(n x r_t)^T, W = sum b r_t r_o^T, w = sum b r_o
+  //   . r_t
+  M3 sum_p, sum_q, sum_u, sum_v, sum_w;
+  double sum_b = 0.0, sum_bw = 0.0;
+  Vec3 sum_r{}, sum_ro{};
+  const bool damped = input.damping > 0.0;
+  Matrix6 volume_jj{};  // sum vol j j^T (upper triangle), scaled into D once Vol_total is known
+  const Mat3 rot_other = rotation_matrix(world_from_other.rotation);
+  const Mat3 rot_tool = rotation_matrix(world_from_tool.rotation);
+  const auto place = [](const Mat3& r, const Vec3& t, const Sphere& sp) {
+    const double x = static_cast<double>(sp.x), y = static_cast<double>(sp.y), z = static_cast<double>(sp.z);
+    return Vec3{r.m[0][0] * x + r.m[0][1] * y + r.m[0][2] * z + t.x,
+                r.m[1][0] * x + r.m[1][1] * y + r.m[1][2] * z + t.y,
+                r.m[2][0] * x + r.m[2][1] * y + r.m[2][2] * z + t.z};
+  };
   double total = 0.0;
-  Matrix6 volume_jj{};  // sum vol j j^T, scaled into D once Vol_total is known
   double weight = 0.0, weighted_radius = 0.0, weighted_lever2 = 0.0;
   double plain_radius = 0.0, plain_lever2 = 0.0;
   for (const SpherePairContact& p : pairs) {
     const Sphere& so = tool_is_b ? p.sphere_a_local : p.sphere_b_local;
     const Sphere& st = tool_is_b ? p.sphere_b_local : p.sphere_a_local;
-    const Vec3 co = transform_point(world_from_other, centre(so));
-    const Vec3 ct = transform_point(world_from_tool, centre(st));
+    const Vec3 co = place(rot_other, world_from_other.position, so);
+    const Vec3 ct = place(rot_tool, world_from_tool.position, st);
     const double r_other = static_cast<double>(so.radius);
     const double r_tool = static_cast<double>(st.radius);
     const Vec3 delta = ct - co;
@@ -95,43 +97,69 @@ WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const P
     total += o.volume;
     // coincident centres leave the centre line to the query's normal, and no sideways stiffness
     const bool has_line = d > 1e-6 * (r_other + r_tool);
-    const Vec3 n = has_line ? delta / d
+    const double inv_d = has_line ? 1.0 / d : 0.0;
+    const Vec3 n = has_line ? inv_d * delta
                             : normal_sign * Vec3{static_cast<double>(p.normal_world[0]),
                                                  static_cast<double>(p.normal_world[1]),
                                                  static_cast<double>(p.normal_world[2])};
     volume_moment += o.volume * (co + o.centroid_offset * n);
     m.volume_gradient_world -= o.area * n;
-    const double s = gradient ? per_area * o.area : per_volume * o.volume;
-    const double ds = gradient ? per_area * area_derivative(d, r_other, r_tool) : -per_volume * o.area;
     const Vec3 ro = co - am;
     const Vec3 rt = ct - am;
-    const Vec3 j_rot = cross(ro, n);
-    const double j[6] = {n.x, n.y, n.z, j_rot.x, j_rot.y, j_rot.z};
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c) volume_jj[r][c] += o.volume * j[r] * j[c];
+    const Vec3 ro_n = cross(ro, n);
+    if (damped) {
+      const double j[6] = {n.x, n.y, n.z, ro_n.x, ro_n.y, ro_n.z};
+      for (int r = 0; r < 6; ++r)
+        for (int c = r; c < 6; ++c) volume_jj[r][c] += o.volume * j[r] * j[c];
+    }
     plain_radius += std::min(r_other, r_tool);
     plain_lever2 += squared_norm(rt);
+    const double s = gradient ? per_area * o.area : per_volume * o.volume;
     if (!(s > 0.0)) continue;  // containment under the gradient law: no area, no push
 
+    const double ds = gradient ? per_area * area_derivative(d, inv_d, r_other, r_tool) : -per_volume * o.area;
     const Vec3 f = s * n;
     m.wrench.force += f;
     m.wrench.torque += cross(ro, f);
-    const double lateral = has_line ? s / d : 0.0;
-    M3 k;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        k.a[r][c] = (ds - lateral) * component(n, r) * component(n, c) + (r == c ? lateral : 0.0);
-    const M3 k_rt = mul(k, skew(rt));
-    const M3 ro_k = mul(skew(ro), k);
-    add_block(m.stiffness, 0, 0, k);
-    add_block(m.stiffness, 0, 3, k_rt, -1.0);
-    add_block(m.stiffness, 3, 0, skew(f));
-    add_block(m.stiffness, 3, 0, ro_k);
-    add_block(m.stiffness, 3, 3, mul(ro_k, skew(rt)), -1.0);
+    const double b = s * inv_d;
+    const double a = ds - b;
+    const Vec3 n_rt = cross(n, rt);
+    const Vec3 an = a * n;
+    const Vec3 a_ro_n = a * ro_n;
+    for (int r = 0; r < 3; ++r) {
+      const double anr = component(an, r), arnr = component(a_ro_n, r), rtr = b * component(rt, r);
+      for (int c = 0; c < 3; ++c) {
+        sum_p.a[r][c] += anr * component(n, c);
+        sum_q.a[r][c] += anr * component(n_rt, c);
+        sum_u.a[r][c] += arnr * component(n, c);
+        sum_v.a[r][c] += arnr * component(n_rt, c);
+        sum_w.a[r][c] += rtr * component(ro, c);
+      }
+    }
+    sum_b += b;
+    sum_bw += b * dot(ro, rt);
+    sum_r += b * rt;
+    sum_ro += b * ro;
     weight += s;
     weighted_radius += s * std::min(r_other, r_tool);
     weighted_lever2 += s * squared_norm(rt);
   }
+  for (int i = 0; i < 3; ++i) {
+    sum_p.a[i][i] += sum_b;
+    sum_v.a[i][i] -= sum_bw;
+  }
+  const M3 skew_r = skew(sum_r);
+  const M3 skew_ro = skew(sum_ro);
+  const M3 skew_f = skew(m.wrench.force);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      m.stiffness[r][c] = sum_p.a[r][c];
+      m.stiffness[r][c + 3] = -(sum_q.a[r][c] + skew_r.a[r][c]);
+      m.stiffness[r + 3][c] = skew_f.a[r][c] + sum_u.a[r][c] + skew_ro.a[r][c];
+      m.stiffness[r + 3][c + 3] = -(sum_v.a[r][c] + sum_w.a[r][c]);
+    }
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < r; ++c) volume_jj[r][c] = volume_jj[c][r];
   m.total_volume = total;
   if (m.pair_count == 0) return m;  // nothing overlaps: the zero wrench
   m.contact = true;
