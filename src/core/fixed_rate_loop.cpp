@@ -20,8 +20,6 @@ using Nanos = std::chrono::nanoseconds;
 // the longest single sleep, so that request_stop() is noticed even at very low rates
 constexpr Nanos kMaxSleepChunk = std::chrono::milliseconds(10);
 
-std::int64_t to_ns(Clock::time_point t) { return std::chrono::duration_cast<Nanos>(t.time_since_epoch()).count(); }
-
 inline void cpu_relax() {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
@@ -29,8 +27,6 @@ inline void cpu_relax() {
   asm volatile("yield");
 #endif
 }
-
-std::uint64_t abs_ns(std::int64_t v) { return static_cast<std::uint64_t>(v < 0 ? -v : v); }
 
 }  // namespace
 
@@ -61,14 +57,9 @@ Status FixedRateLoop::start(Callback callback, ExitCallback on_exit) {
   stop_requested_.store(false, std::memory_order_relaxed);
   failure_.clear();
   priority_raised_.store(false, std::memory_order_relaxed);
-  ticks_.store(0, std::memory_order_relaxed);
   missed_deadlines_.store(0, std::memory_order_relaxed);
   skipped_ticks_.store(0, std::memory_order_relaxed);
-  first_start_ns_.store(0, std::memory_order_relaxed);
-  last_start_ns_.store(0, std::memory_order_relaxed);
-  period_error_.reset();
-  lateness_.reset();
-  callback_duration_.reset();
+  recorder_.reset();
 
   running_.store(true, std::memory_order_release);
   try {
@@ -97,21 +88,10 @@ bool FixedRateLoop::running() const { return running_.load(std::memory_order_acq
 
 FixedRateLoopStats FixedRateLoop::stats() const {
   FixedRateLoopStats s;
-  s.ticks = ticks_.load(std::memory_order_acquire);
+  recorder_.fill(s);
   s.missed_deadlines = missed_deadlines_.load(std::memory_order_relaxed);
   s.skipped_ticks = skipped_ticks_.load(std::memory_order_relaxed);
   s.rate_hz = options_.rate_hz;
-  const std::int64_t first = first_start_ns_.load(std::memory_order_relaxed);
-  const std::int64_t last = last_start_ns_.load(std::memory_order_relaxed);
-  // ticks and the last start are two atomics: recount ticks from the same reading is not
-  // possible, so the rate may be off by one tick while the loop runs
-  if (s.ticks >= 2 && last > first) {
-    s.elapsed_s = static_cast<double>(last - first) * 1e-9;
-    s.achieved_rate_hz = static_cast<double>(s.ticks - 1) / s.elapsed_s;
-  }
-  s.period_error = period_error_.summary();
-  s.lateness = lateness_.summary();
-  s.callback_duration = callback_duration_.summary();
   s.running = running();
   s.priority_raised = priority_raised_.load(std::memory_order_relaxed);
   return s;
@@ -174,17 +154,7 @@ void FixedRateLoop::run(Callback callback, ExitCallback on_exit) {
       info.time_s = std::chrono::duration<double>(scheduled - origin).count();
       info.dt_s = index == 0 ? info.period_s : std::chrono::duration<double>(now - previous_start).count();
       callback(info);
-      const Clock::time_point end = Clock::now();
-
-      lateness_.record(abs_ns((now - scheduled).count()));
-      callback_duration_.record(abs_ns((end - now).count()));
-      if (index == 0) {
-        first_start_ns_.store(to_ns(now), std::memory_order_relaxed);
-      } else {
-        period_error_.record(abs_ns((now - previous_start - period).count()));
-      }
-      last_start_ns_.store(to_ns(now), std::memory_order_relaxed);
-      ticks_.fetch_add(1, std::memory_order_release);
+      recorder_.record(scheduled, now, Clock::now(), period);
 
       previous_start = now;
       ++index;

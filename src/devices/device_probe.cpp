@@ -3,23 +3,34 @@
 #include <fmt/format.h>
 
 #include "uh/devices/force_dimension_device.hpp"
+#include "uh/devices/open_haptics_device.hpp"
 
 namespace uh::devices {
 
 namespace {
 
-DriverFindings probe_force_dimension() {
-  DriverFindings f{.driver = "forcedimension", .runtime = force_dimension_library_search().vendor};
+// the findings of loading `driver`'s runtime the way it would to open a device without a scene
+// config; `library` is what loaded (nothing when f.error says why)
+DriverFindings find_runtime(const char* driver, const LibrarySearch& search, SharedLibrary& library) {
+  DriverFindings f{.driver = driver, .runtime = search.vendor};
   const haptico::DeviceConfig none;
-  f.looked_for = library_candidates(force_dimension_library_search(), none);
-  auto library = SharedLibrary::load_first(force_dimension_library_search(), none);
-  if (!library) {
-    f.error = library.error().message;
+  f.looked_for = library_candidates(search, none);
+  auto loaded = SharedLibrary::load_first(search, none);
+  if (!loaded) {
+    f.error = loaded.error().message;
     return f;
   }
-  f.loaded_from = library->path();
+  library = std::move(loaded).value();
+  f.loaded_from = library.path();
+  return f;
+}
+
+DriverFindings probe_force_dimension() {
+  SharedLibrary library;
+  DriverFindings f = find_runtime("forcedimension", force_dimension_library_search(), library);
+  if (!library.loaded()) return f;
   int (*count)() = nullptr;
-  if (Status bound = library->bind(count, "dhdGetDeviceCount"); !bound) {
+  if (Status bound = library.bind(count, "dhdGetDeviceCount"); !bound) {
     f.error = bound.error().message;
     return f;
   }
@@ -43,6 +54,25 @@ DriverFindings probe_force_dimension() {
   return f;
 }
 
+// HD opens one device by its configured name; the probe opens HD's default device
+DriverFindings probe_open_haptics() {
+  SharedLibrary library;
+  DriverFindings f = find_runtime("openhaptics", open_haptics_library_search(), library);
+  if (!library.loaded()) return f;
+  auto device = OpenHapticsDevice::create({{"library", f.loaded_from}});
+  if (!device) return f;  // cannot happen: the config is the driver's own
+  auto& oh = static_cast<OpenHapticsDevice&>(**device);
+  if (Status opened = oh.open(); !opened) {
+    f.error = opened.error().message;
+    return f;
+  }
+  f.devices.push_back(
+      {.selector = "openhaptics", .model = oh.model(), .serial = oh.serial_number(), .info = oh.info()});
+  const Status closed = oh.close();
+  (void)closed;  // the description is read; a failing close shows at the next open
+  return f;
+}
+
 }  // namespace
 
 std::vector<DriverFindings> probe_drivers(const haptico::DeviceRegistry& registry) {
@@ -50,6 +80,8 @@ std::vector<DriverFindings> probe_drivers(const haptico::DeviceRegistry& registr
   for (const std::string& name : registry.names()) {
     if (name == "forcedimension") {
       out.push_back(probe_force_dimension());
+    } else if (name == "openhaptics") {
+      out.push_back(probe_open_haptics());
     } else {
       out.push_back({.driver = name, .simulated = name.rfind("sim-", 0) == 0});
       if (!out.back().simulated) out.back().error = "this driver cannot be probed";
@@ -69,7 +101,9 @@ Result<DeviceChoice> parse_device_choice(std::string_view text, const haptico::D
   if (colon == std::string_view::npos) return choice;
   const std::string selector(text.substr(colon + 1));
   // the driver's usual selection key, for a bare value
-  const char* usual = choice.driver == "forcedimension" ? "index" : nullptr;
+  const char* usual = choice.driver == "forcedimension" ? "index"
+                      : choice.driver == "openhaptics"  ? "name"
+                                                        : nullptr;
   if (selector.empty()) return Error{fmt::format("--device {}: nothing after ':'", choice.driver)};
   const std::size_t eq = selector.find('=');
   if (eq == std::string::npos) {

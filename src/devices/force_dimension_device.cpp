@@ -90,13 +90,10 @@ ForceDimensionDevice::~ForceDimensionDevice() {
 
 Status ForceDimensionDevice::open() {
   if (open_) return Ok{};
-  auto library = SharedLibrary::load_first(force_dimension_library_search(), config_);
-  if (!library) return Error{fmt::format("forcedimension: {}", library.error().message)};
-  auto api = std::make_unique<dhd::Api>();
-  if (Status s = dhd::bind(*library, *api); !s)
-    return Error{fmt::format("forcedimension: {}", s.error().message)};
-  library_ = std::move(library).value();
-  api_ = std::move(api);
+  if (Status s = load_vendor_api("forcedimension", force_dimension_library_search(), config_, &dhd::bind,
+                                 library_, api_);
+      !s)
+    return s;
   fault_.clear();
   forces_on_ = false;
   faulted_ = false;

@@ -1,11 +1,13 @@
 #include "uh/devices/hardware_drivers.hpp"
 
 #include "uh/devices/force_dimension_device.hpp"
+#include "uh/devices/open_haptics_device.hpp"
 
 namespace uh::devices {
 
 Status register_hardware_drivers(haptico::DeviceRegistry& registry) {
-  return registry.register_driver("forcedimension", &ForceDimensionDevice::create);
+  if (Status s = registry.register_driver("forcedimension", &ForceDimensionDevice::create); !s) return s;
+  return registry.register_driver("openhaptics", &OpenHapticsDevice::create);
 }
 
 haptico::DeviceRegistry all_drivers() {

@@ -41,6 +41,9 @@ FixedRateLoopOptions loop_options(const HapticManagerOptions& o) {
 HapticManager::HapticManager(std::unique_ptr<HapticDevice> device, const HapticManagerOptions& options)
     : options_(options), device_(std::move(device)), loop_(loop_options(options)) {
   assert(device_ != nullptr && "uh::haptico::HapticManager::HapticManager(): device must not be null");
+  // a device that brings its own servo thread is the clock: the tick runs in its frames
+  if (auto* clocked = dynamic_cast<ClockedDevice*>(device_.get()); clocked != nullptr)
+    servo_ = &clocked->servo_clock();
   const double fade_ticks = options_.soft_start_s * options_.rate_hz;
   fade_ticks_ = fade_ticks > 1.0 && std::isfinite(fade_ticks) ? fade_ticks : 1.0;
   if (options_.trace_capacity > 0) trace_ = std::make_unique<SpscQueue<TraceSample>>(options_.trace_capacity);
@@ -101,7 +104,7 @@ Status HapticManager::start() {
   if (!(options_.rate_hz > 0.0 && options_.rate_hz <= 10000.0)) {
     return Error{fmt::format("haptic manager: rate_hz {} is outside (0, 10000]", options_.rate_hz)};
   }
-  if (loop_.running()) return Error{"haptic manager: already running"};
+  if (running()) return Error{"haptic manager: already running"};
   if (Status s = open(); !s) return s;
   // a thread that ended by itself is joined by the loop's start(); its failure is history now
   failure_.clear();
@@ -110,12 +113,13 @@ Status HapticManager::start() {
   move_event_.refuse_binding(kMoveBindRefused);
   force_event_.refuse_binding(kForceBindRefused);
   sent_event_.refuse_binding(kSentBindRefused);
-  Status started = loop_.start(
-      [this](const TickInfo& t) {
-        const double now = std::chrono::duration<double>(t.start_time.time_since_epoch()).count();
-        tick(now);
-      },
-      [this](const LoopExit& exit) { on_loop_exit(exit); });
+  auto on_tick = [this](const TickInfo& t) {
+    const double now = std::chrono::duration<double>(t.start_time.time_since_epoch()).count();
+    tick(now);
+  };
+  auto on_exit = [this](const LoopExit& exit) { on_loop_exit(exit); };
+  Status started =
+      servo_ != nullptr ? servo_->start(options_.rate_hz, on_tick, on_exit) : loop_.start(on_tick, on_exit);
   if (!started) allow_binding();
   return started;
 }
@@ -144,7 +148,14 @@ void HapticManager::send_final_zero(double now_s, bool read_device) {
   sent_event_.broadcast(sample);
 }
 
+bool HapticManager::running() const { return servo_ != nullptr ? servo_->running() : loop_.running(); }
+
+std::uint64_t HapticManager::missed_deadlines() const {
+  return servo_ != nullptr ? servo_->missed_deadlines() : loop_.missed_deadlines();
+}
+
 void HapticManager::stop() {
+  if (servo_ != nullptr) servo_->stop();
   loop_.stop();
   // the haptic thread is joined: this thread may talk to the device and bind delegates now
   allow_binding();
@@ -159,7 +170,7 @@ void HapticManager::allow_binding() {
 }
 
 Status HapticManager::thread_status() const {
-  if (loop_.running() || failure_.empty()) return Ok{};
+  if (running() || failure_.empty()) return Ok{};
   return Error{failure_};
 }
 
@@ -175,7 +186,7 @@ Status HapticManager::device_status() {
 
 TraceSample HapticManager::step(double now_s) {
   assert(open_ && "uh::haptico::HapticManager::step(): open() the device first");
-  assert(!loop_.running() && "uh::haptico::HapticManager::step(): a threaded session is running");
+  assert(!running() && "uh::haptico::HapticManager::step(): a threaded session is running");
   return tick(now_s);
 }
 
@@ -284,7 +295,7 @@ std::size_t HapticManager::drain_trace(std::ostream& csv) {
 
 HapticStats HapticManager::stats() const {
   HapticStats s;
-  s.loop = loop_.stats();
+  s.loop = servo_ != nullptr ? servo_->stats() : loop_.stats();
   s.ticks = ticks_.load();
   s.force_clamped = force_clamped_.load();
   s.torque_clamped = torque_clamped_.load();

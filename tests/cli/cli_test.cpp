@@ -451,8 +451,8 @@ TEST_F(CliTest, FailedWritesLeaveEarlierOutputsWhole) {
 
 // `uh devices` and `uh run --device` with the stand-in libdhd (tests/devices/standins/)
 std::string with_standin(const fs::path& dir) {
-  return fmt::format("UH_CACHE_DIR='{}' UH_FORCEDIMENSION_LIBRARY='{}' ", (dir / "cache").string(),
-                     UH_STANDIN_DHD);
+  return fmt::format("UH_CACHE_DIR='{}' UH_FORCEDIMENSION_LIBRARY='{}' UH_OPENHAPTICS_LIBRARY='{}' ",
+                     (dir / "cache").string(), UH_STANDIN_DHD, UH_STANDIN_HD);
 }
 
 // a small scene: the stylus on a simulated line through the bunny's middle
@@ -493,6 +493,15 @@ TEST_F(CliTest, DevicesListsWhereEachDriverLookedAndWhatItFound) {
   EXPECT_EQ(dev["dof_actuated"], 3);
   EXPECT_EQ(dev["max_force_n"], 12.0);
   EXPECT_EQ(dev["workspace_half_extents_m"][2], 0.055);
+  const nlohmann::json* oh = nullptr;
+  for (const auto& d : j["drivers"])
+    if (d["driver"] == "openhaptics") oh = &d;
+  ASSERT_NE(oh, nullptr) << r.out;
+  EXPECT_EQ((*oh)["loaded_from"], UH_STANDIN_HD);
+  ASSERT_EQ((*oh)["devices"].size(), 1u) << r.out;
+  EXPECT_EQ((*oh)["devices"][0]["selector"], "openhaptics");
+  EXPECT_EQ((*oh)["devices"][0]["model"], "Touch");
+  EXPECT_EQ((*oh)["devices"][0]["max_force_n"], 3.3);
 
   // without the runtime: every place it looked, and why nothing was found
   const CommandRun none = uh("devices", "UH_FORCEDIMENSION_LIBRARY=/nonexistent/libdhd.so ");
@@ -521,10 +530,10 @@ TEST_F(CliTest, RunOnTheDeviceNamedOnTheCommandLine) {
   const CommandRun unknown =
       uh(fmt::format("run '{}' --device nope --stepped", scene.string()), with_standin(dir_));
   EXPECT_EQ(unknown.exit_code, 1);
-  EXPECT_EQ(
-      unknown.err,
-      "uh: --device: unknown driver 'nope' (known drivers: forcedimension, sim-circle, sim-hand, sim-line, "
-      "sim-raster, sim-replay)\n");
+  EXPECT_EQ(unknown.err,
+            "uh: --device: unknown driver 'nope' (known drivers: forcedimension, openhaptics, sim-circle, "
+            "sim-hand, sim-line, "
+            "sim-raster, sim-replay)\n");
   const CommandRun missing = uh(
       fmt::format("run '{}' --device forcedimension:serial=4 --stepped", scene.string()), with_standin(dir_));
   EXPECT_EQ(missing.exit_code, 1);
@@ -672,6 +681,25 @@ TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("friction   static"), std::string::npos) << r.out;
   EXPECT_EQ(read_text(png).substr(1, 3), "PNG");
+}
+
+// a threaded run clocked by HD's scheduler (the stand-in's own thread)
+TEST_F(CliTest, RunOnOpenHapticsNamedOnTheCommandLine) {
+  const fs::path scene = write_small_device_scene(dir_);
+  const CommandRun r = uh(fmt::format("run '{}' --device openhaptics --seconds 0.3 --json", scene.string()),
+                          with_standin(dir_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["haptic"]["ticks"].get<int>(), 100);
+  EXPECT_GT(j["force"]["max_n"].get<double>(), 0.5);
+  EXPECT_LE(j["force"]["max_n"].get<double>(), 3.3);
+  const CommandRun named =
+      uh(fmt::format("run '{}' --device 'openhaptics:Left Touch' --seconds 0.3", scene.string()),
+         with_standin(dir_));
+  EXPECT_EQ(named.exit_code, 1);
+  EXPECT_NE(named.err.find("openhaptics: opening 'Left Touch' (hdInitDevice) failed: HD error 0x302"),
+            std::string::npos)
+      << named.err;
 }
 
 }  // namespace

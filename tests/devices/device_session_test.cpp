@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dhd_standin_control.hpp"
+#include "hd_standin_control.hpp"
 #include "scene_test_support.hpp"
 #include "uh/controllers/haptic_session.hpp"
 
@@ -20,15 +21,17 @@ struct DeviceSessionTest : ::testing::Test {
     std::filesystem::remove_all(*cache_);
     delete cache_;
   }
-  // the small scene with its tool bound to the forcedimension driver on the stand-in
-  static std::unique_ptr<HapticSession> make() {
+  // the small scene with its tool bound to `driver` on the stand-in `library`
+  static std::unique_ptr<HapticSession> make(const char* driver = "forcedimension",
+                                             const char* library = devices::testing::DhdStandin::path()) {
     const std::string json = replaced(
         testing::small_scene_json(),
         R"("config": { "start": [0.0, 0.0, 0.10], "end": [0.0, 0.0, 0.045], "duration_s": 0.5, "bounce": true,
                             "dof_actuated": 6, "max_force_n": 6 })",
-        fmt::format(R"("config": {{ "library": "{}" }})", devices::testing::DhdStandin::path()));
-    auto scene = parse_scene(replaced(json, R"("driver": "sim-line")", R"("driver": "forcedimension")"),
-                             "small.json", testing::test_assets());
+        fmt::format(R"("config": {{ "library": "{}" }})", library));
+    auto scene =
+        parse_scene(replaced(json, R"("driver": "sim-line")", fmt::format(R"("driver": "{}")", driver)),
+                    "small.json", testing::test_assets());
     EXPECT_TRUE(scene) << scene.error().message;
     if (!scene) return nullptr;
     SessionOptions options;
@@ -96,6 +99,39 @@ TEST_F(DeviceSessionTest, ForceDimensionFaultEndsAThreadedRun) {
   EXPECT_EQ(standin.get("forces_enabled"), 0.0);
   EXPECT_EQ(standin.get("force_z"), 0.0);
   EXPECT_EQ(standin.received().size(), 300u);  // nothing reached the device after the fault
+}
+
+// the stylus rests inside the bunny (field z = HD's y): a threaded session clocked by HD's scheduler
+// renders the contact within the Touch's 3.3 N, and a mid-session HD error ends it with HD's message
+TEST_F(DeviceSessionTest, OpenHapticsSessionRendersTheContactOnHdsClock) {
+  devices::testing::HdStandin standin;
+  standin.set("rest_y", 0.045);
+  auto session = make("openhaptics", devices::testing::HdStandin::path());
+  ASSERT_TRUE(session);
+  const Status ran = session->run(0.4);
+  ASSERT_TRUE(ran) << ran.error().message;
+  const SessionReport& r = session->report();
+  EXPECT_GT(r.contact_ticks, 100u);
+  EXPECT_GT(r.force_max_n, 0.5);
+  EXPECT_LE(r.force_max_n, 3.3 + 1e-9);  // the Touch's nominal force, below the tool's 6 N
+  EXPECT_GT(r.haptic_rate_hz, 0.0);      // the scheduler's frames
+  EXPECT_GT(standin.get("y"), 0.045);    // pushed up and out of the bunny
+  EXPECT_EQ(standin.get("force_y"), 0.0);
+  EXPECT_EQ(standin.get("force_output"), 0.0);
+  session.reset();  // releases the device: HD opens each device once
+
+  standin.set("error_after_frames", 150);
+  auto faulty = make("openhaptics", devices::testing::HdStandin::path());
+  ASSERT_TRUE(faulty);
+  const Status failed = faulty->run(30.0);
+  ASSERT_FALSE(failed);
+  EXPECT_NE(
+      failed.error().message.find("device 'openhaptics Touch' faulted: the servo frame reported HD error "
+                                  "0x302: Communication error"),
+      std::string::npos)
+      << failed.error().message;
+  EXPECT_TRUE(faulty->report().stopped_early);
+  EXPECT_EQ(standin.get("force_output"), 0.0);
 }
 
 }  // namespace

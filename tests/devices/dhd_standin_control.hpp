@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "uh/devices/shared_library.hpp"
+#include "standin_support.hpp"
 
 namespace uh::devices::testing {
 
@@ -16,11 +16,8 @@ class DhdStandin {
  public:
   static const char* path() { return UH_STANDIN_DHD; }
 
-  DhdStandin() {
-    auto library = SharedLibrary::load(path());
-    EXPECT_TRUE(library) << (library ? "" : library.error().message);
-    if (!library) return;
-    library_ = std::move(library).value();
+  DhdStandin() : library_(load_standin(path())) {
+    if (!library_.loaded()) return;
     EXPECT_TRUE(library_.bind(reset_, "standin_dhd_reset"));
     EXPECT_TRUE(library_.bind(set_, "standin_dhd_set"));
     EXPECT_TRUE(library_.bind(get_, "standin_dhd_get"));
@@ -33,12 +30,7 @@ class DhdStandin {
   double get(const char* key, int device = 0) const { return get_(device, key); }
   /// Every force the device received while its forces were on.
   std::vector<std::array<double, 3>> received(int device = 0) const {
-    const int n = received_(device, nullptr, 0);
-    std::vector<double> flat(3 * static_cast<std::size_t>(n));
-    received_(device, flat.data(), n);
-    std::vector<std::array<double, 3>> out(static_cast<std::size_t>(n));
-    for (std::size_t i = 0; i < out.size(); ++i) out[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
-    return out;
+    return received_forces([&](double* out, int max) { return received_(device, out, max); });
   }
 
  private:

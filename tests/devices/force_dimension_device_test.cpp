@@ -26,9 +26,7 @@ using haptico::TraceSample;
 DeviceConfig standin_config() { return DeviceConfig{{"library", testing::DhdStandin::path()}}; }
 
 std::unique_ptr<haptico::HapticDevice> make(const DeviceConfig& config) {
-  auto device = all_drivers().create("forcedimension", config);
-  EXPECT_TRUE(device) << (device ? "" : device.error().message);
-  return device ? std::move(device).value() : nullptr;
+  return testing::make_device("forcedimension", config);
 }
 
 TEST(ForceDimensionDevice, IsRegisteredAndRejectsBadSettings) {

@@ -1,5 +1,6 @@
 // Tests on a real device, run only when UH_HARDWARE names its driver (see docs/devices.md):
-//   UH_HARDWARE=forcedimension ctest --test-dir build/release -L hardware --output-on-failure
+//   UH_HARDWARE=forcedimension (or openhaptics) ctest --test-dir build/release -L hardware
+//   --output-on-failure
 // Hold the handle lightly: the forces are small (at most 1 N) and pull toward the workspace centre.
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 
 #include "uh/devices/force_dimension_device.hpp"
 #include "uh/devices/hardware_drivers.hpp"
+#include "uh/devices/open_haptics_device.hpp"
 #include "uh/haptico/haptic_manager.hpp"
 
 namespace uh::devices {
@@ -25,9 +27,45 @@ bool requested(const std::string& driver) {
   return v != nullptr && driver == v;
 }
 
-#define UH_REQUIRE_HARDWARE(driver)                                                                          \
-  if (!requested(driver)) GTEST_SKIP() << "set UH_HARDWARE=" driver " to run this test on a " driver " devi" \
-                                                                                                     "ce"
+// `n` live states: each valid, time increasing, the handle in (or near) the reported workspace;
+// closes the device
+void expect_live_states(haptico::HapticDevice& device, int n) {
+  const haptico::DeviceInfo info = device.info();
+  double last_time = -1.0;
+  for (int i = 0; i < n; ++i) {
+    const DeviceState s = device.read_state();
+    ASSERT_EQ(s.status, DeviceStatus::kOk) << device.fault_reason();
+    EXPECT_GT(s.time_s, last_time);
+    last_time = s.time_s;
+    EXPECT_LE(std::abs(s.position.x), 2.0 * info.workspace_half_extents.x);
+    EXPECT_LE(std::abs(s.position.y), 2.0 * info.workspace_half_extents.y);
+    EXPECT_LE(std::abs(s.position.z), 2.0 * info.workspace_half_extents.z);
+  }
+  EXPECT_TRUE(device.close());
+}
+
+// 2000 ticks of a gentle spring toward the workspace centre (50 N/m, limited by the config's
+// max_force_n), then stopped: it must end without a fault
+void run_gentle_spring(haptico::HapticManager& manager) {
+  manager.force_on_haptic_tick().add_delegate(
+      [](const DeviceState& s, DeviceCommand& c) { c.force = -50.0 * s.position - 2.0 * s.linear_velocity; });
+  const Status started = manager.start();
+  ASSERT_TRUE(started) << started.error().message;
+  // two seconds of ticks, however long they take
+  while (manager.ticks() < 2000 && manager.running())
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  manager.stop();
+  EXPECT_TRUE(manager.thread_status());
+  const Status device = manager.device_status();
+  EXPECT_TRUE(device) << device.error().message;
+  EXPECT_GE(manager.stats().ticks, 2000u);
+}
+
+#define UH_REQUIRE_HARDWARE(driver)                                          \
+  if (!requested(driver))                                                    \
+  GTEST_SKIP() << "set UH_HARDWARE=" driver " to run this test on a " driver \
+                  " devi"                                                    \
+                  "ce"
 
 TEST(Hardware, ForceDimensionDescribesItselfAndReadsLiveStates) {
   UH_REQUIRE_HARDWARE("forcedimension");
@@ -41,18 +79,7 @@ TEST(Hardware, ForceDimensionDescribesItselfAndReadsLiveStates) {
               dynamic_cast<ForceDimensionDevice&>(device).serial_number(), info.max_force_n);
   EXPECT_GT(info.max_force_n, 0.0);
   EXPECT_LE(info.max_force_n, 20.0);
-  double last_time = -1.0;
-  for (int i = 0; i < 2000; ++i) {
-    const DeviceState s = device.read_state();
-    ASSERT_EQ(s.status, DeviceStatus::kOk) << device.fault_reason();
-    EXPECT_GT(s.time_s, last_time);
-    last_time = s.time_s;
-    // the handle is in (or near) the workspace the driver reports
-    EXPECT_LE(std::abs(s.position.x), 2.0 * info.workspace_half_extents.x);
-    EXPECT_LE(std::abs(s.position.y), 2.0 * info.workspace_half_extents.y);
-    EXPECT_LE(std::abs(s.position.z), 2.0 * info.workspace_half_extents.z);
-  }
-  EXPECT_TRUE(device.close());
+  expect_live_states(device, 2000);
 }
 
 TEST(Hardware, ForceDimensionRendersAGentleSpringAndStopsAtZero) {
@@ -61,23 +88,38 @@ TEST(Hardware, ForceDimensionRendersAGentleSpringAndStopsAtZero) {
   ASSERT_TRUE(created) << created.error().message;
   auto* fd = dynamic_cast<ForceDimensionDevice*>(created->get());
   haptico::HapticManager manager(std::move(created).value(), {.rate_hz = 1000.0});
-  manager.force_on_haptic_tick().add_delegate([](const DeviceState& s, DeviceCommand& c) {
-    c.force = -50.0 * s.position - 2.0 * s.linear_velocity;  // 50 N/m toward the centre, clamped to 1 N
-  });
-  const Status started = manager.start();
-  ASSERT_TRUE(started) << started.error().message;
-  // two seconds of ticks, however long they take
-  while (manager.ticks() < 2000 && manager.running())
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  manager.stop();
-  EXPECT_TRUE(manager.thread_status());
-  const Status device = manager.device_status();
-  EXPECT_TRUE(device) << device.error().message;
-  EXPECT_GE(manager.stats().ticks, 2000u);
+  run_gentle_spring(manager);
   EXPECT_GT(fd->com_rate_hz(), 500.0);
   std::printf("  DHD communication rate %.0f Hz, %llu ticks, %llu saturated\n", fd->com_rate_hz(),
               static_cast<unsigned long long>(manager.stats().ticks),
               static_cast<unsigned long long>(fd->saturated_commands()));
+}
+
+TEST(Hardware, OpenHapticsDescribesItselfAndReadsLiveStates) {
+  UH_REQUIRE_HARDWARE("openhaptics");
+  auto created = all_drivers().create("openhaptics", {});
+  ASSERT_TRUE(created) << created.error().message;
+  auto& device = **created;
+  const Status opened = device.open();
+  ASSERT_TRUE(opened) << opened.error().message;
+  const haptico::DeviceInfo info = device.info();
+  std::printf("  %s, serial %s, max %.2f N\n", info.name.c_str(),
+              dynamic_cast<OpenHapticsDevice&>(device).serial_number().c_str(), info.max_force_n);
+  EXPECT_GT(info.max_force_n, 0.0);
+  EXPECT_LE(info.max_force_n, 40.0);
+  expect_live_states(device, 500);  // each read outside a run is one synchronous scheduler frame
+}
+
+TEST(Hardware, OpenHapticsRendersAGentleSpringOnHdsClock) {
+  UH_REQUIRE_HARDWARE("openhaptics");
+  auto created = all_drivers().create("openhaptics", {{"max_force_n", "0.8"}});
+  ASSERT_TRUE(created) << created.error().message;
+  haptico::HapticManager manager(std::move(created).value(), {.rate_hz = 1000.0});
+  run_gentle_spring(manager);
+  const haptico::HapticStats stats = manager.stats();
+  EXPECT_GT(stats.loop.achieved_rate_hz, 500.0);
+  std::printf("  HD scheduler %.0f Hz over %llu ticks, jitter p99 %.0f us\n", stats.loop.achieved_rate_hz,
+              static_cast<unsigned long long>(stats.ticks), stats.loop.period_error.p99_ns * 1e-3);
 }
 
 }  // namespace

@@ -36,6 +36,7 @@
 
 #include "uh/core/latency_histogram.hpp"
 #include "uh/core/result.hpp"
+#include "uh/core/tick_recorder.hpp"
 
 namespace uh {
 
@@ -136,14 +137,9 @@ class FixedRateLoop {
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
   std::atomic<bool> priority_raised_{false};
-  std::atomic<std::uint64_t> ticks_{0};
   std::atomic<std::uint64_t> missed_deadlines_{0};
   std::atomic<std::uint64_t> skipped_ticks_{0};
-  std::atomic<std::int64_t> first_start_ns_{0};
-  std::atomic<std::int64_t> last_start_ns_{0};
-  LatencyHistogram period_error_;
-  LatencyHistogram lateness_;
-  LatencyHistogram callback_duration_;
+  TickRecorder recorder_;
 };
 
 }  // namespace uh

@@ -44,7 +44,7 @@ std::vector<DriverFindings> probe_drivers(const haptico::DeviceRegistry& registr
 struct DeviceChoice {
   std::string driver{};
   /// The selection as config keys: SELECTOR is KEY=VALUE, or a bare VALUE for the driver's usual
-  /// key (forcedimension: index).
+  /// key (forcedimension: index, openhaptics: name).
   haptico::DeviceConfig selection{};
 };
 

@@ -8,7 +8,8 @@
 
 namespace uh::devices {
 
-/// Registers the hardware drivers in `registry`: `forcedimension` (libdhd). See docs/devices.md.
+/// Registers the hardware drivers in `registry`: `forcedimension` (libdhd),
+/// `openhaptics` (libHD). See docs/devices.md.
 Status register_hardware_drivers(haptico::DeviceRegistry& registry);
 
 /// A registry with the simulated drivers and the hardware drivers: what `uh run`, the C API and

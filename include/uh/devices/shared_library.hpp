@@ -3,6 +3,7 @@
 /// SharedLibrary: a vendor library loaded at run time, and the search for it.
 
 #include <bit>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -79,5 +80,21 @@ class SharedLibrary {
   void* handle_ = nullptr;
   std::string path_;
 };
+
+/// What a driver's open() does first: loads the first library of `search` (given `config`) and
+/// binds the vendor's functions into a new `Api` with `bind_api`; on success `library` and `api`
+/// hold them. Errors are prefixed with "`driver`: ".
+template <typename Api>
+Status load_vendor_api(std::string_view driver, const LibrarySearch& search,
+                       const haptico::DeviceConfig& config, Status (*bind_api)(const SharedLibrary&, Api&),
+                       SharedLibrary& library, std::unique_ptr<Api>& api) {
+  auto loaded = SharedLibrary::load_first(search, config);
+  if (!loaded) return Error{std::string(driver) + ": " + loaded.error().message};
+  auto bound = std::make_unique<Api>();
+  if (Status s = bind_api(*loaded, *bound); !s) return Error{std::string(driver) + ": " + s.error().message};
+  library = std::move(loaded).value();
+  api = std::move(bound);
+  return Ok{};
+}
 
 }  // namespace uh::devices

@@ -18,6 +18,7 @@
 #include "uh/core/spsc_queue.hpp"
 #include "uh/haptico/force_limiter.hpp"
 #include "uh/haptico/haptic_device.hpp"
+#include "uh/haptico/servo_clock.hpp"
 #include "uh/haptico/trace_sample.hpp"
 
 namespace uh::haptico {
@@ -79,7 +80,10 @@ struct HapticStats {
 ///      at once, never rate-limited; each engaged limit is counted (stats().limits);
 ///   5. device.command(command); the tick is pushed to the trace queue if enabled;
 ///   6. SentOnHapticTick.broadcast(sample)  (what was read, asked for and sent this tick).
-/// The same tick code runs in threaded sessions (start()/stop()) and stepped ones (step()).
+/// The same tick code runs in threaded sessions (start()/stop()) and stepped ones (step()). The
+/// haptic thread is the manager's own FixedRateLoop, or for a ClockedDevice (OpenHaptics) the
+/// vendor's servo thread: the tick then runs inside the device's servo frame, the device is the
+/// clock, and stats().loop describes the device's frames.
 ///
 /// Frames and units: those of the device (DeviceState, DeviceCommand), SI.
 ///
@@ -92,8 +96,9 @@ struct HapticStats {
 /// controlling thread. Bind delegates only while no threaded session runs (the Delegator is not
 /// a cross-thread primitive; start() publishes the bindings to the haptic thread): from start()
 /// to stop() binding is refused (an invalid handle or empty connection, an error logged, see
-/// Delegator::refuse_binding). Delegates run on the haptic thread and must be real-time safe. halt(), resume(), clear_fault(), stats() and
-/// running() may be called from any thread; drain_trace() from one consumer thread.
+/// Delegator::refuse_binding). Delegates run on the haptic thread and must be real-time safe. halt(),
+/// resume(), clear_fault(), stats() and running() may be called from any thread; drain_trace() from one
+/// consumer thread.
 class HapticManager {
  public:
   /// Takes ownership of `device` (not null). Allocates the trace queue. Not real-time safe.
@@ -166,10 +171,10 @@ class HapticManager {
   HapticStats stats() const;
   /// Missed deadlines of the haptic thread since start(), without the cost of stats(). Any
   /// thread; real-time safe (so a delegate may read it during a tick).
-  std::uint64_t missed_deadlines() const { return loop_.missed_deadlines(); }
+  std::uint64_t missed_deadlines() const;
   /// Ticks run (HapticStats::ticks) without the cost of stats(). Any thread; real-time safe.
   std::uint64_t ticks() const { return ticks_.load(); }
-  bool running() const { return loop_.running(); }
+  bool running() const;
   bool is_open() const { return open_; }
   /// The device's description as read by open().
   const DeviceInfo& device_info() const { return info_; }
@@ -197,6 +202,7 @@ class HapticManager {
   ForceLimiter limiter_{};  // haptic thread while running
   bool open_ = false;
   FixedRateLoop loop_;
+  ServoClock* servo_ = nullptr;  // the device's own clock (a ClockedDevice), else loop_ ticks
   Delegator<const DeviceState&> move_event_;
   Delegator<const DeviceState&, DeviceCommand&> force_event_;
   Delegator<const TraceSample&> sent_event_;
