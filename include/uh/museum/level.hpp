@@ -80,8 +80,8 @@ struct RuleNumbers {
   double reach = 1.0;                 ///< Vive reaches a case or the table within this [m]
   double run_hear_radius = 4.0;       ///< guards hear running within this [m]
   double glass_hear_radius = 8.0;     ///< guards hear a case breaking within this [m]
-  double view_range = 5.0;            ///< guards see Vive within this [m] ...
-  double view_half_angle_deg = 30.0;  ///< ... and this angle either side of where they face
+  double view_range = 4.0;            ///< guards see Vive within this [m] ...
+  double view_half_angle_deg = 25.0;  ///< ... and this angle either side of where they face
   double patrol_speed = 1.0;          ///< a guard on its round [m/s]
   double investigate_speed = 1.8;     ///< a guard walking to a noise [m/s]
   double linger_s = 4.0;              ///< how long a guard looks around where it heard a noise [s]
