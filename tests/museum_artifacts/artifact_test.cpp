@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "uh/collette/ist_builder.hpp"
 #include "uh/collette/mesh_import.hpp"
 
 namespace uh::museum_artifacts {
@@ -84,6 +85,50 @@ TEST(MuseumArtifacts, HardTellsAreSubtlerThanEasyOnesYetAboveTheMillimetre) {
     EXPECT_GE(hard.depth, 0.0009) << to_string(kind);
     EXPECT_FALSE(easy.description.empty());
     EXPECT_EQ(easy.feature, hard.feature);
+  }
+}
+
+// how far a packing reaches along the line through `at` with direction `n` (unit) [m]: the
+// highest point along the line of the leaf spheres it crosses
+double packing_reach(const collette::SphereTree& tree, Vec3 at, Vec3 n) {
+  double reach = -1.0;
+  for (const Sphere& s : tree.leaves()) {
+    const Vec3 c = Vec3{s.x, s.y, s.z} - at;
+    const double along = dot(c, n);
+    const double off2 = squared_norm(c - n * along);
+    const double r = s.radius;
+    if (off2 < r * r) reach = std::max(reach, along + std::sqrt(r * r - off2));
+  }
+  return reach;
+}
+
+// The finest tells (hard, under a millimetre) show in the packings of artifact_shape()'s default
+// sphere count: along the line where the two surfaces part most, the packing of the piece with
+// the bump reaches out further than the other's by at least half the tell
+TEST(MuseumArtifacts, TheDefaultPackingResolvesTheFinestTells) {
+  struct Finest {
+    ArtifactKind kind;
+    Piece bumped;  // the piece whose surface stands out at the tell
+  };
+  for (const Finest f :
+       {Finest{ArtifactKind::scarab, Piece::genuine}, Finest{ArtifactKind::goblet, Piece::forgery}}) {
+    const Piece plain = f.bumped == Piece::genuine ? Piece::forgery : Piece::genuine;
+    const collette::TriangleMesh b = artifact_mesh(f.kind, Difficulty::hard, f.bumped);
+    const collette::TriangleMesh p = artifact_mesh(f.kind, Difficulty::hard, plain);
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < b.vertices.size(); ++i)
+      if (norm(b.vertices[i] - p.vertices[i]) > norm(b.vertices[at] - p.vertices[at])) at = i;
+    const Vec3 n = normalized(b.vertices[at] - p.vertices[at]);
+    const auto packed_b = collette::build_ist_asset(b, 0, {.sphere_count = 10000});
+    const auto packed_p = collette::build_ist_asset(p, 0, {.sphere_count = 10000});
+    ASSERT_TRUE(packed_b.has_value() && packed_p.has_value());
+    // from 5 mm inside the plain surface, along the outward direction of the tell
+    const Vec3 start = p.vertices[at] - n * 0.005;
+    const double reach_b = packing_reach(packed_b->asset.tree, start, n);
+    const double reach_p = packing_reach(packed_p->asset.tree, start, n);
+    const Tell t = tell(f.kind, Difficulty::hard);
+    EXPECT_GT(reach_b - reach_p, 0.5 * t.depth)
+        << to_string(f.kind) << ": reach " << reach_b << " vs " << reach_p << " from 5 mm inside";
   }
 }
 
