@@ -60,7 +60,8 @@ struct WrenchModelOptions {
   /// rendered last (until a new frame arrives or the tool comes back), >= 1.
   double hold_beyond = 2.0;
   /// Blend time when a new model arrives [s]; 0: the interval between the last two frames
-  /// (clamped to [kMinBlendS, kMaxBlendS]), so that the blend ends as the next frame comes.
+  /// (clamped to [kMinBlendS, kMaxBlendS]; 10 ms until two have arrived), so that the blend ends
+  /// as the next frame comes.
   double blend_s = 0.0;
 };
 
