@@ -84,6 +84,12 @@ struct RunArgs {
 void print_summary(const controllers::SessionReport& r) {
   std::printf("scene %s: %.1f s%s%s\n", r.scene.c_str(), r.seconds, r.stepped ? " (stepped, simulated time)" : "",
               r.stopped_early ? " (stopped early)" : "");
+  const controllers::DeviceReport& d = r.device;
+  std::printf("  device    %s%s%s, max %.1f N%s\n", d.name.c_str(),
+              d.serial.empty() ? "" : fmt::format(", serial {}", d.serial).c_str(),
+              d.name.rfind(d.driver, 0) == 0 ? "" : fmt::format(" (driver {})", d.driver).c_str(),
+              d.max_force_n,
+              d.com_rate_hz > 0.0 ? fmt::format(", communication {:.0f} Hz", d.com_rate_hz).c_str() : "");
   std::printf("  haptic    %.1f Hz (target %.0f), %llu ticks, %llu missed deadlines, jitter p50 %.1f us, p99 %.1f us, max %.1f us\n",
               r.haptic_rate_hz, r.haptic_target_hz, static_cast<unsigned long long>(r.haptic_ticks),
               static_cast<unsigned long long>(r.haptic_missed_deadlines), r.jitter_p50_us, r.jitter_p99_us, r.jitter_max_us);

@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "uh/devices/force_dimension_device.hpp"
+
 namespace uh::controllers {
 namespace {
 
@@ -365,6 +367,14 @@ void HapticSession::collect_report(double seconds, bool stepped) {
   const haptico::HapticStats hs = manager_->stats();
   r.haptic_target_hz = haptic_hz_;
   r.haptic_ticks = hs.ticks;
+  const haptico::DeviceInfo& info = manager_->device_info();
+  r.device = {.driver = scene_.tool.device.driver,
+              .name = info.name,
+              .model = info.model,
+              .serial = info.serial,
+              .max_force_n = info.max_force_n};
+  if (const auto* fd = dynamic_cast<const devices::ForceDimensionDevice*>(&manager_->device()))
+    r.device.com_rate_hz = fd->com_rate_hz();
   if (stepped) {
     r.haptic_rate_hz = haptic_hz_;
   } else {
@@ -424,6 +434,13 @@ std::string session_report_json(const SessionReport& r) {
       {"mode", r.stepped ? "stepped" : "threaded"},
       {"seconds", r.seconds},
       {"stopped_early", r.stopped_early},
+      {"device",
+       {{"driver", r.device.driver},
+        {"name", r.device.name},
+        {"model", r.device.model},
+        {"serial", r.device.serial},
+        {"max_force_n", r.device.max_force_n},
+        {"com_rate_hz", r.device.com_rate_hz}}},
       {"haptic",
        {{"target_hz", r.haptic_target_hz},
         {"rate_hz", r.haptic_rate_hz},

@@ -184,6 +184,8 @@ Status ForceDimensionDevice::describe() {
                                  : model != nullptr ? model->half_extents
                                                     : Vec3{0.05, 0.05, 0.05};
   info_.nominal_rate_hz = 4000.0;
+  info_.model = model_;
+  info_.serial = serial_ != 0 ? std::to_string(serial_) : "";
   return Ok{};
 }
 
@@ -249,7 +251,8 @@ haptico::DeviceState ForceDimensionDevice::read_state() {
   s.orientation = quat_from_rotation_matrix(m);
   s.linear_velocity = {vx, vy, vz};
   s.buttons = api.dhdGetButtonMask(id_);
-  if ((++reads_ & 1023u) == 0) {
+  // sampled soon after the start (the first reads have no history) and every 1024 reads after
+  if ((++reads_ & 1023u) == 64) {
     const double khz = api.dhdGetComFreq(id_);
     if (std::isfinite(khz)) com_rate_hz_.store(khz * 1000.0, std::memory_order_relaxed);
   }

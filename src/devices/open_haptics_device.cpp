@@ -156,6 +156,8 @@ Status OpenHapticsDevice::describe() {
         fmt::format("openhaptics: {} has 6 output DOF but reports no valid nominal max torque", model_)};
   info_.workspace_half_extents = to_field(half_mm) * 1e-3;
   info_.nominal_rate_hz = 1000.0;
+  info_.model = model_;
+  info_.serial = serial_;
   return Ok{};
 }
 

@@ -526,6 +526,12 @@ TEST_F(CliTest, RunOnTheDeviceNamedOnTheCommandLine) {
   EXPECT_EQ(j["haptic"]["ticks"], 500);
   EXPECT_GT(j["force"]["max_n"].get<double>(), 0.5);
   EXPECT_LE(j["force"]["max_n"].get<double>(), 6.0);
+  // the report names the device, and DHD's communication rate (the stand-in's 1 kHz)
+  EXPECT_EQ(j["device"]["driver"], "forcedimension");
+  EXPECT_EQ(j["device"]["name"], "forcedimension omega.3");
+  EXPECT_EQ(j["device"]["model"], "omega.3");
+  EXPECT_EQ(j["device"]["serial"], "11001");
+  EXPECT_EQ(j["device"]["com_rate_hz"], 1000.0);
 
   const CommandRun unknown =
       uh(fmt::format("run '{}' --device nope --stepped", scene.string()), with_standin(dir_));
@@ -693,6 +699,9 @@ TEST_F(CliTest, RunOnOpenHapticsNamedOnTheCommandLine) {
   EXPECT_GT(j["haptic"]["ticks"].get<int>(), 100);
   EXPECT_GT(j["force"]["max_n"].get<double>(), 0.5);
   EXPECT_LE(j["force"]["max_n"].get<double>(), 3.3);
+  EXPECT_EQ(j["device"]["name"], "openhaptics Touch");
+  EXPECT_EQ(j["device"]["serial"], "220-00042");
+  EXPECT_EQ(j["device"]["com_rate_hz"], 0.0);  // HD reports no communication rate
   const CommandRun named =
       uh(fmt::format("run '{}' --device 'openhaptics:Left Touch' --seconds 0.3", scene.string()),
          with_standin(dir_));

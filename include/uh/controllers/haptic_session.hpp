@@ -61,9 +61,22 @@ struct RateSample {
   double rate_hz = 0.0;  ///< collision steps per second in the window [Hz]
 };
 
+/// The device a session ran on (plain data).
+struct DeviceReport {
+  std::string driver;  ///< registry name, e.g. "forcedimension"
+  std::string name;    ///< DeviceInfo::name, e.g. "forcedimension omega.3"
+  std::string model;   ///< as the device reports it ("" for simulated devices)
+  std::string serial;  ///< "" when it has none
+  double max_force_n = 0.0;
+  /// The vendor's measured communication rate [Hz] where it reports one (forcedimension:
+  /// dhdGetComFreq), else 0.
+  double com_rate_hz = 0.0;
+};
+
 /// What `uh run --json` prints, and more. Plain data.
 struct SessionReport {
   std::string scene;
+  DeviceReport device{};
   bool stepped = false;
   double seconds = 0.0;                ///< the time run [s] (less than asked when stopped early)
   bool stopped_early = false;          ///< request_stop() ended run() or run_stepped() before its time

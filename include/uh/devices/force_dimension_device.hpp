@@ -59,7 +59,7 @@ class ForceDimensionDevice final : public haptico::HapticDevice {
   /// Where libdhd was loaded from (after open()).
   const std::string& library_path() const { return library_.path(); }
   /// The communication rate DHD achieved [Hz] (dhdGetComFreq), sampled by the haptic thread
-  /// every 1024 reads and once more by close(). Any thread.
+  /// at the 64th read, every 1024 reads after, and once more by close(). Any thread.
   double com_rate_hz() const { return com_rate_hz_.load(std::memory_order_relaxed); }
   /// Commands the device clipped (DHD_MOTOR_SATURATED). Any thread.
   std::uint64_t saturated_commands() const { return saturated_.load(); }

@@ -18,6 +18,8 @@ struct DeviceInfo {
   double max_torque_nm = 0.0;     ///< largest torque [N m], > 0 if dof_actuated == 6
   Vec3 workspace_half_extents{};  ///< half extents of the reachable box about the base origin [m]
   double nominal_rate_hz = 1000.0;  ///< servo rate the device is made for [Hz]
+  std::string model{};   ///< the model as the device reports it ("" for simulated devices), e.g. "omega.3"
+  std::string serial{};  ///< its serial number as text ("" when it has none)
 };
 
 }  // namespace uh::haptico

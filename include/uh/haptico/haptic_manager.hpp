@@ -178,6 +178,8 @@ class HapticManager {
   bool is_open() const { return open_; }
   /// The device's description as read by open().
   const DeviceInfo& device_info() const { return info_; }
+  /// The device itself, e.g. for a driver's own counters (their thread rules apply).
+  const HapticDevice& device() const { return *device_; }
   /// The limit chain built by open() from the device's and options().limits (controlling thread,
   /// while no threaded session runs).
   const ForceLimiter& limiter() const { return limiter_; }
