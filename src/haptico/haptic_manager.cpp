@@ -155,7 +155,12 @@ std::uint64_t HapticManager::missed_deadlines() const {
 }
 
 void HapticManager::stop() {
-  if (servo_ != nullptr) servo_->stop();
+  if (servo_ != nullptr && servo_->running()) {
+    servo_->stop();
+    // a run whose last frame never came: the device's servo thread stopped answering (the clock
+    // gave up on it and turned forces off); latched like any device fault
+    if (!ended_with_zero_) faulted_.store(true, std::memory_order_release);
+  }
   loop_.stop();
   // the haptic thread is joined: this thread may talk to the device and bind delegates now
   allow_binding();

@@ -249,5 +249,28 @@ TEST(OpenHapticsDevice, AnErrorMidRunStopsTheForcesAndReopeningWorks) {
   EXPECT_EQ(standin.get("init_count"), 2.0);
 }
 
+// a scheduler that stops running frames: stopping does not hang, turns the forces off without it
+// and reports the device as faulted
+TEST(OpenHapticsDevice, ASchedulerThatStopsAnsweringEndsWithForcesOffAndAFault) {
+  testing::HdStandin standin;
+  HapticManager manager(make(standin_config()), {.rate_hz = 1000.0});
+  manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& c) {
+    c.force = {0.0, 0.0, 1.0};
+  });
+  ASSERT_TRUE(manager.start());
+  wait_for([&] { return standin.get("force_output") == 1.0; });
+  ASSERT_EQ(standin.get("force_output"), 1.0);
+  standin.set("freeze", 1);
+  manager.stop();  // gives up on the frozen scheduler after a bounded wait
+  EXPECT_FALSE(manager.running());
+  EXPECT_EQ(standin.get("force_output"), 0.0);
+  const Status status = manager.device_status();
+  ASSERT_FALSE(status);
+  EXPECT_EQ(
+      status.error().message,
+      "device 'openhaptics Touch' faulted: the HD scheduler stopped running servo frames: no frame for 2 s; "
+      "forces were disabled; it was sent zero force");
+}
+
 }  // namespace
 }  // namespace uh::devices
