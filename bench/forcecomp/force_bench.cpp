@@ -166,7 +166,7 @@ void BM_HeldReevaluateThenPenalty(benchmark::State& state) {
 }
 BENCHMARK(BM_HeldReevaluateThenPenalty)->Arg(100)->Arg(1000)->Arg(10000);
 
-// copying a collision result into the held set (once per collision frame)
+// holding a collision result (once per collision frame): a view, no copy
 void BM_HeldHold(benchmark::State& state) {
   const auto pairs = make_pairs(static_cast<int>(state.range(0)), Pose{}, Pose{});
   HeldContactSet held(static_cast<std::int32_t>(pairs.size()));

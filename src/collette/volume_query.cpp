@@ -412,22 +412,37 @@ const VolumeQueryResult& VolumeQuery::run(const SphereTree& a, const SphereTree&
 void VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& world_from_a, const Pose& world_from_b,
                       ContactFrame& out) {
   const auto start = std::chrono::steady_clock::now();
-  const Pose b_in_a = inverse(world_from_a) * world_from_b;
-  const VolumeQueryResult& r = run(a, b, b_in_a);
+  out.pair_count = 0;
+  out.section_count = 0;
+  const ContactSection& s = append_section(a, b, world_from_a, world_from_b, out);
+  const VolumeQueryResult& r = result_;
   out.world_from_a = world_from_a;
   out.world_from_b = world_from_b;
   out.total_volume = r.total_volume;
   out.restoring_direction_world = transform_vector(world_from_a, r.restoring_direction);
   out.volume_centroid_world = r.total_volume > 0.0 ? transform_point(world_from_a, r.volume_centroid) : Vec3{};
-  out.volume_gradient_world = transform_vector(world_from_a, r.volume_gradient);
+  out.volume_gradient_world = s.volume_gradient_world;
   out.distance = 0.0;
-  const std::int32_t n = std::min<std::int32_t>(r.pair_count, ContactFrame::kMaxPairs);
+  out.truncated = s.truncated;
+  if (s.pair_count == 0) out.section_count = 0;  // nothing to hold: a frame without pairs has no section
+  out.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+const ContactSection& VolumeQuery::append_section(const SphereTree& a, const SphereTree& b,
+                                                  const Pose& world_from_a, const Pose& world_from_b,
+                                                  ContactFrame& out) {
+  const Pose b_in_a = inverse(world_from_a) * world_from_b;
+  const VolumeQueryResult& r = run(a, b, b_in_a);
+  const std::int32_t first = out.pair_count;
+  const std::int32_t n = r.pair_count;
+  out.resize_pairs(first + n);  // grows the frame (only) when it holds fewer pairs than ever before
   const Mat3 m = rotation_matrix(normalized(world_from_a.rotation));
   const auto leaves_a = a.leaves();
   const auto leaves_b = b.leaves();
+  const auto pairs = out.pairs();
   for (std::int32_t i = 0; i < n; ++i) {
     const PairOverlap& p = pairs_[static_cast<std::size_t>(i)];
-    SpherePairContact& c = out.pairs[static_cast<std::size_t>(i)];
+    SpherePairContact& c = pairs[static_cast<std::size_t>(first + i)];
     c.volume = p.volume;
     c.area = p.area;
     for (int k = 0; k < 3; ++k) {
@@ -445,9 +460,13 @@ void VolumeQuery::run(const SphereTree& a, const SphereTree& b, const Pose& worl
     c.sphere_a_local = leaves_a[static_cast<std::size_t>(p.leaf_a)];
     c.sphere_b_local = leaves_b[static_cast<std::size_t>(p.leaf_b)];
   }
-  out.pair_count = n;
-  out.truncated = r.stats.overlapping_pairs + r.near_pairs > n;
-  out.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out.add_section({.world_from_a = world_from_a,
+                          .world_from_b = world_from_b,
+                          .total_volume = r.total_volume,
+                          .volume_gradient_world = transform_vector(world_from_a, r.volume_gradient),
+                          .first_pair = first,
+                          .pair_count = n,
+                          .truncated = r.stats.overlapping_pairs + r.near_pairs > n});
 }
 
 }  // namespace uh::collette

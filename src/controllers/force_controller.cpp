@@ -6,6 +6,20 @@
 namespace uh::controllers {
 namespace {
 
+// The volume-weighted centroid of one section's pairs [m, world frame].
+Vec3 section_centroid(const ContactFrame& frame, const ContactSection& section) {
+  Vec3 sum{};
+  double volume = 0.0;
+  for (const SpherePairContact& p : frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
+                                                          static_cast<std::size_t>(section.pair_count))) {
+    const double v = static_cast<double>(p.volume);
+    sum += v * Vec3{static_cast<double>(p.centroid_world[0]), static_cast<double>(p.centroid_world[1]),
+                    static_cast<double>(p.centroid_world[2])};
+    volume += v;
+  }
+  return volume > 0.0 ? sum / volume : Vec3{};
+}
+
 // Raises an atomic maximum written by one thread (the haptic thread) and read by others.
 void raise_max(std::atomic<double>& max, double value) {
   if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
@@ -75,30 +89,93 @@ forcecomp::Wrench ForceController::add_surface(Watched& w, const forcecomp::Wren
 }
 
 void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManager& manager) {
+  world_ = &world;
   manager_ = &manager;
   collision_connection_ = world.on_collision().connect<&ForceController::on_collision>(*this);
   force_connection_ = manager.force_on_haptic_tick().connect<&ForceController::on_force>(*this);
 }
 
+ForceController::Watched* ForceController::find_watched(collette::ObjectId object) {
+  for (auto& w : watched_)
+    if (w->object == object) return w.get();
+  return nullptr;
+}
+
+// Collision thread: the model of one object's section of a frame (null: no contact with it).
+void ForceController::publish_model(Watched& w, const ContactFrame& frame, const ContactSection* section) {
+  const Pose world_from_other = section != nullptr ? section->world_from_a : frame.world_from_a;
+  const Pose world_from_tool_at_frame = section != nullptr ? section->world_from_b : frame.world_from_b;
+  // the model is built here, on the collision thread, around the tool pose the query used
+  const Pose& world_from_tool =
+      component_.options().side == forcecomp::ContactSide::kB ? world_from_tool_at_frame : world_from_other;
+  const forcecomp::BodyMotion at_frame = w.component.body_motion(world_from_tool, {}, {});
+  const auto pairs = section != nullptr ? frame.pairs().subspan(static_cast<std::size_t>(section->first_pair),
+                                                                static_cast<std::size_t>(section->pair_count))
+                                        : std::span<const SpherePairContact>{};
+  forcecomp::WrenchModel& m = w.models.write_buffer();
+  m = forcecomp::build_wrench_model(pairs, world_from_other, world_from_tool_at_frame,
+                                    w.component.penalty_input(at_frame, {}, w.coverage_product), options_.model);
+  m.sequence = frame.sequence;
+  m.time_s = frame.time_s;
+  w.modelled_contact = m.contact;
+  w.models.publish();
+}
+
 void ForceController::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
-  if (b != tool_) return;  // the tool is always B of its watched pairs: forces push B out of A
-  const bool model = uses_model();
-  for (auto& w : watched_) {
-    if (w->object != a) continue;
-    if (model) {
-      // the model is built here, on the collision thread, around the tool pose the query used
-      const Pose& world_from_tool =
-          component_.options().side == forcecomp::ContactSide::kB ? frame.world_from_b : frame.world_from_a;
-      const forcecomp::BodyMotion at_frame = w->component.body_motion(world_from_tool, {}, {});
-      w->models.write_buffer() = forcecomp::build_wrench_model(
-          frame, w->component.penalty_input(at_frame, {}, w->coverage_product), options_.model);
-      w->models.publish();
-    }
-    if (!model || options_.check_model) {
-      copy_contact_frame(frame, w->inbox.write_buffer());
-      w->inbox.publish();
-    }
+  if (b != tool_ || !uses_model()) return;  // the tool is always B of its watchers: forces push B out of A
+  if (a != ContactFrame::kEveryObject) {
+    if (Watched* w = find_watched(a)) publish_model(*w, frame, frame.sections().empty() ? nullptr : &frame.sections().front());
     return;
+  }
+  // the tool against everything: a model per touched object, and one without contact for each
+  // watched object the tool just left
+  for (auto& w : watched_) w->in_frame = false;
+  for (const ContactSection& s : frame.sections()) {
+    Watched* w = find_watched(s.object_a);
+    if (w == nullptr) continue;
+    w->in_frame = true;
+    publish_model(*w, frame, &s);
+  }
+  for (auto& w : watched_)
+    if (!w->in_frame && w->modelled_contact) publish_model(*w, frame, nullptr);
+}
+
+// Haptic thread: holds each watched object's part of a new frame where it lies.
+void ForceController::take_frame(const ContactFrame& frame, const Pose& world_from_tool,
+                                 const forcecomp::BodyMotion& tool_motion) {
+  const bool model = uses_model();
+  if (!model) frames_received_.fetch_add(1, std::memory_order_relaxed);
+  const bool every = frame.object_a == ContactFrame::kEveryObject;
+  for (auto& w : watched_) {
+    if (!every && w->object != frame.object_a) continue;
+    const ContactSection* section = nullptr;
+    for (const ContactSection& s : frame.sections())
+      if (s.object_a == w->object) section = &s;
+    if (section == nullptr || section->pair_count == 0) {
+      w->held.clear();
+      w->held_wrench = {};
+      w->held_pairs = 0;
+      if (!model) w->surface.reset();
+      continue;
+    }
+    w->held.hold(frame, *section);
+    w->world_from_object = section->world_from_a;
+    if (!model) {
+      // the section's centroid: the frame's when it has one section, else the pairs' own
+      const Vec3 centroid = frame.section_count == 1 ? frame.volume_centroid_world : section_centroid(frame, *section);
+      hold_contact_geometry(*w,
+                            {section->world_from_b, section->world_from_a, centroid, section->volume_gradient_world,
+                             section->total_volume},
+                            world_from_tool);
+    }
+    if (!options_.multi_rate) {
+      // held-force mode: the frame's own force, kept until the next frame
+      const auto r = w->component.evaluate(frame.pairs().subspan(static_cast<std::size_t>(section->first_pair),
+                                                                 static_cast<std::size_t>(section->pair_count)),
+                                           tool_motion, {}, w->coverage_product);
+      w->held_wrench = r.wrench;
+      w->held_pairs = r.pair_count;
+    }
   }
 }
 
@@ -128,31 +205,12 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   const bool model = uses_model();
   Vec3 exact_force{};  // check_model: the exact re-evaluation's force, beside the model's
   std::uint64_t clamped = 0, held = 0;
+  if ((!model || options_.check_model) && world_ != nullptr) {
+    // the previous frames' slots go back to the collision thread: hold the new ones where they lie
+    for (const collette::WatcherId watcher : watchers_)
+      if (const ContactFrame* frame = world_->take_contact(watcher)) take_frame(*frame, world_from_tool, tool_motion);
+  }
   for (auto& w : watched_) {
-    if (w->inbox.update()) {
-      const ContactFrame& frame = w->inbox.read_buffer();
-      if (!model) frames_received_.fetch_add(1, std::memory_order_relaxed);
-      if (frame.pair_count > 0) {
-        w->held.hold(frame);
-        w->world_from_object = frame.world_from_a;
-        if (!model)
-          hold_contact_geometry(*w,
-                                {frame.world_from_b, frame.world_from_a, frame.volume_centroid_world,
-                                 frame.volume_gradient_world, frame.total_volume},
-                                world_from_tool);
-        if (!options_.multi_rate) {
-          // held-force mode: the frame's own force, kept until the next frame
-          const auto r = w->component.evaluate(frame, tool_motion, {}, w->coverage_product);
-          w->held_wrench = r.wrench;
-          w->held_pairs = r.pair_count;
-        }
-      } else {
-        w->held.clear();
-        w->held_wrench = {};
-        w->held_pairs = 0;
-        if (!model) w->surface.reset();
-      }
-    }
     if (model) {
       if (w->models.update()) {
         const forcecomp::WrenchModel& m = w->models.read_buffer();

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <map>
 #include <thread>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -59,19 +61,34 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;
   std::vector<double> object_coverages;
+  // objects of one shape share its tree (a room repeats a few meshes): loaded once
+  std::map<std::tuple<std::string, std::string, std::int64_t, double>, ShapeTree> loaded;
   for (const SceneObject& object : scene.objects) {
-    auto tree = load_shape_tree(object.shape, cache, options.build_progress);
+    const auto key = std::make_tuple(object.shape.mesh.string(), object.shape.ist.string(),
+                                     object.shape.spheres, object.shape.meters_per_unit);
+    Result<ShapeTree> tree = Error{""};
+    if (const auto it = loaded.find(key); it != loaded.end() && !object.shape.tree) {
+      tree = it->second;
+    } else {
+      tree = load_shape_tree(object.shape, cache, options.build_progress);
+      if (tree && !object.shape.tree) loaded.emplace(key, *tree);
+    }
     if (!tree) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message)};
-    object_coverages.push_back(tree->coverage);
-    auto id = world.add_object({.tree = tree->tree, .world_from_object = object.pose, .name = object.name});
+    auto id = world.add_object({.tree = tree->tree,
+                                .world_from_object = object.pose,
+                                .coverage = tree->coverage,
+                                .name = object.name});
     if (!id) return id.error();
     object_ids.push_back(*id);
+    object_coverages.push_back(tree->coverage);
   }
   auto tool_tree = load_shape_tree(scene.tool.shape, cache, options.build_progress);
   if (!tool_tree) return Error{fmt::format("{}: tool '{}': {}", scene.source, scene.tool.name, tool_tree.error().message)};
   // the tool's pose comes from the device on the first haptic tick (BridgingController)
-  auto tool_id =
-      world.add_object({.tree = tool_tree->tree, .has_initial_pose = false, .name = scene.tool.name});
+  auto tool_id = world.add_object({.tree = tool_tree->tree,
+                                   .has_initial_pose = false,
+                                   .coverage = tool_tree->coverage,
+                                   .name = scene.tool.name});
   if (!tool_id) return tool_id.error();
   session->tool_id_ = *tool_id;
 
@@ -99,10 +116,23 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
                                              .side = forcecomp::ContactSide::kB});
   session->force_controller_ =
       std::make_unique<ForceController>(session->tool_id_, component, scene.tool.workspace, force_options);
+  // the tool is B of every watcher: the frames' forces push it out of the objects. Watching every
+  // object is one watcher of the tool against everything (the broad phase picks the objects it
+  // touches); a coherence skin keeps one watcher per pair (the kept candidates belong to a pair).
+  const bool watch_all = scene.watch.size() == scene.objects.size() && !scene.objects.empty() &&
+                         !(options.coherence_skin.value_or(scene.coherence_skin) > 0.0);
+  if (watch_all) {
+    auto w = world.add_tool_watcher(session->tool_id_);
+    if (!w) return w.error();
+    session->force_controller_->read_frames_of(*w);
+  }
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end()) continue;
-    // the tool is B of every watched pair: the frames' forces push it out of the object
-    if (auto w = world.add_collision_watcher(object_ids[i], session->tool_id_); !w) return w.error();
+    if (!watch_all) {
+      auto w = world.add_collision_watcher(object_ids[i], session->tool_id_);
+      if (!w) return w.error();
+      session->force_controller_->read_frames_of(*w);
+    }
     const forcecomp::ContactMaterial material =
         forcecomp::combine_materials(scene.objects[i].material, scene.tool.material, scene.tool.force);
     session->force_controller_->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage,
@@ -116,6 +146,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   self.sent_connection_ = self.manager_->sent_on_haptic_tick().connect<&HapticSession::on_tick_sent>(self);
   self.collision_connection_ = world.on_collision().connect<&HapticSession::on_collision>(self);
   self.touching_.assign(scene.objects.size(), 0);
+  self.touching_now_.assign(scene.objects.size(), 0);
   self.object_ids_ = object_ids;
   self.report_.scene = scene.name;
   return session;
@@ -156,16 +187,37 @@ void HapticSession::on_tick_sent(const haptico::TraceSample& sample) {
 }
 
 void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
-  // collision thread: edges of the overlap become events for the owner
-  if (b != tool_id_ || a < 0 || static_cast<std::size_t>(a) >= touching_.size()) return;
-  const bool touching = frame.total_volume > 0.0;
-  if (touching == (touching_[static_cast<std::size_t>(a)] != 0)) return;
-  touching_[static_cast<std::size_t>(a)] = touching ? 1 : 0;
+  // collision thread: edges of the overlap become events for the owner. The session registered
+  // its objects first, so an object's world id is its index in the scene.
+  if (b != tool_id_) return;
+  if (a != ContactFrame::kEveryObject) {
+    if (a < 0 || static_cast<std::size_t>(a) >= touching_.size()) return;
+    const bool touching = frame.total_volume > 0.0;
+    contact_edge(a, touching, frame.time_s, touching ? frame.total_volume : 0.0,
+                 touching ? frame.pair_count : 0);
+    return;
+  }
+  // the tool against everything: a section per object it touches; the others are apart
+  std::fill(touching_now_.begin(), touching_now_.end(), std::uint8_t{0});
+  for (const ContactSection& s : frame.sections()) {
+    if (s.object_a < 0 || static_cast<std::size_t>(s.object_a) >= touching_.size() || !(s.total_volume > 0.0))
+      continue;
+    touching_now_[static_cast<std::size_t>(s.object_a)] = 1;
+    contact_edge(s.object_a, true, frame.time_s, s.total_volume, s.pair_count);
+  }
+  for (std::size_t i = 0; i < touching_.size(); ++i)
+    if (touching_now_[i] == 0) contact_edge(static_cast<collette::ObjectId>(i), false, frame.time_s, 0.0, 0);
+}
+
+void HapticSession::contact_edge(collette::ObjectId object, bool touching, double time_s, double volume,
+                                 std::int32_t pairs) {
+  if (touching == (touching_[static_cast<std::size_t>(object)] != 0)) return;
+  touching_[static_cast<std::size_t>(object)] = touching ? 1 : 0;
   const ContactEvent event{.kind = touching ? ContactEventKind::kBegin : ContactEventKind::kEnd,
-                           .object = a,
-                           .time_s = frame.time_s - t0_s_,
-                           .volume = touching ? frame.total_volume : 0.0,
-                           .pairs = touching ? frame.pair_count : 0};
+                           .object = object,
+                           .time_s = time_s - t0_s_,
+                           .volume = volume,
+                           .pairs = pairs};
   if (!events_.try_push(event)) dropped_events_.increment();
 }
 
@@ -395,6 +447,11 @@ void HapticSession::collect_report(double seconds, bool stepped) {
   r.query_median_us = ws.query_time.p50_ns * 1e-3;
   r.query_p99_us = ws.query_time.p99_ns * 1e-3;
   r.query_max_us = ws.query_time.max_ns * 1e-3;
+  r.step_median_us = ws.step_time.p50_ns * 1e-3;
+  r.step_p99_us = ws.step_time.p99_ns * 1e-3;
+  r.step_max_us = ws.step_time.max_ns * 1e-3;
+  r.objects = ws.objects;
+  r.frame_bytes = ws.frame_bytes;
   r.max_pairs = ws.max_pairs;
   r.truncated_frames = ws.truncated_frames;
   r.coherent_queries = ws.coherent_queries;
@@ -461,6 +518,9 @@ std::string session_report_json(const SessionReport& r) {
           {"mean", r.collision_rate_mean_hz}}},
         {"steps", r.collision_steps},
         {"query_us", {{"median", r.query_median_us}, {"p99", r.query_p99_us}, {"max", r.query_max_us}}},
+        {"step_us", {{"median", r.step_median_us}, {"p99", r.step_p99_us}, {"max", r.step_max_us}}},
+        {"objects", r.objects},
+        {"frame_bytes", r.frame_bytes},
         {"max_pairs", r.max_pairs},
         {"truncated_frames", r.truncated_frames},
         {"coherent_queries", r.coherent_queries}}},

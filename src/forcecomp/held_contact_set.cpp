@@ -23,56 +23,46 @@ void store(float (&out)[3], const Vec3& v) {
 
 }  // namespace
 
-HeldContactSet::HeldContactSet(std::int32_t capacity)
-    : capacity_(capacity),
-      held_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
-      normal_a_local_(new Vec3[static_cast<std::size_t>(std::max(capacity, 1))]),
-      scratch_(new SpherePairContact[static_cast<std::size_t>(std::max(capacity, 1))]),
-      packed_(new PackedPair[static_cast<std::size_t>(std::max(capacity, 1))]),
-      local_(new LocalPair[static_cast<std::size_t>(std::max(capacity, 1))]) {
-  assert(capacity > 0 && "uh::forcecomp::HeldContactSet::HeldContactSet(): capacity must be positive");
+HeldContactSet::HeldContactSet(std::int32_t reevaluate_capacity)
+    : scratch_capacity_(std::max(reevaluate_capacity, 0)),
+      scratch_(new SpherePairContact[static_cast<std::size_t>(std::max(reevaluate_capacity, 1))]) {
+  assert(reevaluate_capacity >= 0 &&
+         "uh::forcecomp::HeldContactSet::HeldContactSet(): capacity must be >= 0");
 }
 
 void HeldContactSet::hold(const ContactFrame& frame) {
-  const auto count = static_cast<std::size_t>(std::clamp(frame.pair_count, 0, ContactFrame::kMaxPairs));
-  hold(std::span<const SpherePairContact>(frame.pairs.data(), count), frame.sequence, frame.time_s);
-  // the frame knows its poses: express the normals in A's frame for the coincident-centre case
-  const Quat a_from_world = conjugate(frame.world_from_a.rotation);
-  for (std::int32_t i = 0; i < size_; ++i) {
-    const float* n = held_[static_cast<std::size_t>(i)].normal_world;
-    normal_a_local_[static_cast<std::size_t>(i)] =
-        rotate(a_from_world, Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]), static_cast<double>(n[2])});
-  }
+  hold(frame.pairs(), frame.sequence, frame.time_s);
+  // the frame knows its poses: the normals go into A's frame for the coincident-centre case
+  const auto sections = frame.sections();
+  a_from_world_held_ =
+      conjugate(sections.empty() ? frame.world_from_a.rotation : sections.front().world_from_a.rotation);
+}
+
+void HeldContactSet::hold(const ContactFrame& frame, const ContactSection& section) {
+  hold(frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
+                             static_cast<std::size_t>(section.pair_count)),
+       frame.sequence, frame.time_s);
+  a_from_world_held_ = conjugate(section.world_from_a.rotation);
 }
 
 void HeldContactSet::hold(std::span<const SpherePairContact> pairs, std::uint64_t sequence, double time_s) {
-  const std::size_t n = std::min(pairs.size(), static_cast<std::size_t>(capacity_));
-  dropped_pairs_ += pairs.size() - n;
-  std::copy_n(pairs.begin(), n, held_.get());
-  for (std::size_t i = 0; i < n; ++i) {
-    const Sphere& a = pairs[i].sphere_a_local;
-    const Sphere& b = pairs[i].sphere_b_local;
-    packed_[i] = {a.x, a.y, a.z, a.radius, b.x, b.y, b.z, b.radius};
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const float* nw = held_[i].normal_world;
-    // without poses the world normal is the best guess for A's frame (exact when A is unrotated)
-    normal_a_local_[i] = {static_cast<double>(nw[0]), static_cast<double>(nw[1]), static_cast<double>(nw[2])};
-  }
-  size_ = static_cast<std::int32_t>(n);
+  held_ = pairs;
+  // without poses the world normal is the best guess for A's frame (exact when A is unrotated)
+  a_from_world_held_ = Quat{};
   sequence_ = sequence;
   time_s_ = time_s;
 }
 
 void HeldContactSet::clear() {
-  size_ = 0;
+  held_ = {};
   sequence_ = 0;
   time_s_ = 0.0;
 }
 
 std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_from_a, const Pose& world_from_b) {
-  for (std::int32_t k = 0; k < size_; ++k) {
-    const auto i = static_cast<std::size_t>(k);
+  const std::size_t n = std::min(held_.size(), static_cast<std::size_t>(scratch_capacity_));
+  dropped_pairs_ += held_.size() - n;
+  for (std::size_t i = 0; i < n; ++i) {
     const SpherePairContact& in = held_[i];
     SpherePairContact& out = scratch_[i];
     out = in;
@@ -85,14 +75,14 @@ std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_
     const SphereOverlap<double> o = sphere_overlap(d, ra, rb);
     // coincident centres (within float storage precision) leave the centre line undefined: keep
     // the held normal, turned with A
-    const Vec3 u = d > 1e-6 * (ra + rb) ? delta / d : rotate(world_from_a.rotation, normal_a_local_[i]);
+    const Vec3 u = d > 1e-6 * (ra + rb) ? delta / d : rotate(world_from_a.rotation, held_normal_in_a(in));
     const Vec3 centroid = ca + o.centroid_offset * u;
     out.volume = static_cast<float>(o.volume);
     out.area = static_cast<float>(o.area);
     store(out.normal_world, u);
     store(out.centroid_world, centroid);
   }
-  return {scratch_.get(), static_cast<std::size_t>(size_)};
+  return {scratch_.get(), n};
 }
 
 PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& world_from_b, const PenaltyInput& input) {
@@ -108,42 +98,29 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
     for (int j = 0; j < 3; ++j) r[i][j] = static_cast<float>(rot.m[i][j]);
   const float tx = static_cast<float>(a_from_b.position.x), ty = static_cast<float>(a_from_b.position.y),
               tz = static_cast<float>(a_from_b.position.z);
+  // B's sphere of a held pair in A's frame, its distance to A's sphere; false when apart
+  struct Local {
+    float dx, dy, dz, d2, rs;
+  };
+  const auto place = [&](const SpherePairContact& p, Local& l) {
+    const Sphere& b = p.sphere_b_local;
+    const Sphere& a = p.sphere_a_local;
+    l.dx = r[0][0] * b.x + r[0][1] * b.y + r[0][2] * b.z + tx - a.x;
+    l.dy = r[1][0] * b.x + r[1][1] * b.y + r[1][2] * b.z + ty - a.y;
+    l.dz = r[2][0] * b.x + r[2][1] * b.y + r[2][2] * b.z + tz - a.z;
+    l.d2 = l.dx * l.dx + l.dy * l.dy + l.dz * l.dz;
+    l.rs = a.radius + b.radius;
+    return l.d2 < l.rs * l.rs;  // apart: most near pairs of the contact margin end here
+  };
+  // pass 1: the total volume (it scales the damping of every pair in pass 2)
   double total = 0.0;
-  std::int32_t count = 0;
-  for (std::int32_t k = 0; k < size_; ++k) {
-    const PackedPair& p = packed_[static_cast<std::size_t>(k)];
-    const float bx = r[0][0] * p.bx + r[0][1] * p.by + r[0][2] * p.bz + tx;
-    const float by = r[1][0] * p.bx + r[1][1] * p.by + r[1][2] * p.bz + ty;
-    const float bz = r[2][0] * p.bx + r[2][1] * p.by + r[2][2] * p.bz + tz;
-    const float dx = bx - p.ax, dy = by - p.ay, dz = bz - p.az;
-    const float d2 = dx * dx + dy * dy + dz * dz;
-    const float rs = p.ar + p.br;
-    if (!(d2 < rs * rs)) continue;  // apart: most near pairs of the contact margin end here
-    const float d = std::sqrt(d2);
-    const float inv = d > 0.f ? 1.f / d : 0.f;
-    LocalPair& out = local_[static_cast<std::size_t>(count)];
-    const SphereOverlap<float> o = sphere_overlap(d, p.ar, p.br);
-    out.volume = o.volume;
-    out.area = o.area;
-    const float off = o.centroid_offset;
-    if (!(out.volume > 0.f)) continue;
-    if (d > 1e-6f * rs) {
-      out.nx = dx * inv;
-      out.ny = dy * inv;
-      out.nz = dz * inv;
-    } else {
-      const Vec3& n = normal_a_local_[static_cast<std::size_t>(k)];
-      out.nx = static_cast<float>(n.x);
-      out.ny = static_cast<float>(n.y);
-      out.nz = static_cast<float>(n.z);
-    }
-    out.cx = p.ax + out.nx * off;
-    out.cy = p.ay + out.ny * off;
-    out.cz = p.az + out.nz * off;
-    total += static_cast<double>(out.volume);
-    ++count;
+  for (const SpherePairContact& p : held_) {
+    Local l;
+    if (!place(p, l)) continue;
+    const float volume =
+        sphere_overlap(std::sqrt(l.d2), p.sphere_a_local.radius, p.sphere_b_local.radius).volume;
+    if (volume > 0.f) total += static_cast<double>(volume);
   }
-  local_count_ = count;
 
   PenaltyResult result;
   result.total_volume = total;
@@ -157,12 +134,32 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   const BodyMotion tool = to_a(input.tool);
   const BodyMotion other = to_a(input.other);
   detail::PenaltySum sum(input, total, tool, other);
-  for (std::int32_t k = 0; k < local_count_; ++k) {
-    const LocalPair& p = local_[static_cast<std::size_t>(k)];
+  // pass 2: the same per-pair terms in float, fed to the law in double
+  for (const SpherePairContact& p : held_) {
+    Local l;
+    if (!place(p, l)) continue;
+    const float d = std::sqrt(l.d2);
+    const SphereOverlap<float> o = sphere_overlap(d, p.sphere_a_local.radius, p.sphere_b_local.radius);
+    if (!(o.volume > 0.f)) continue;
+    float nx, ny, nz;
+    if (d > 1e-6f * l.rs) {
+      const float inv = 1.f / d;
+      nx = l.dx * inv;
+      ny = l.dy * inv;
+      nz = l.dz * inv;
+    } else {
+      const Vec3 n = held_normal_in_a(p);
+      nx = static_cast<float>(n.x);
+      ny = static_cast<float>(n.y);
+      nz = static_cast<float>(n.z);
+    }
+    const float off = o.centroid_offset;
     ++result.pair_count;
-    sum.add(static_cast<double>(p.volume), static_cast<double>(p.area),
-            Vec3{static_cast<double>(p.nx), static_cast<double>(p.ny), static_cast<double>(p.nz)},
-            Vec3{static_cast<double>(p.cx), static_cast<double>(p.cy), static_cast<double>(p.cz)});
+    sum.add(static_cast<double>(o.volume), static_cast<double>(o.area),
+            Vec3{static_cast<double>(nx), static_cast<double>(ny), static_cast<double>(nz)},
+            Vec3{static_cast<double>(p.sphere_a_local.x + nx * off),
+                 static_cast<double>(p.sphere_a_local.y + ny * off),
+                 static_cast<double>(p.sphere_a_local.z + nz * off)});
   }
   result.pushing_pairs = sum.pushing_pairs;
   const Vec3& force = sum.force;

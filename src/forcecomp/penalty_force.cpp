@@ -39,8 +39,7 @@ PenaltyResult evaluate_penalty(std::span<const SpherePairContact> pairs, const P
 }
 
 PenaltyResult evaluate_penalty(const ContactFrame& frame, const PenaltyInput& input) {
-  const auto count = static_cast<std::size_t>(std::clamp(frame.pair_count, 0, ContactFrame::kMaxPairs));
-  return evaluate_penalty(std::span<const SpherePairContact>(frame.pairs.data(), count), input);
+  return evaluate_penalty(frame.pairs(), input);
 }
 
 }  // namespace uh::forcecomp

@@ -185,9 +185,7 @@ WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const P
 
 WrenchModel build_wrench_model(const ContactFrame& frame, const PenaltyInput& input,
                                const WrenchModelOptions& options) {
-  const auto count = static_cast<std::size_t>(std::clamp(frame.pair_count, 0, ContactFrame::kMaxPairs));
-  WrenchModel m = build_wrench_model(std::span<const SpherePairContact>(frame.pairs.data(), count),
-                                     frame.world_from_a, frame.world_from_b, input, options);
+  WrenchModel m = build_wrench_model(frame.pairs(), frame.world_from_a, frame.world_from_b, input, options);
   m.sequence = frame.sequence;
   m.time_s = frame.time_s;
   return m;

@@ -59,6 +59,7 @@ TEST_F(WorldFixture, RejectsBadSetup) {
   const auto b = world.add_object({.tree = tree, .name = "b"});
   ASSERT_TRUE(a && b);
   EXPECT_FALSE(world.start().has_value()) << "start without a watcher must fail";
+  EXPECT_FALSE(world.add_object({.tree = tree, .coverage = 0.0, .name = "c"}).has_value());
   EXPECT_FALSE(world.add_collision_watcher(*a, *a).has_value());
   EXPECT_FALSE(world.add_collision_watcher(*a, 7).has_value());
   EXPECT_TRUE(world.add_collision_watcher(*a, *b).has_value());
@@ -240,6 +241,256 @@ TEST_F(WorldFixture, AnObjectWithoutAPoseIsNotQueriedUntilItsMoverSetsOne) {
   world.step(0.001);
   ASSERT_TRUE(world.read_contact(w, *frame));
   EXPECT_GT(frame->total_volume, 0.0);
+}
+
+}  // namespace
+}  // namespace uh::collette
+
+#include <random>
+#include <set>
+
+#include "uh/collette/dynamic_aabb_tree.hpp"
+
+namespace uh::collette {
+namespace {
+
+TEST(DynamicAabbTree, QueriesMatchAllPairsThroughInsertsMovesAndRemoves) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> pos(-10.0, 10.0), size(0.1, 2.0), step(-0.6, 0.6);
+  DynamicAabbTree tree(4);
+  struct Item {
+    Aabb box;
+    std::int32_t proxy;
+  };
+  std::vector<Item> items;  // index = user value; proxy -1 once removed
+  const auto random_box = [&] {
+    const Vec3 c{pos(rng), pos(rng), pos(rng)};
+    const double h = size(rng);
+    return aabb::of_sphere(c, h);
+  };
+  const double margin = 0.3;
+  for (int round = 0; round < 40; ++round) {
+    for (int k = 0; k < 10; ++k) {
+      const Aabb box = random_box();
+      items.push_back({box, tree.create(box, margin, static_cast<std::int32_t>(items.size()))});
+    }
+    for (Item& it : items) {
+      if (it.proxy < 0) continue;
+      const Vec3 d{step(rng), step(rng), step(rng)};
+      it.box = {it.box.min + d, it.box.max + d};
+      tree.move(it.proxy, it.box, margin);
+      ASSERT_TRUE(aabb::contains(tree.fat_box(it.proxy), it.box));
+    }
+    for (int k = 0; k < 4; ++k) {
+      Item& it = items[std::uniform_int_distribution<std::size_t>(0, items.size() - 1)(rng)];
+      if (it.proxy < 0) continue;
+      tree.destroy(it.proxy);
+      it.proxy = -1;
+    }
+    ASSERT_TRUE(tree.valid()) << "round " << round;
+    // reference: every live item whose fat box overlaps the query box, by testing all of them
+    for (int q = 0; q < 20; ++q) {
+      const Aabb box = random_box();
+      std::set<std::int32_t> expected, found;
+      for (std::size_t i = 0; i < items.size(); ++i)
+        if (items[i].proxy >= 0 && aabb::overlaps(tree.fat_box(items[i].proxy), box))
+          expected.insert(static_cast<std::int32_t>(i));
+      tree.query(box, [&](std::int32_t user) {
+        EXPECT_TRUE(found.insert(user).second) << "reported twice";
+        return true;
+      });
+      ASSERT_EQ(found, expected) << "round " << round << " query " << q;
+      // and the fat boxes hold the tight ones, so no true overlap is missed
+      for (std::size_t i = 0; i < items.size(); ++i)
+        if (items[i].proxy >= 0 && aabb::overlaps(items[i].box, box)) {
+          ASSERT_TRUE(found.count(static_cast<std::int32_t>(i)));
+        }
+    }
+  }
+  int live = 0;
+  for (const Item& it : items) live += it.proxy >= 0 ? 1 : 0;
+  EXPECT_EQ(tree.proxy_count(), live);
+  // balanced: an AVL-like tree of n leaves is at most about 1.44 log2(n) + 2 high
+  EXPECT_LE(tree.height(), static_cast<int>(1.45 * std::log2(static_cast<double>(live)) + 2.0));
+}
+
+TEST_F(WorldFixture, StaleIdsAreRefusedWithAMessageAndSlotsAreReusedUnderANewGeneration) {
+  CollisionWorld world;
+  const ObjectId a = *world.add_object({.tree = tree, .name = "a"});
+  const ObjectId b = *world.add_object({.tree = tree, .world_from_object = {{}, {0.5, 0, 0}}, .name = "b"});
+  const WatcherId w = *world.add_collision_watcher(a, b);
+  const Status refused = world.remove_object(b);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("remove the watcher first"), std::string::npos)
+      << refused.error().message;
+  ASSERT_TRUE(world.remove_watcher(w).has_value());
+  ASSERT_TRUE(world.remove_object(b).has_value());
+  EXPECT_FALSE(world.contains(b));
+  EXPECT_EQ(world.object_count(), 1);
+
+  const ObjectId c = *world.add_object({.tree = tree, .name = "c"});
+  EXPECT_NE(c, b) << "the reused slot carries a new generation";
+  EXPECT_TRUE(world.contains(c));
+  const Status again = world.remove_object(b);
+  ASSERT_FALSE(again.has_value());
+  EXPECT_NE(again.error().message.find("stale"), std::string::npos) << again.error().message;
+  const auto watch_stale = world.add_collision_watcher(a, b);
+  ASSERT_FALSE(watch_stale.has_value());
+  EXPECT_NE(watch_stale.error().message.find("stale"), std::string::npos);
+  EXPECT_FALSE(world.set_pose(b, Pose{})) << "a stale id must not move the slot's new object";
+  EXPECT_EQ(world.stats().stale_poses, 1u);
+  EXPECT_FALSE(world.remove_watcher(w).has_value());
+  EXPECT_NE(world.remove_object(12345).error().message.find("no object"), std::string::npos);
+  const ObjectId fixed = *world.add_object({.tree = tree, .is_static = true, .name = "fixed"});
+  EXPECT_FALSE(world.set_pose(fixed, Pose{})) << "a static object does not move";
+}
+
+// Objects scattered in a room; the lens volumes of one object's leaves against the tool's, by
+// testing every leaf pair (no tree, no broad phase).
+struct Room {
+  std::vector<Pose> poses;
+  std::vector<ObjectId> ids;
+};
+
+TEST_F(WorldFixture, ToolAgainstEverythingMatchesBruteForcePerObject) {
+  CollisionWorld world({.compute_distance = false});
+  const auto small = make_tree(lattice_block(3, 0.05f));
+  const std::vector<Sphere> small_leaves = lattice_block(3, 0.05f);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coord(-1.0, 1.0), angle(0.0, 3.0);
+  Room room;
+  for (int i = 0; i < 40; ++i) {
+    const Pose p{quat_from_axis_angle(normalized(Vec3{coord(rng), coord(rng), 1.0}), angle(rng)),
+                 {coord(rng), coord(rng), 0.2 * coord(rng)}};
+    room.poses.push_back(p);
+    room.ids.push_back(*world.add_object(
+        {.tree = small, .world_from_object = p, .is_static = i % 2 == 0, .coverage = 0.5, .name = "object"}));
+  }
+  const ObjectId tool =
+      *world.add_object({.tree = tree, .has_initial_pose = false, .coverage = 0.8, .name = "tool"});
+  const WatcherId w = *world.add_tool_watcher(tool);
+  EXPECT_FALSE(world.add_tool_watcher(tool).has_value()) << "watched against everything already";
+  auto frame = std::make_unique<ContactFrame>();
+  int sections_seen = 0;
+  for (int step = 0; step < 30; ++step) {
+    const Pose tool_pose{quat_from_axis_angle({0, 0, 1}, 0.1 * step),
+                         {-1.0 + 0.07 * step, 0.3 * std::sin(0.2 * step), 0.0}};
+    ASSERT_TRUE(world.set_pose(tool, tool_pose));
+    if (step == 15) {  // one object moves into the tool's path
+      room.poses[1] = Pose{{}, tool_pose.position + Vec3{0.1, 0.0, 0.0}};
+      ASSERT_TRUE(world.set_pose(room.ids[1], room.poses[1]));
+    }
+    world.step(0.001 * step);
+    ASSERT_TRUE(world.read_contact(w, *frame));
+    EXPECT_EQ(frame->object_a, ContactFrame::kEveryObject);
+    EXPECT_EQ(frame->object_b, tool);
+    double total = 0.0;
+    std::set<ObjectId> in_frame;
+    for (const ContactSection& s : frame->sections()) {
+      in_frame.insert(s.object_a);
+      EXPECT_EQ(s.object_b, tool);
+      EXPECT_DOUBLE_EQ(s.coverage_product, 0.4);
+      const auto i = static_cast<std::size_t>(std::find(room.ids.begin(), room.ids.end(), s.object_a) -
+                                              room.ids.begin());
+      ASSERT_LT(i, room.ids.size());
+      const double expected = brute_force_volume(small_leaves, room.poses[i], leaves, tool_pose);
+      EXPECT_NEAR(s.total_volume, expected, 1e-4 * expected + 1e-12);
+      double pair_sum = 0.0;
+      for (int k = 0; k < s.pair_count; ++k)
+        pair_sum += static_cast<double>(frame->pairs()[static_cast<std::size_t>(s.first_pair + k)].volume);
+      EXPECT_NEAR(pair_sum, s.total_volume, 1e-4 * s.total_volume + 1e-12);
+      total += s.total_volume;
+      ++sections_seen;
+    }
+    EXPECT_NEAR(frame->total_volume, total, 1e-12 + 1e-12 * total);
+    // every object without a section is apart from the tool by brute force
+    for (std::size_t i = 0; i < room.ids.size(); ++i)
+      if (in_frame.count(room.ids[i]) == 0) {
+        EXPECT_EQ(brute_force_volume(small_leaves, room.poses[i], leaves, tool_pose), 0.0);
+      }
+  }
+  EXPECT_GT(sections_seen, 20) << "the path must touch objects";
+  const CollisionWorldStats stats = world.stats();
+  EXPECT_LT(stats.broad_phase_candidates, 30u * 40u / 2) << "the broad phase must skip most objects";
+}
+
+TEST_F(WorldFixture, ObjectsComeAndGoWhileTheThreadRunsAndTheReaderTakesFrames) {
+  CollisionWorld world(
+      {.rate_hz = 4000.0, .compute_distance = false, .max_objects = 64, .max_pending_changes = 16});
+  const auto small = make_tree(lattice_block(2, 0.05f));
+  const ObjectId tool = *world.add_object({.tree = tree, .world_from_object = Pose{}, .name = "tool"});
+  const WatcherId w = *world.add_tool_watcher(tool);
+  ASSERT_TRUE(world.start().has_value());
+  std::atomic<bool> done{false};
+  std::atomic<int> frames{0}, sections{0}, bad{0};
+  std::thread reader([&] {
+    while (!done.load()) {
+      if (const ContactFrame* f = world.take_contact(w)) {
+        ++frames;
+        double total = 0.0;
+        for (const ContactSection& s : f->sections()) {
+          ++sections;
+          total += s.total_volume;
+          if (s.first_pair + s.pair_count > f->pair_count || s.object_b != tool) ++bad;
+        }
+        if (std::abs(total - f->total_volume) > 1e-9 * (1.0 + total)) ++bad;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  });
+  // this thread adds objects in and out of the tool, removes them again, and moves some meanwhile
+  std::vector<ObjectId> live;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> coord(-0.5, 0.5);
+  for (int round = 0; round < 200; ++round) {
+    const auto added = world.add_object(
+        {.tree = small, .world_from_object = {{}, {coord(rng), coord(rng), coord(rng)}}, .name = "o"});
+    if (added) live.push_back(*added);  // refusals (too many waiting changes) are fine: retried next round
+    if (live.size() > 20 || (round % 3 == 0 && !live.empty())) {
+      const ObjectId gone = live.front();
+      if (world.remove_object(gone).has_value()) {
+        live.erase(live.begin());
+        EXPECT_FALSE(world.set_pose(gone, Pose{}));
+      }
+    }
+    if (!live.empty()) world.set_pose(live.back(), Pose{{}, {coord(rng), 0.0, 0.0}});
+    std::this_thread::sleep_for(std::chrono::microseconds(300));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  done = true;
+  reader.join();
+  world.stop();
+  EXPECT_EQ(bad.load(), 0);
+  EXPECT_GT(frames.load(), 10);
+  EXPECT_GT(sections.load(), 0);
+  EXPECT_EQ(world.stats().objects, static_cast<std::int32_t>(live.size()) + 1);
+}
+
+TEST_F(WorldFixture, FrameMemoryFollowsTheOverlap) {
+  CollisionWorld world({.compute_distance = false});
+  const auto fine = make_tree(lattice_block(12, 0.025f));  // the same cube, 1,728 spheres
+  const ObjectId a = *world.add_object({.tree = fine, .name = "a"});
+  const ObjectId b =
+      *world.add_object({.tree = fine, .world_from_object = {{}, {0.0125, 0.0125, 0.0125}}, .name = "b"});
+  const WatcherId w = *world.add_collision_watcher(a, b);
+  for (int i = 0; i < 3; ++i) {  // deep: every slot of the handoff holds the deep frame once
+    world.step(0.001 * i);
+    ASSERT_NE(world.take_contact(w), nullptr);
+  }
+  const std::int64_t deep = world.stats().frame_bytes;
+  const std::int64_t pairs = world.stats().last_pairs;
+  ASSERT_GT(pairs, 3000);
+  EXPECT_GE(deep, 3 * pairs * static_cast<std::int64_t>(sizeof(SpherePairContact)));
+  EXPECT_LE(deep, 3 * 2 * pairs * static_cast<std::int64_t>(sizeof(SpherePairContact)) + 4096);
+  ASSERT_TRUE(world.set_pose(b, Pose{{}, {0.58, 0, 0}}));  // a graze: a few pairs
+  for (int i = 3; i < 9; ++i) {
+    world.step(0.001 * i);
+    ASSERT_NE(world.take_contact(w), nullptr);
+  }
+  const std::int64_t graze_pairs = world.stats().last_pairs;
+  ASSERT_GT(graze_pairs, 0);
+  ASSERT_LT(graze_pairs, pairs / 10);
+  EXPECT_LT(world.stats().frame_bytes, deep / 4) << "the frames give back what the deep contact took";
 }
 
 }  // namespace

@@ -124,7 +124,7 @@ TEST(VolumeQuery, ContactFrameMatchesResultInWorldFrame) {
   EXPECT_LT(norm(frame->volume_centroid_world - transform_point(world_from_a, local.volume_centroid)), 1e-4);
   double sum = 0.0;
   for (int i = 0; i < frame->pair_count; ++i) {
-    const SpherePairContact& c = frame->pairs[static_cast<std::size_t>(i)];
+    const SpherePairContact& c = frame->pairs()[static_cast<std::size_t>(i)];
     sum += static_cast<double>(c.volume);
     // recompute the pair from the local spheres and the world poses
     const Vec3 ca = transform_point(world_from_a, testing::centre(c.sphere_a_local));

@@ -120,15 +120,28 @@ TEST(LatestValue, NoTornOrOlderValuesAcrossThreads) {
   EXPECT_GT(updates, 0u);
 }
 
-TEST(LatestValue, CarriesALargeContactFrame) {
+TEST(LatestValue, HandsAContactFrameOverInPlaceWithTheStorageItsWriterGrew) {
   auto v = std::make_unique<uh::LatestValue<uh::ContactFrame>>();
   uh::ContactFrame& f = v->write_buffer();
   f.sequence = 9;
-  f.pair_count = 2;
-  f.pairs[uh::ContactFrame::kMaxPairs - 1].leaf_a = 123;
+  f.resize_pairs(40000);  // more than any fixed capacity the frame ever had
+  f.pairs()[39999].leaf_a = 123;
+  const uh::SpherePairContact* written = f.pairs().data();
   v->publish();
   ASSERT_TRUE(v->update());
-  EXPECT_EQ(v->read_buffer().sequence, 9u);
-  EXPECT_EQ(v->read_buffer().pair_count, 2);
-  EXPECT_EQ(v->read_buffer().pairs[uh::ContactFrame::kMaxPairs - 1].leaf_a, 123);
+  const uh::ContactFrame& r = v->read_buffer();
+  EXPECT_EQ(r.sequence, 9u);
+  ASSERT_EQ(r.pair_count, 40000);
+  EXPECT_EQ(r.pairs()[39999].leaf_a, 123);
+  EXPECT_EQ(r.pairs().data(), written) << "the reader gets the writer's storage, not a copy";
+  // the next frame is filled in another slot: small, and the first slot's storage is untouched
+  uh::ContactFrame& g = v->write_buffer();
+  EXPECT_NE(&g, &r);
+  g.resize_pairs(3);
+  g.sequence = 10;
+  EXPECT_EQ(r.pairs()[39999].leaf_a, 123);
+  v->publish();
+  ASSERT_TRUE(v->update());
+  EXPECT_EQ(v->read_buffer().pair_count, 3);
+  EXPECT_LT(v->read_buffer().memory_bytes(), 40000 * sizeof(uh::SpherePairContact));
 }

@@ -124,8 +124,8 @@ TEST(HeldContactSet, FusedEvaluationMatchesReevaluateThenPenalty) {
   auto frame = std::make_unique<ContactFrame>();
   const std::vector<SpherePairContact> before = brute_force_pairs(a, wa, b, b0);
   ASSERT_GT(before.size(), 10u);
-  std::copy(before.begin(), before.end(), frame->pairs.begin());
-  frame->pair_count = static_cast<std::int32_t>(before.size());
+  frame->resize_pairs(static_cast<std::int32_t>(before.size()));
+  std::copy(before.begin(), before.end(), frame->pairs().begin());
   frame->world_from_a = wa;
   frame->world_from_b = b0;
   HeldContactSet held(64);
@@ -188,11 +188,12 @@ TEST(HeldContactSet, MultiRateForceFollowsTheHandBetweenCollisionFrames) {
   double max_error_reevaluated = 0.0, max_error_constant = 0.0;
   double max_jump_reevaluated = 0.0, max_jump_constant = 0.0;
   Vec3 last_reevaluated{}, last_constant{};
+  std::vector<SpherePairContact> pairs;  // the held frame: it stays valid while held (the set is a view)
   for (int tick = 0; tick < 400; ++tick) {
     const Pose wb{Quat{}, {0.0, 0.0, 0.03 - 5e-5 * tick}};  // from 3 cm above the slab top downwards
     const BodyMotion self = tool.body_motion(wb, {}, {});
     if (tick % 10 == 0) {
-      const auto pairs = brute_force_pairs(slab, Pose{}, tool_spheres, wb);
+      pairs = brute_force_pairs(slab, Pose{}, tool_spheres, wb);
       held.hold(pairs, static_cast<std::uint64_t>(tick), 0.001 * tick);
       held_constant = tool.evaluate(pairs, self).wrench.force;
     }
@@ -213,13 +214,17 @@ TEST(HeldContactSet, MultiRateForceFollowsTheHandBetweenCollisionFrames) {
   EXPECT_LT(max_jump_reevaluated, 0.2 * max_jump_constant);
 }
 
-TEST(HeldContactSet, DropsPairsBeyondCapacityAndCountsThem) {
+TEST(HeldContactSet, HoldsEveryPairAndReevaluatesAsManyAsItsScratchHoldsCountingTheRest) {
   const SpherePairContact p = test::make_pair(sphere(0, 0, 0, 1), Pose{}, sphere(1, 0, 0, 1), Pose{});
   const std::vector<SpherePairContact> pairs(5, p);
   HeldContactSet held(3);
   held.hold(pairs, 1, 0.0);
-  EXPECT_EQ(held.size(), 3);
+  EXPECT_EQ(held.size(), 5) << "holding is a view: no capacity limits it";
+  EXPECT_EQ(held.reevaluate(Pose{}, Pose{}).size(), 3u);
   EXPECT_EQ(held.dropped_pairs(), 2u);
+  // the fused evaluation covers all five: five times one pair's volume
+  const double one = evaluate_penalty(std::span<const SpherePairContact>(&p, 1), PenaltyInput{}).total_volume;
+  EXPECT_NEAR(held.evaluate(Pose{}, Pose{}, PenaltyInput{}).total_volume, 5.0 * one, 1e-6 * one);
   held.clear();
   EXPECT_TRUE(held.empty());
   EXPECT_TRUE(held.reevaluate(Pose{}, Pose{}).empty());
@@ -228,8 +233,8 @@ TEST(HeldContactSet, DropsPairsBeyondCapacityAndCountsThem) {
 TEST(HeldContactSet, CoincidentCentresKeepHeldNormalTurnedWithA) {
   auto frame = std::make_unique<ContactFrame>();
   // small sphere of B inside a big sphere of A, slightly off centre: normal +y
-  frame->pairs[0] = test::make_pair(sphere(0, 0, 0, 1), Pose{}, sphere(0, 0.1, 0, 0.2), Pose{});
-  frame->pair_count = 1;
+  frame->resize_pairs(1);
+  frame->pairs()[0] = test::make_pair(sphere(0, 0, 0, 1), Pose{}, sphere(0, 0.1, 0, 0.2), Pose{});
   HeldContactSet held(4);
   held.hold(*frame);
   // now B's sphere sits exactly on A's centre and A has turned 90 degrees about z

@@ -187,8 +187,9 @@ TEST(PenaltyForce, SkipsNonFiniteAndEmptyPairs) {
 
 TEST(PenaltyForce, ContactFrameOverloadUsesValidPairsOnly) {
   auto frame = std::make_unique<ContactFrame>();
-  frame->pairs[0] = unit_pair();
-  frame->pairs[1] = unit_pair();  // present in storage but beyond pair_count
+  frame->resize_pairs(2);
+  frame->pairs()[0] = unit_pair();
+  frame->pairs()[1] = unit_pair();  // present in storage but beyond pair_count
   frame->pair_count = 1;
   PenaltyInput in;
   in.law = ForceLaw::kPaper;

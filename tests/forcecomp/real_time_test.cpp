@@ -24,11 +24,11 @@ TEST(RealTime, AllocationCounterSeesAllocations) {
 
 TEST(RealTime, TickPathsDoNotAllocate) {
   auto frame = std::make_unique<ContactFrame>();
+  frame->resize_pairs(50);
   for (int i = 0; i < 50; ++i) {
-    frame->pairs[static_cast<std::size_t>(i)] = test::make_pair(
+    frame->pairs()[static_cast<std::size_t>(i)] = test::make_pair(
         test::sphere(0.01 * i, 0, 0, 0.2), Pose{}, test::sphere(0.01 * i + 0.3, 0.05, 0, 0.15), Pose{}, i, i);
   }
-  frame->pair_count = 50;
   HeldContactSet held(128);
   ForceComponentOptions options;
   options.params.damping = 1.0;

@@ -44,7 +44,9 @@ static_assert(std::is_trivially_copyable_v<PairOverlap>);
 /// Options for VolumeQuery (Box2D-style aggregate: `VolumeQuery q({.collect_pairs = false});`).
 struct VolumeQueryOptions {
   bool collect_pairs = true;      ///< store each overlapping pair in pairs(); totals are always computed
-  int pair_capacity = ContactFrame::kMaxPairs;  ///< most pairs stored; further pairs set `truncated`
+  /// Most pairs stored (the query's own buffer, 40 bytes a pair, one per query object); further
+  /// pairs set `truncated`. Frames are sized by what each run stored, not by this.
+  int pair_capacity = 32768;
   /// Also store leaf pairs that are apart by less than this [length], with volume 0, normal along
   /// their centre line and centroid on A's sphere towards B. For multi-rate force rendering: a
   /// holder of the pair set re-evaluates them every haptic tick and sees them start to overlap
@@ -101,13 +103,18 @@ class VolumeQuery {
   const VolumeQueryResult& run(const SphereTree& a, const SphereTree& b, const Pose& b_in_a);
 
   /// Runs the query for A and B at their world poses and fills `out` in the world frame:
-  /// totals, restoring direction, centroid, the pairs (up to ContactFrame::kMaxPairs, then
-  /// `truncated`), `distance` = 0, `query_seconds`. Leaves `sequence`, `time_s` and the object ids
-  /// for the caller. Pairs are copied from the query's pair buffer, so construct the query with
-  /// `collect_pairs` (the default) and `pair_capacity >= ContactFrame::kMaxPairs` (the default) to
-  /// get all of them. Real-time safe in steady state.
+  /// totals, restoring direction, centroid, the pairs (all the query stored, see pair_capacity;
+  /// `truncated` beyond), one section when there are pairs, `distance` = 0, `query_seconds`. Leaves
+  /// `sequence`, `time_s` and the object ids (also the section's) for the caller. Pairs are
+  /// copied from the query's pair buffer, so construct the query with `collect_pairs` (the default).
+  /// Allocates only when `out` has never held as many pairs (the frame grows; it does not shrink).
   void run(const SphereTree& a, const SphereTree& b, const Pose& world_from_a, const Pose& world_from_b,
            ContactFrame& out);
+  /// Runs the query and appends its pairs and one section (ids left for the caller) to `out`,
+  /// leaving the frame's header alone: a frame of several object pairs is built from these.
+  /// Returns the section (valid until the next append). Allocation as in run().
+  const ContactSection& append_section(const SphereTree& a, const SphereTree& b, const Pose& world_from_a,
+                                       const Pose& world_from_b, ContactFrame& out);
 
   /// Forgets the coherence candidates: the next run traverses. Call it when a tree changes (runs
   /// with other trees than the last traversal's do this themselves, by address).

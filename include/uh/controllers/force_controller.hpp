@@ -72,18 +72,22 @@ struct ForceControllerStats {
 
 /// Binds OnCollision (collision thread) and ForceOnHapticTick (haptic thread).
 ///
-/// On the collision thread, on_collision() builds each frame's wrench model (TickForce::kModel) or
-/// copies the frame (kExact, held forces) into a lock-free LatestValue per watched pair. On the
-/// haptic thread, on_force() takes the newest model and renders it (WrenchModelRenderer), or holds
-/// the newest frame's pairs and evaluates the volumetric penalty force and torque on the tool
-/// (ForceComponent, its law),
+/// On the collision thread, on_collision() builds each frame's wrench model per watched object
+/// (TickForce::kModel; a frame of the tool against everything has a section per object) into a
+/// lock-free LatestValue per watched object. On the haptic thread, on_force() takes the newest
+/// model and renders it (WrenchModelRenderer), or (kExact, held forces, check_model) takes the
+/// newest frame of each of its watchers straight from the world's handoff
+/// (CollisionWorld::take_contact: the frame crosses threads once and is used where it lies, never
+/// copied), holds each object's pairs and evaluates the volumetric penalty force and torque on the
+/// tool (ForceComponent, its law),
 /// optionally through a virtual coupling, applies ForceSafety (NaN guard, watchdog on the age of
 /// the contact data) and adds the result, in the device frame, to the command; the manager's
 /// limit chain bounds the sum.
 ///
-/// Threads: construct, add_watched() and bind() on the controlling thread before the threads start;
-/// stats() from any thread. Memory for all watched pairs is allocated in add_watched(); the tick
-/// never allocates, locks, throws or logs.
+/// Threads: construct, add_watched(), read_frames_of() and bind() on the controlling thread before
+/// the threads start; the controller is then the reader of its watchers' frames (remove them from
+/// the world only after it stopped); stats() from any thread. Its memory does not depend on the
+/// pairs; the tick never allocates, locks, throws or logs.
 class ForceController {
  public:
   ForceController(collette::ObjectId tool, const forcecomp::ForceComponent& tool_component,
@@ -101,6 +105,11 @@ class ForceController {
   void add_watched(collette::ObjectId object, double coverage_product = 1.0,
                    const forcecomp::ContactMaterial* material = nullptr,
                    const forcecomp::SurfaceStageOptions& surface = {});
+
+  /// Takes the frames of this world watcher (a watched pair (object, tool) or the tool against
+  /// everything) on the haptic thread, for kExact, held forces and check_model. Controlling
+  /// thread, before bind().
+  void read_frames_of(collette::WatcherId watcher) { watchers_.push_back(watcher); }
 
   /// Connects to the world's OnCollision and the manager's ForceOnHapticTick. The coupling's proxy
   /// is placed at the handle on the first tick. Controlling thread, before the threads start.
@@ -132,15 +141,19 @@ class ForceController {
     Vec3 contact_point_tool{};                 // the held frame's contact point, tool frame [m]
     Vec3 contact_point_world_at_frame{};       // where that point was when the frame was queried [m]
     double depth_at_frame_m = 0.0;             // the held frame's penetration estimate [m]
-    LatestValue<ContactFrame> inbox;           // collision thread -> haptic thread (kExact, held forces)
     LatestValue<forcecomp::WrenchModel> models;  // collision thread -> haptic thread (kModel)
+    bool modelled_contact = false;             // collision thread: the last model published had contact
     forcecomp::WrenchModelRenderer renderer;   // haptic thread
-    forcecomp::HeldContactSet held;            // haptic thread
+    forcecomp::HeldContactSet held;            // haptic thread: a view of the world's frame, its section
+    bool in_frame = false;                     // haptic thread: scratch of taking a frame
     Pose world_from_object{};                  // object pose used by the held frame's query
     forcecomp::Wrench held_wrench{};           // force of the newest frame (held-force mode)
     std::int32_t held_pairs = 0;
-    explicit Watched(const forcecomp::WrenchModelOptions& model) : renderer(model), held(ContactFrame::kMaxPairs) {}
+    explicit Watched(const forcecomp::WrenchModelOptions& model) : renderer(model) {}
   };
+  Watched* find_watched(collette::ObjectId object);
+  void publish_model(Watched& w, const ContactFrame& frame, const ContactSection* section);
+  void take_frame(const ContactFrame& frame, const Pose& world_from_tool, const forcecomp::BodyMotion& tool_motion);
 
   collette::ObjectId tool_;
   forcecomp::ForceComponent component_;
@@ -149,6 +162,8 @@ class ForceController {
   forcecomp::ForceSafety safety_;
   forcecomp::VirtualCoupling coupling_;
   std::vector<std::unique_ptr<Watched>> watched_;
+  std::vector<collette::WatcherId> watchers_;
+  collette::CollisionWorld* world_ = nullptr;
   haptico::HapticManager* manager_ = nullptr;
   ScopedConnection collision_connection_;
   ScopedConnection force_connection_;

@@ -93,6 +93,10 @@ struct SessionReport {
   double collision_rate_min_hz = 0.0, collision_rate_median_hz = 0.0, collision_rate_mean_hz = 0.0;
   std::uint64_t collision_steps = 0;
   double query_median_us = 0.0, query_p99_us = 0.0, query_max_us = 0.0;
+  /// duration of a whole collision step (every watcher) [us]
+  double step_median_us = 0.0, step_p99_us = 0.0, step_max_us = 0.0;
+  std::int32_t objects = 0;      ///< objects in the collision world (the tool included)
+  std::int64_t frame_bytes = 0;  ///< heap bytes of the watchers' contact frames at the end of the run
   std::int64_t max_pairs = 0;
   std::uint64_t truncated_frames = 0;
   std::uint64_t coherent_queries = 0;   ///< collision queries that reused their kept candidates
@@ -226,6 +230,8 @@ class HapticSession {
   void monitor(std::stop_token stop);
   void on_tick_sent(const haptico::TraceSample& sample);
   void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
+  void contact_edge(collette::ObjectId object, bool touching, double time_s, double volume,
+                    std::int32_t pairs);
 
   Scene scene_;
   haptico::DeviceCommand last_sent_{};
@@ -262,6 +268,7 @@ class HapticSession {
   SpscQueue<ContactEvent> events_{kEventCapacity};
   EventCounter dropped_events_;
   std::vector<std::uint8_t> touching_;          // per scene object; collision thread
+  std::vector<std::uint8_t> touching_now_;      // per scene object: scratch of on_collision
   std::vector<collette::ObjectId> object_ids_;  // per scene object
 
   std::ostream* trace_ = nullptr;  // written by the monitor thread while it runs, then by stop()

@@ -9,9 +9,13 @@
 /// a value that is being written (no tearing) and always gets the newest published one;
 /// intermediate values the reader did not pick up in time are dropped, by design.
 ///
-/// T must be trivially copyable and default constructible. It may be large: the three slots live
-/// on the heap, allocated once by the constructor and value-initialised. Each slot is aligned to
-/// a cache line so that small values do not share one between threads.
+/// T must be default constructible. It may be large, or own storage of its own (a ContactFrame's
+/// pairs): the three slots live on the heap, allocated once by the constructor and
+/// value-initialised, and a value is handed over in place, never copied, by write_buffer() and
+/// publish() on one side and update() and read_buffer() on the other; write() and try_read() copy
+/// and need a copyable T. Each slot is aligned to a cache line so that small values do not share
+/// one between threads. A slot's own storage belongs to whichever side holds the slot: the writer
+/// may grow it while filling the write buffer, the reader may use (not grow) the read buffer.
 ///
 /// Threads: exactly one writer thread (write_buffer, publish, write) and exactly one reader thread
 /// (update, read_buffer, try_read, has_value) at a time. The roles may change hands only through
@@ -30,7 +34,6 @@ namespace uh {
 
 template <typename T>
 class LatestValue {
-  static_assert(std::is_trivially_copyable_v<T>, "uh::LatestValue<T>: T must be trivially copyable");
   static_assert(std::is_default_constructible_v<T>, "uh::LatestValue<T>: T must be default constructible");
 
  public:
@@ -51,7 +54,7 @@ class LatestValue {
   }
 
   /// Copies `value` into the write buffer and publishes it. Writer thread.
-  void write(const T& value) {
+  void write(const T& value) requires std::is_copy_assignable_v<T> {
     write_buffer() = value;
     publish();
   }
@@ -69,10 +72,12 @@ class LatestValue {
   /// The value taken by the last successful update() (a value-initialised T before the first).
   /// Reader thread; valid until the next update().
   const T& read_buffer() const { return slots_[read_index_].value; }
+  /// The same slot, writable: the reader owns it until its next update() (e.g. scratch inside T).
+  T& read_buffer() { return slots_[read_index_].value; }
 
   /// If a newer value arrived, copies it into `out` and returns true; otherwise leaves `out`
   /// untouched and returns false. Reader thread.
-  bool try_read(T& out) {
+  bool try_read(T& out) requires std::is_copy_assignable_v<T> {
     if (!update()) return false;
     out = read_buffer();
     return true;
