@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <set>
 
 #include "scene_test_support.hpp"
 #include "uh/collette/ist_file.hpp"
@@ -161,6 +162,22 @@ TEST(Scene, TheRepositoryScenesParse) {
   }
   const auto main_scene = load_scene(test_assets().parent_path() / "scenes" / "bunny_sweep.json");
   ASSERT_TRUE(main_scene.has_value()) << main_scene.error().message;
+}
+
+TEST(Scene, TheMuseumRoomHasAHundredWatchedObjectsOfThreeShapes) {
+  const auto scene = load_scene(test_assets().parent_path() / "scenes" / "museum_room.json");
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  ASSERT_EQ(scene->objects.size(), 100u);
+  EXPECT_EQ(scene->watch.size(), 100u) << "every object is watched: one watcher of the tool against everything";
+  std::set<std::string> names, meshes;
+  for (const SceneObject& o : scene->objects) {
+    names.insert(o.name);
+    meshes.insert(o.shape.mesh.filename().string());
+    EXPECT_TRUE(std::filesystem::exists(o.shape.mesh)) << o.shape.mesh;
+    EXPECT_EQ(o.shape.spheres, 10000);
+  }
+  EXPECT_EQ(names.size(), 100u);
+  EXPECT_EQ(meshes, (std::set<std::string>{"bunny_npm_3674.obj", "torus.obj", "vase.obj"}));
 }
 
 TEST(Scene, DefaultSceneIsEmbeddedAndWritesItsMeshes) {
