@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <random>
 #include <thread>
 
@@ -285,7 +286,8 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
   const museum::Level& level = options.level;
   auto server = start(options);
   ASSERT_TRUE(server);
-  json summary;
+  json summary;                             // written by Phantom's thread, read after the join
+  std::atomic<bool> summary_arrived{false};  // what Vive's loop may look at meanwhile
   std::thread phantom_thread([&] {
     Client phantom(server->port());
     phantom.request(hello_as("phantom"), "welcome");
@@ -298,6 +300,7 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
       if (!m) return;
       if ((*m)["type"] == "summary") {
         summary = *m;
+        summary_arrived.store(true, std::memory_order_release);
         return;
       }
       if ((*m)["type"] != "snapshot" || (*m)["table"].empty()) continue;
@@ -325,7 +328,7 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
     // the round may end (both verdicts given) before the last snapshot shows empty hands
     act_until(vive, link, "deliver", [](const json& s) { return s["vive"]["carried"].empty(); });
     // stays connected until the round ends (a drop would pause it)
-    while (next_snapshot(vive).has_value() && summary.is_null()) {
+    while (next_snapshot(vive).has_value() && !summary_arrived.load(std::memory_order_acquire)) {
     }
     return true;
   }();
