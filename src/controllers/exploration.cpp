@@ -233,8 +233,9 @@ Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const P
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   std::vector<std::pair<Vec3, double>> world;
   for (const Sphere& s : leaves) {
-    const Vec3 c = transform_point(world_from_object, Vec3{s.x, s.y, s.z});
-    const double r = s.radius;
+    const Vec3 c = transform_point(world_from_object, Vec3{static_cast<double>(s.x), static_cast<double>(s.y),
+                                                            static_cast<double>(s.z)});
+    const double r = static_cast<double>(s.radius);
     world.emplace_back(c, r);
     lo = {std::min(lo.x, c.x - r), std::min(lo.y, c.y - r), std::min(lo.z, c.z - r)};
     hi = {std::max(hi.x, c.x + r), std::max(hi.y, c.y + r), std::max(hi.z, c.z + r)};
@@ -253,7 +254,7 @@ Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const P
   Vec3 tip{0, 0, 1e300};
   for (const Sphere& s : tool.leaves()) {
     const double bottom = static_cast<double>(s.z) - static_cast<double>(s.radius);
-    if (bottom < tip.z) tip = {s.x, s.y, bottom};
+    if (bottom < tip.z) tip = {static_cast<double>(s.x), static_cast<double>(s.y), bottom};
   }
   ExplorePlan plan;
   plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + 0.003 - tip.z};

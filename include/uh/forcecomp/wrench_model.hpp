@@ -160,7 +160,6 @@ class WrenchModelRenderer {
   Wrench offset_{};  // blend: added to the model, fading to zero
   double blend_start_s_ = 0.0;
   double blend_s_ = 0.0;
-  double previous_frame_s_ = 0.0;  // time_s of the model before this one
   double frame_interval_s_ = 0.0;
   std::uint64_t clamped_ticks_ = 0;
   std::uint64_t held_ticks_ = 0;
