@@ -83,10 +83,14 @@ Result<std::vector<TrajectorySample>> SimReplayDevice::load_csv(const std::strin
 SimReplayDevice::SimReplayDevice(std::vector<TrajectorySample> samples, const SimReplayOptions& options)
     : ScriptedDevice("sim-replay", options.device), samples_(std::move(samples)), options_(options) {}
 
-std::uint32_t SimReplayDevice::buttons_at(double t) const {
+double SimReplayDevice::recording_time(double t) const {
   const double duration = duration_s();
   if (options_.loop && duration > 0.0) t = std::fmod(t, duration);
-  const double when = samples_.front().time_s + t;
+  return samples_.front().time_s + t;
+}
+
+std::uint32_t SimReplayDevice::buttons_at(double t) const {
+  const double when = recording_time(t);
   // held from a sample until the next one (a press is an event, not a quantity to interpolate)
   const auto it = std::upper_bound(samples_.begin(), samples_.end(), when,
                                    [](double value, const TrajectorySample& s) { return value < s.time_s; });
@@ -94,9 +98,7 @@ std::uint32_t SimReplayDevice::buttons_at(double t) const {
 }
 
 Pose SimReplayDevice::pose_at(double t) const {
-  const double duration = duration_s();
-  if (options_.loop && duration > 0.0) t = std::fmod(t, duration);
-  const double when = samples_.front().time_s + t;
+  const double when = recording_time(t);
   if (when <= samples_.front().time_s) return samples_.front().pose;
   if (when >= samples_.back().time_s) return samples_.back().pose;
   const auto it = std::upper_bound(samples_.begin(), samples_.end(), when,

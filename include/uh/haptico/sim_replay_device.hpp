@@ -45,6 +45,8 @@ class SimReplayDevice final : public ScriptedDevice {
  private:
   Pose pose_at(double t) const override;
   std::uint32_t buttons_at(double t) const override;
+  /// The recording's own time at device time t (wrapped when looping).
+  double recording_time(double t) const;
   std::vector<TrajectorySample> samples_;
   SimReplayOptions options_;
 };
