@@ -115,6 +115,50 @@ TEST(SceneMaterials, EveryBadValueIsRefusedWithTheFileAndTheField) {
       with_material(
           R"({ "texture": { "type": "random", "roughness": 1e-5, "correlation_length": 0.001, "seed": 1.5 } })"),
       "field 'objects[0].material.texture.seed': expected a whole number");
+  // every field's every other way to be wrong: out of range above, of the wrong type, unknown
+  const std::pair<std::string, std::string> more_cases[] = {
+      {R"({ "stiffness": 1e13 })", "field 'objects[0].material.stiffness': expected a number in"},
+      {R"({ "damping": 1e7 })", "field 'objects[0].material.damping': expected a number in"},
+      {R"({ "friction": { "static": 0.5, "dynamic": -0.1 } })",
+       "field 'objects[0].material.friction.dynamic': expected a number in [0, 10]"},
+      {R"({ "friction": { "static": 11, "dynamic": 0.1 } })",
+       "field 'objects[0].material.friction.static': expected a number in [0, 10]"},
+      {R"({ "friction": { "static": 0.5, "dynamic": "low" } })",
+       "field 'objects[0].material.friction.dynamic': expected a number"},
+      {R"({ "friction": { "static": 0.5, "dynamic": 0.1, "kinetic": 0.1 } })",
+       "field 'objects[0].material.friction.kinetic': unknown field"},
+      {R"({ "texture": "ridges" })", "field 'objects[0].material.texture': expected an object"},
+      {R"({ "texture": { "type": 2 } })",
+       "field 'objects[0].material.texture.type': expected a non-empty string"},
+      {R"({ "texture": { "type": "grating", "period": 0.002 } })",
+       "field 'objects[0].material.texture': a grating needs 'period' [m] and 'amplitude' [m]"},
+      {R"({ "texture": { "type": "grating", "period": 2, "amplitude": 1e-4 } })",
+       "field 'objects[0].material.texture.period': expected a number in"},
+      {R"({ "texture": { "type": "grating", "period": 0.002, "amplitude": -1e-4 } })",
+       "field 'objects[0].material.texture.amplitude': expected a number in [0, 0.01]"},
+      {R"({ "texture": { "type": "grating", "period": 0.002, "amplitude": 1e-4, "direction": [1, 0] } })",
+       "field 'objects[0].material.texture.direction': expected [x, y, z]"},
+      {R"({ "texture": { "type": "grating", "period": 0.002, "amplitude": 1e-4, "direction": [1, "y", 0] } })",
+       "field 'objects[0].material.texture.direction': expected [x, y, z] of numbers"},
+      {R"({ "texture": { "type": "random", "roughness": 1e-5, "correlation_length": 0.001, "period": 0.002 } })",
+       "field 'objects[0].material.texture.period': unknown field"},
+      {R"({ "texture": { "type": "random", "roughness": 0.1, "correlation_length": 0.001 } })",
+       "field 'objects[0].material.texture.roughness': expected a number in [0, 0.01]"},
+      {R"({ "texture": { "type": "random", "roughness": 1e-5, "correlation_length": 2 } })",
+       "field 'objects[0].material.texture.correlation_length': expected a number in"},
+      {R"({ "texture": { "type": "random", "roughness": "fine", "correlation_length": 0.001 } })",
+       "field 'objects[0].material.texture.roughness': expected a number"},
+      {R"({ "texture": { "type": "random", "roughness": 1e-5, "correlation_length": 0.001, "seed": -1 } })",
+       "field 'objects[0].material.texture.seed': expected a whole number in"},
+  };
+  for (const auto& [material, needle] : more_cases) expect_error(with_material(material), needle);
+  expect_error(with_material(R"(null)"), "field 'objects[0].material': expected an object");
+  expect_error(with_material(R"("x")", R"({ "x": 3 })"), "field 'materials.x': expected an object");
+  expect_error(with_material(R"("x")", R"({ "x": { "friction": { "static": 0.1, "dynamic": 0.2 } } })"),
+               "field 'materials.x.friction.dynamic': is above 'static'");
+  expect_error(
+      replaced(small_scene_json(), R"("name": "stylus",)", R"("name": "stylus", "material": "felt",)"),
+      "field 'tool.material': no material is named 'felt' (the scene's 'materials' has none)");
   // named entries are checked under their own path
   expect_error(with_material(R"("x")", R"({ "x": { "damping": "lots" } })"),
                "field 'materials.x.damping': expected a number");
