@@ -8,15 +8,25 @@
 //
 // Counters per benchmark: median_us, p99_us, max_us per query; the FCL and Bullet rows also carry
 // the ratio of their median to this module's volume-query median on the same case.
+//
+// Deep random poses (BM_DeepRandomPoses, `--benchmark_filter=DeepRandom`): B at kDeepPoses random
+// orientations (fixed seed), each moved along its own random direction until the packings overlap
+// by a quarter of the packing volume (bisection on the exact query's volume). Every iteration runs
+// the volume query and FCL's all-contacts query on the same pose, one after the other (alternating
+// which goes first), so both see the same machine load; each pose 10 times. Counters: median, p90 and max of
+// both over all poses and repetitions, and the ratio of the medians.
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -42,6 +52,8 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int kSpheres = 10000;
 constexpr int kWobblePoses = 64;
+constexpr int kDeepPoses = 64;
+constexpr double kDeepOverlapFraction = 0.25;  // of the packing volume
 
 struct Scene {
   TriangleMesh mesh;
@@ -51,6 +63,8 @@ struct Scene {
   double first_contact_x = 0.0;  // x-shift of B's box centre at first contact
   std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> fcl_model;
   std::vector<Pose> poses[2];    // [shallow, deep] wobbled poses of B in A
+  std::vector<Pose> deep_random;  // random orientations, a quarter of the packing volume overlapping
+  std::vector<double> deep_random_fraction;  // the overlap fraction reached at each
 };
 
 fcl::Transform3d to_fcl(const Pose& p) {
@@ -107,6 +121,41 @@ Result<SphereTree> load_or_build_tree(const TriangleMesh& mesh, const std::files
   return std::move(asset.tree);
 }
 
+// A uniformly random rotation (Shoemake's method).
+Quat random_rotation(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double u1 = u(rng), u2 = 2.0 * kPi * u(rng), u3 = 2.0 * kPi * u(rng);
+  const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+  return normalized(Quat{a * std::cos(u2), a * std::sin(u2), b * std::sin(u3), b * std::cos(u3)});
+}
+
+// Per random rotation, the shift along a random direction at which the packings overlap by
+// kDeepOverlapFraction of their volume: the overlap is 1 at shift 0 for the identity rotation, but
+// a rotated copy may overlap less than that fraction even centred; such rotations are redrawn.
+void make_deep_random_poses(Scene& sc) {
+  std::mt19937_64 rng(20261123);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  VolumeQuery query({.collect_pairs = false});
+  const double packing_volume = sc.tree.total_volume();
+  const auto fraction = [&](const Pose& p) {
+    return query.run(sc.tree, sc.tree, p).total_volume / packing_volume;
+  };
+  const double reach = 2.0 * static_cast<double>(sc.tree.root().radius) + 1e-3;
+  while (static_cast<int>(sc.deep_random.size()) < kDeepPoses) {
+    const Quat rot = random_rotation(rng);
+    const Vec3 dir = normalized(Vec3{gauss(rng), gauss(rng), gauss(rng)});
+    if (fraction(pose_of_b(sc, rot, {})) < kDeepOverlapFraction) continue;
+    double lo = 0.0, hi = reach;  // overlap above the target at lo, below it at hi
+    for (int i = 0; i < 32; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (fraction(pose_of_b(sc, rot, mid * dir)) > kDeepOverlapFraction ? lo : hi) = mid;
+    }
+    const Pose p = pose_of_b(sc, rot, 0.5 * (lo + hi) * dir);
+    sc.deep_random.push_back(p);
+    sc.deep_random_fraction.push_back(fraction(p));
+  }
+}
+
 const Scene& scene() {
   static const std::unique_ptr<Scene> s = [] {
     auto sc = std::make_unique<Scene>();
@@ -156,6 +205,7 @@ const Scene& scene() {
         sc->poses[c].push_back(pose_of_b(*sc, wob * rot, Vec3{x, 0, 0} + dx));
       }
     }
+    make_deep_random_poses(*sc);
     std::fprintf(stderr, "scene: %zu triangles, %d spheres, %d nodes, depth %d, x-extent %.4g, first contact at x %.4g\n",
                  sc->mesh.triangles.size(), sc->tree.leaf_count(), sc->tree.node_count(), sc->tree.depth(), sc->extent_x,
                  sc->first_contact_x);
@@ -164,14 +214,20 @@ const Scene& scene() {
   return *s;
 }
 
+// quantile q of sorted times
+double quantile(const std::vector<double>& sorted, double q) {
+  return sorted.empty() ? 0.0
+                        : sorted[std::min(sorted.size() - 1,
+                                          static_cast<std::size_t>(q * static_cast<double>(sorted.size())))];
+}
+
 // per-query wall times -> counters; returns the median [s]
 double report(benchmark::State& state, std::vector<double>& times) {
   if (times.empty()) return 0.0;
   std::sort(times.begin(), times.end());
-  const auto at = [&](double q) { return times[std::min(times.size() - 1, static_cast<std::size_t>(q * static_cast<double>(times.size())))]; };
-  const double median = at(0.5);
+  const double median = quantile(times, 0.5);
   state.counters["median_us"] = median * 1e6;
-  state.counters["p99_us"] = at(0.99) * 1e6;
+  state.counters["p99_us"] = quantile(times, 0.99) * 1e6;
   state.counters["max_us"] = times.back() * 1e6;
   return median;
 }
@@ -378,6 +434,76 @@ void BM_FclMeshMesh(benchmark::State& state) {
   state.SetLabel(std::string(case_name(c)) + (all ? " all contacts" : " boolean"));
 }
 BENCHMARK(BM_FclMeshMesh)->ArgsProduct({{0, 1}, {1, 0}})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+
+// The deep random poses: our volume query (pairs + totals) and FCL's all-contacts query on the
+// same pose in each iteration; the manual time is ours.
+void BM_DeepRandomPoses(benchmark::State& state) {
+  const Scene& s = scene();
+  VolumeQuery query;
+  fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
+  fcl::CollisionObjectd b(s.fcl_model, fcl::Transform3d::Identity());
+  const fcl::CollisionRequestd request(1000000, true);
+  std::vector<double> ours, fcl_times;
+  ours.reserve(1 << 14);
+  fcl_times.reserve(1 << 14);
+  std::size_t k = 0;
+  double pairs = 0.0, node_pairs = 0.0, leaf_tests = 0.0, contacts = 0.0;
+  std::int64_t pairs_min = std::numeric_limits<std::int64_t>::max(), pairs_max = 0;
+  for (auto _ : state) {
+    const Pose& p = s.deep_random[k % s.deep_random.size()];
+    const auto run_ours = [&] {
+      const auto t0 = Clock::now();
+      const VolumeQueryResult& r = query.run(s.tree, s.tree, p);
+      ours.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      benchmark::DoNotOptimize(r.total_volume);
+      pairs += static_cast<double>(r.stats.overlapping_pairs);
+      pairs_min = std::min(pairs_min, r.stats.overlapping_pairs);
+      pairs_max = std::max(pairs_max, r.stats.overlapping_pairs);
+      node_pairs += static_cast<double>(r.stats.node_pairs_visited);
+      leaf_tests += static_cast<double>(r.stats.leaf_pairs_tested);
+    };
+    const auto run_fcl = [&] {
+      b.setTransform(to_fcl(p));
+      fcl::CollisionResultd result;
+      const auto t0 = Clock::now();
+      fcl::collide(&a, &b, request, result);
+      fcl_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      contacts += static_cast<double>(result.numContacts());
+    };
+    if (k % 2 == 0) {
+      run_ours();
+      run_fcl();
+    } else {
+      run_fcl();
+      run_ours();
+    }
+    state.SetIterationTime(ours.back());
+    ++k;
+  }
+  const double n = static_cast<double>(std::max<std::size_t>(1, k));
+  std::sort(ours.begin(), ours.end());
+  std::sort(fcl_times.begin(), fcl_times.end());
+  state.counters["median_us"] = quantile(ours, 0.5) * 1e6;
+  state.counters["p90_us"] = quantile(ours, 0.9) * 1e6;
+  state.counters["max_us"] = ours.empty() ? 0.0 : ours.back() * 1e6;
+  state.counters["fcl_median_us"] = quantile(fcl_times, 0.5) * 1e6;
+  state.counters["fcl_p90_us"] = quantile(fcl_times, 0.9) * 1e6;
+  state.counters["fcl_max_us"] = fcl_times.empty() ? 0.0 : fcl_times.back() * 1e6;
+  state.counters["ratio_fcl_over_ist"] =
+      quantile(ours, 0.5) > 0.0 ? quantile(fcl_times, 0.5) / quantile(ours, 0.5) : 0.0;
+  state.counters["overlapping_pairs"] = pairs / n;
+  state.counters["overlapping_pairs_min"] = static_cast<double>(pairs_min);
+  state.counters["overlapping_pairs_max"] = static_cast<double>(pairs_max);
+  state.counters["node_pairs"] = node_pairs / n;
+  state.counters["leaf_tests"] = leaf_tests / n;
+  state.counters["fcl_contacts"] = contacts / n;
+  const auto [lo, hi] = std::minmax_element(s.deep_random_fraction.begin(), s.deep_random_fraction.end());
+  state.counters["overlap_fraction_min"] = *lo;
+  state.counters["overlap_fraction_max"] = *hi;
+  state.SetLabel(std::to_string(s.deep_random.size()) +
+                 " random orientations, a quarter of the volume overlapping");
+}
+BENCHMARK(BM_DeepRandomPoses)->Iterations(10 * kDeepPoses)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
 struct CountContacts : btCollisionWorld::ContactResultCallback {
   int count = 0;
