@@ -675,6 +675,32 @@ TEST_F(CliTest, ExploreFindsTheTexturePeriodAtTenKilohertzToo) {
   EXPECT_LT(out["objects"][0]["work_on_hand_j"].get<double>(), 1e-3);
 }
 
+// The flat slab (a packed box, scenes/materials_flat.json): friction within 10 % on a flat packed
+// face as on the round ones; the packing's grain (its spheres' caps under the face) must not read
+// as friction. Two objects (one packing, cached between the runs) keep the test lean.
+TEST_F(CliTest, ExploreRecoversFrictionOnAFlatPackedSlab) {
+  const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_flat.json";
+  std::ifstream in(path);
+  const MaterialsScene scene{nlohmann::json::parse(in)};
+  for (const std::string object : {"sticky", "slippery", "plain"}) {
+    const CommandRun r = uh(fmt::format("explore '{}' --object {} --json", path.string(), object),
+                            fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json e = json_of(r)["objects"][0];
+    EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << object << ": passive";
+    if (object == "plain") {
+      EXPECT_LT(e["friction_static"].get<double>(), 0.06) << "the grain is no friction";
+      EXPECT_LT(e["friction_dynamic"].get<double>(), 0.02) << "the grain is no friction";
+      continue;
+    }
+    const auto m = scene.material(object)["friction"];
+    for (const std::string coefficient : {"static", "dynamic"})
+      EXPECT_NEAR(e["friction_" + coefficient].get<double>(), m[coefficient].get<double>(),
+                  0.1 * m[coefficient].get<double>())
+          << object << " " << coefficient;
+  }
+}
+
 TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {
   const CommandRun bad = uh(fmt::format("explore '{}' --object marble", materials_scene_path().string()),
                             fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
