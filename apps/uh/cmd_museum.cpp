@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "museum_client.hpp"
 #include "uh/museum/level.hpp"
 #include "uh/museum_service/game_server.hpp"
 
@@ -25,11 +26,13 @@ int museum_serve(const MuseumServeArgs& args) {
   museum::Level level =
       museum::make_level(args.level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy);
   if (args.minutes > 0.0) level.rules.round_s = args.minutes * 60.0;
+  const MuseumClientFiles client = museum_client_files(level);  // Vive's page, served at `/`
   auto server = museum_service::GameServer::start({.host = args.host,
                                                    .port = static_cast<std::uint16_t>(args.port),
                                                    .token = args.token,
                                                    .level = std::move(level),
-                                                   .seed = args.seed});
+                                                   .seed = args.seed,
+                                                   .files = client.files});
   if (!server) {
     const std::string& m = server.error().message;
     return fail(m.find("token is required") != std::string::npos ? m + " (give --token)" : m);
@@ -37,6 +40,7 @@ int museum_serve(const MuseumServeArgs& args) {
   const std::string url = (*server)->url();
   std::printf("uh museum serve: %s level, seed %llu; players connect to ws%sws; Ctrl-C stops\n",
               args.level.c_str(), static_cast<unsigned long long>(args.seed), url.substr(4).c_str());
+  if (client.has_page) std::printf("uh museum serve: Vive plays in a browser at %s\n", url.c_str());
   std::fflush(stdout);
   wait_for_stop_signal(stop_signals);
   (*server)->stop();

@@ -5,10 +5,11 @@
 
 namespace uh::cli::view {
 
-std::vector<service::StaticFile> static_files() {
+std::vector<service::StaticFile> static_files(std::string_view folder) {
   std::vector<service::StaticFile> out;
   for (const File& f : files()) {
     const std::filesystem::path path(f.path);
+    if (path.parent_path() != std::filesystem::path(folder)) continue;
     const std::string ext = path.extension().string();
     const char* type = ext == ".html" ? "text/html; charset=utf-8"
                        : ext == ".js" ? "text/javascript; charset=utf-8"

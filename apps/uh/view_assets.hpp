@@ -1,6 +1,7 @@
 #pragma once
-// The live view's page and bundled script (web/, built by esbuild), compiled into uh by
-// cmake/UhEmbed.cmake; empty when the build has no live view (UH_BUILD_VIEW=OFF).
+// The browser pages and their bundled scripts (web/, built by esbuild), compiled into uh by
+// cmake/UhEmbed.cmake: the live view of `uh serve` (dist/) and Vive's client of `uh museum serve`
+// (dist/museum/); empty when the build has no pages (UH_BUILD_VIEW=OFF).
 
 #include <span>
 #include <string_view>
@@ -17,7 +18,8 @@ struct File {
 
 std::span<const File> files();
 
-/// The files as the server serves them ("/index.html", "/view.js").
-std::vector<service::StaticFile> static_files();
+/// The files of one page's folder as the server serves them: "dist" gives the live view
+/// ("/index.html", "/view.js"), "dist/museum" Vive's client ("/index.html", "/museum.js").
+std::vector<service::StaticFile> static_files(std::string_view folder = "dist");
 
 }  // namespace uh::cli::view

@@ -5,8 +5,7 @@
 // console shows no errors. Writes a screenshot.
 //
 //   node view_test.mjs UH_BINARY SCREENSHOT.png
-import { spawn } from 'node:child_process';
-import { chromium } from 'playwright-core';
+import { check, runBrowserTest, startServer } from './browser_harness.mjs';
 
 const [uhBinary, screenshotPath] = process.argv.slice(2);
 if (!uhBinary || !screenshotPath) {
@@ -14,40 +13,11 @@ if (!uhBinary || !screenshotPath) {
   process.exit(2);
 }
 
-const failures = [];
-function check(condition, what) {
-  console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!condition) failures.push(what);
-}
-
 // uh serve on any free port; it prints the URL it listens on
-const server = spawn(uhBinary, ['serve', '--port', '0', '--no-realtime'], { stdio: ['ignore', 'pipe', 'inherit'] });
-const url = await new Promise((resolve, reject) => {
-  let out = '';
-  server.stdout.on('data', (chunk) => {
-    out += chunk;
-    const match = out.match(/live view: (http:\/\/127\.0\.0\.1:\d+\/)/);
-    if (match) resolve(match[1]);
-  });
-  server.on('exit', (code) => reject(new Error(`uh serve exited with ${code} before listening`)));
-  setTimeout(() => reject(new Error('uh serve did not print its URL within 20 s')), 20000);
-});
-const serverExited = new Promise((resolve) => server.on('exit', (code, signal) => resolve({ code, signal })));
+const server = await startServer(uhBinary, ['serve', '--port', '0', '--no-realtime'], /live view: (http:\/\/127\.0\.0\.1:\d+\/)/);
+const url = server.url;
 
-const browser = await chromium.launch({
-  executablePath: '/usr/bin/chromium',
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-         '--disable-background-networking', '--disable-component-update', '--no-first-run'],
-});
-try {
-  const page = await browser.newPage({ viewport: { width: 960, height: 600 } });
-  const consoleErrors = [];
-  page.on('console', (message) => { if (message.type() === 'error') consoleErrors.push(message.text()); });
-  page.on('pageerror', (error) => consoleErrors.push(String(error)));
-  // nothing but the service itself is fetched
-  const foreign = [];
-  page.on('request', (request) => { if (!request.url().startsWith(url) && !request.url().startsWith('ws://127.0.0.1')) foreign.push(request.url()); });
-
+await runBrowserTest('view test', server, { width: 960, height: 600 }, async ({ page }) => {
   await page.goto(url);
   await page.waitForFunction(() => window.uhView && window.uhView.connected, null, { timeout: 15000 });
   check(true, 'the page connects to the service');
@@ -102,15 +72,4 @@ try {
   await page.waitForFunction(() => window.uhView.forceN > 0.5, null, { timeout: 15000 }).catch(() => {});
   await page.screenshot({ path: screenshotPath });
   await page.evaluate(() => window.testController.close());
-  check(consoleErrors.length === 0, `no console errors${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
-  check(foreign.length === 0, `nothing fetched from elsewhere${foreign.length ? ': ' + foreign.join(' ') : ''}`);
-} catch (error) {
-  check(false, String(error));
-} finally {
-  await browser.close();
-  server.kill('SIGTERM');
-}
-const { code } = await serverExited;
-check(code === 0, `uh serve stops cleanly on SIGTERM (exit ${code})`);
-console.log(`view test: ${failures.length === 0 ? 'passed' : `${failures.length} failed`}`);
-process.exit(failures.length === 0 ? 0 : 1);
+});

@@ -1,0 +1,26 @@
+#pragma once
+// What `uh museum serve` serves over HTTP for Vive's browser client (web/src/museum.js,
+// docs/museum.md): the page and its bundled script at `/`, and every artifact kind's look as
+// `/artifacts/KIND.json` {"kind", "vertices": [x, y, z, ...], "triangles": [i, j, k, ...]} (metres,
+// the piece standing on z = 0) for the pictures Falcon shows and the pieces drawn in the cases.
+
+#include <string>
+#include <vector>
+
+#include "uh/museum/level.hpp"
+#include "uh/service/web_socket_host.hpp"
+
+namespace uh::cli {
+
+/// The files and the texts they point into (keep it alive while the server runs).
+struct MuseumClientFiles {
+  std::vector<std::string> texts;
+  std::vector<service::StaticFile> files;
+  bool has_page = false;  ///< whether the build bundled the page (UH_BUILD_VIEW)
+};
+
+/// The page (empty without UH_BUILD_VIEW) and the looks of `level`'s artifact kinds. A piece's
+/// genuine mesh stands for both: a forgery looks the same.
+MuseumClientFiles museum_client_files(const museum::Level& level);
+
+}  // namespace uh::cli
