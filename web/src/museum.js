@@ -24,6 +24,7 @@ const kSnapDistance = 1.5;         // a server position this far from the predic
 const kCorrectionPerSnapshot = 0.25;  // share of the prediction's error removed at each snapshot
 const kMouseRadiansPerPixel = 0.0025;
 const kTurnRadiansPerS = 2.2;      // turning with keys
+const kAutopilotBrakeS = 0.3;      // a scripted walk slows down this long before its end
 const kPieceDisplayM = 0.35;       // pieces in the cases are shown enlarged to this size [m]
 
 // ---- keys: remappable, kept in localStorage ---------------------------------------------------
@@ -74,6 +75,11 @@ const museum = {
   frames: 0,
   pictures: {},          // kind -> data URL of Falcon's picture
   trace: null,           // when an array (tests): {drawn: guards} per frame, {snapshot: guards} per snapshot
+  // a scripted walk (tests, demos): {path: [[x, y], ...], run}; Vive walks it, facing where she goes,
+  // through the same prediction and moves as the keys; null when done
+  autopilot: null,
+  ringsDrawn: 0,         // noise rings drawn (not counting the one around Vive while she runs)
+  running: false,        // whether Vive runs now (the red ring around her shows)
 };
 window.uhMuseum = museum;
 
@@ -123,12 +129,26 @@ function walkable(x, y) {
 function buildLevel() {
   levelGroup.clear();
   cases.length = 0;
-  const floorMaterial = new THREE.MeshLambertMaterial({ color: 0x8a8f99 });
-  const dockMaterial = new THREE.MeshLambertMaterial({ color: 0x6d7380 });
+  // floors tiled in half-metre squares: walking shows against them
+  const tiles = document.createElement('canvas');
+  tiles.width = tiles.height = 64;
+  const paint = tiles.getContext('2d');
+  paint.fillStyle = '#ffffff';
+  paint.fillRect(0, 0, 64, 64);
+  paint.fillStyle = '#d0d0d0';
+  paint.fillRect(0, 0, 32, 32);
+  paint.fillRect(32, 32, 32, 32);
+  const tileTexture = new THREE.CanvasTexture(tiles);
+  tileTexture.wrapS = tileTexture.wrapT = THREE.RepeatWrapping;
+  const floorMaterial = (colour, w, h) => {
+    const map = tileTexture.clone();
+    map.repeat.set(w, h);  // one 64 px tile (2 x 2 squares) per metre
+    return new THREE.MeshLambertMaterial({ color: colour, map });
+  };
   for (const room of level.rooms) {
     const w = room.max[0] - room.min[0];
     const h = room.max[1] - room.min[1];
-    const floor = new THREE.Mesh(new THREE.PlaneGeometry(w, h), /dock|door/.test(room.name) ? dockMaterial : floorMaterial);
+    const floor = new THREE.Mesh(new THREE.PlaneGeometry(w, h), floorMaterial(/dock|door/.test(room.name) ? 0x7d838f : 0x9aa0aa, w, h));
     floor.rotation.x = -Math.PI / 2;
     floor.position.copy(floorToWorld((room.min[0] + room.max[0]) / 2, (room.min[1] + room.max[1]) / 2));
     levelGroup.add(floor);
@@ -552,7 +572,9 @@ function usableAction() {
 function useNearest() {
   const use = usableAction();
   if (use && use.action) send({ type: 'action', action: use.action });
+  return use ? use.action : null;
 }
+museum.use = useNearest;  // what the use key does, for scripts: the action sent, or null
 
 const kEventText = {
   case_broken: (e) => [`Glass breaks: heard within ${e.radius} m`, 'warn'],
@@ -767,6 +789,7 @@ function addRing(pos, radius, colour, seconds) {
   ring.position.copy(floorToWorld(pos[0], pos[1], 0.03));
   ring.userData = { radius, born: performance.now() / 1000, seconds };
   ringsGroup.add(ring);
+  museum.ringsDrawn++;
 }
 // the ring of Vive's own running: how far the guards hear her feet
 const runRing = new THREE.Mesh(new THREE.RingGeometry(0.95, 1, 64),
@@ -797,6 +820,26 @@ let accumulatorS = 0;
 let wanted = [0, 0];
 let running = false;
 
+// the wanted move of the scripted walk: towards its next waypoint, slowing down for the last so
+// she stops on it; null when there is none
+function autopilotMove(dt) {
+  const pilot = museum.autopilot;
+  if (!pilot || !museum.predicted) return null;
+  const speed = pilot.run ? rules.run_speed : rules.walk_speed;
+  const distanceTo = (p) => Math.hypot(p[0] - museum.predicted[0], p[1] - museum.predicted[1]);
+  while (pilot.path.length > 1 && distanceTo(pilot.path[0]) <= Math.max(0.15, speed * dt)) pilot.path.shift();
+  if (pilot.path.length === 1 && distanceTo(pilot.path[0]) <= 0.05) pilot.path.shift();
+  if (pilot.path.length === 0) {
+    museum.autopilot = null;
+    return null;
+  }
+  const dx = pilot.path[0][0] - museum.predicted[0], dy = pilot.path[0][1] - museum.predicted[1];
+  const n = Math.hypot(dx, dy);
+  yaw = Math.atan2(dy, dx);
+  const share = pilot.path.length === 1 ? Math.min(1, n / (speed * kAutopilotBrakeS)) : 1;
+  return [(dx / n) * share, (dy / n) * share];
+}
+
 function readInput(dt) {
   if (isHeld('turn_left')) yaw += kTurnRadiansPerS * dt;
   if (isHeld('turn_right')) yaw -= kTurnRadiansPerS * dt;
@@ -804,10 +847,18 @@ function readInput(dt) {
   const r = (isHeld('right') ? 1 : 0) - (isHeld('left') ? 1 : 0);
   let x = Math.cos(yaw) * f + Math.sin(yaw) * r;
   let y = Math.sin(yaw) * f - Math.cos(yaw) * r;
-  const n = Math.hypot(x, y);
+  let n = Math.hypot(x, y);
   if (n > 1) { x /= n; y /= n; }
+  let run = isHeld('run');
+  const piloted = autopilotMove(dt);
+  if (piloted) {
+    [x, y] = piloted;
+    n = Math.hypot(x, y);
+    run = museum.autopilot.run;
+  }
   wanted = [x, y];
-  running = isHeld('run') && n > 0;
+  running = run && n > 0;
+  museum.running = running;
   const now = performance.now() / 1000;
   const changed = !lastMove || lastMove.run !== running ||
     Math.hypot(lastMove.x - x, lastMove.y - y) > 0.03 || ((x !== 0 || y !== 0) !== (lastMove.x !== 0 || lastMove.y !== 0));
