@@ -41,14 +41,21 @@ void print_text(const devices::DriverFindings& f) {
   std::printf("%s: %s\n", f.driver.c_str(), f.runtime.c_str());
   for (const auto& c : f.looked_for)
     std::printf("  looked for %s (from %s)\n", c.path.c_str(), c.origin.c_str());
-  if (!f.loaded_from.empty()) std::printf("  loaded %s\n", f.loaded_from.c_str());
+  // a service (haply) is connected to, a library loaded
+  if (!f.loaded_from.empty())
+    std::printf("  %s %s\n", f.loaded_from.rfind("ws://", 0) == 0 ? "connected to" : "loaded",
+                f.loaded_from.c_str());
   for (const auto& d : f.devices) {
     const auto& w = d.info.workspace_half_extents;
-    std::printf(
-        "  %s  %s, serial %s: %d-DOF sensed, %d-DOF force, max %.1f N, workspace +-%.0f x %.0f x %.0f mm, "
-        "%.0f Hz\n",
-        d.selector.c_str(), d.model.c_str(), d.serial.empty() ? "none" : d.serial.c_str(), d.info.dof_sensed,
-        d.info.dof_actuated, d.info.max_force_n, w.x * 1e3, w.y * 1e3, w.z * 1e3, d.info.nominal_rate_hz);
+    // what a device does not report is said so, never shown as a zero
+    const std::string workspace =
+        w == Vec3{} ? "workspace not reported"
+                    : fmt::format("workspace +-{:.0f} x {:.0f} x {:.0f} mm", w.x * 1e3, w.y * 1e3, w.z * 1e3);
+    const std::string rate = d.info.nominal_rate_hz > 0.0 ? fmt::format("{:.0f} Hz", d.info.nominal_rate_hz)
+                                                          : std::string("rate set by the client");
+    std::printf("  %s  %s, serial %s: %d-DOF sensed, %d-DOF force, max %.1f N, %s, %s\n", d.selector.c_str(),
+                d.model.c_str(), d.serial.empty() ? "none" : d.serial.c_str(), d.info.dof_sensed,
+                d.info.dof_actuated, d.info.max_force_n, workspace.c_str(), rate.c_str());
   }
   if (f.devices.empty()) std::printf("  no device: %s\n", f.error.c_str());
 }

@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 
 #include "uh/devices/force_dimension_device.hpp"
+#ifdef UH_DEVICES_HAPLY
+#include "uh/devices/haply_device.hpp"
+#endif
 #include "uh/devices/open_haptics_device.hpp"
 
 namespace uh::devices {
@@ -73,6 +76,43 @@ DriverFindings probe_open_haptics() {
   return f;
 }
 
+#ifdef UH_DEVICES_HAPLY
+// the service's inventory lists every Inverse3 it runs; each is opened for its description
+DriverFindings probe_haply() {
+  DriverFindings f{.driver = "haply", .runtime = "Haply Inverse Service"};
+  const haptico::DeviceConfig none;
+  f.looked_for = {haply_service_url(none)};
+  auto first = HaplyDevice::create(none);
+  if (!first) {
+    f.error = first.error().message;  // a malformed UH_HAPLY_URL
+    return f;
+  }
+  auto& service = static_cast<HaplyDevice&>(**first);
+  if (Status opened = service.open(); !opened) {
+    f.error = opened.error().message;
+    return f;
+  }
+  f.loaded_from = service.url().path;
+  const std::vector<std::string> ids = service.inventory();
+  const Status closed = service.close();
+  (void)closed;  // closing a connection reports nothing
+  for (const std::string& id : ids) {
+    auto device = HaplyDevice::create({{"device_id", id}});
+    if (!device) continue;  // cannot happen: the id came from the service's own inventory check
+    auto& haply = static_cast<HaplyDevice&>(**device);
+    if (Status opened = haply.open(); !opened) {
+      f.error += fmt::format("{}{}", f.error.empty() ? "" : "; ", opened.error().message);
+      continue;
+    }
+    f.devices.push_back(
+        {.selector = fmt::format("haply:{}", id), .model = "Inverse3", .serial = id, .info = haply.info()});
+    const Status done = haply.close();
+    (void)done;
+  }
+  return f;
+}
+#endif
+
 }  // namespace
 
 std::vector<DriverFindings> probe_drivers(const haptico::DeviceRegistry& registry) {
@@ -82,6 +122,10 @@ std::vector<DriverFindings> probe_drivers(const haptico::DeviceRegistry& registr
       out.push_back(probe_force_dimension());
     } else if (name == "openhaptics") {
       out.push_back(probe_open_haptics());
+#ifdef UH_DEVICES_HAPLY
+    } else if (name == "haply") {
+      out.push_back(probe_haply());
+#endif
     } else {
       out.push_back({.driver = name, .simulated = name.rfind("sim-", 0) == 0});
       if (!out.back().simulated) out.back().error = "this driver cannot be probed";
@@ -103,6 +147,7 @@ Result<DeviceChoice> parse_device_choice(std::string_view text, const haptico::D
   // the driver's usual selection key, for a bare value
   const char* usual = choice.driver == "forcedimension" ? "index"
                       : choice.driver == "openhaptics"  ? "name"
+                      : choice.driver == "haply"        ? "device_id"
                                                         : nullptr;
   if (selector.empty()) return Error{fmt::format("--device {}: nothing after ':'", choice.driver)};
   const std::size_t eq = selector.find('=');

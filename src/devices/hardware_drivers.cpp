@@ -1,12 +1,18 @@
 #include "uh/devices/hardware_drivers.hpp"
 
 #include "uh/devices/force_dimension_device.hpp"
+#ifdef UH_DEVICES_HAPLY
+#include "uh/devices/haply_device.hpp"
+#endif
 #include "uh/devices/open_haptics_device.hpp"
 
 namespace uh::devices {
 
 Status register_hardware_drivers(haptico::DeviceRegistry& registry) {
   if (Status s = registry.register_driver("forcedimension", &ForceDimensionDevice::create); !s) return s;
+#ifdef UH_DEVICES_HAPLY  // not in the Windows build (src/devices/CMakeLists.txt)
+  if (Status s = registry.register_driver("haply", &HaplyDevice::create); !s) return s;
+#endif
   return registry.register_driver("openhaptics", &OpenHapticsDevice::create);
 }
 

@@ -296,14 +296,7 @@ Status OpenHapticsDevice::start(double rate_hz, FixedRateLoop::Callback tick,
   if (running()) return Error{"openhaptics: the servo loop is already running"};
   if (servo_dead_) return Error{"openhaptics: the HD scheduler stopped answering; re-open the device"};
   const hd::Api& api = *api_;
-  tick_ = std::move(tick);
-  on_exit_ = std::move(on_exit);
-  rate_hz_ = rate_hz;
-  period_ = std::chrono::nanoseconds(static_cast<std::int64_t>(std::llround(1e9 / rate_hz)));
-  frame_index_ = 0;
-  thrown_.clear();
-  missed_.store(0, std::memory_order_relaxed);
-  recorder_.reset();
+  run_.begin(rate_hz, std::move(tick), std::move(on_exit));
   stop_requested_.store(false, std::memory_order_relaxed);
   // the rate is the scheduler's: set it with the scheduler stopped
   api.hdStopScheduler();
@@ -328,49 +321,19 @@ unsigned int OpenHapticsDevice::run_frame() {
   const Clock::time_point start = Clock::now();
   api.hdBeginFrame(hhd_);
   t_in_frame = true;
-  LoopExit exit;
+  run_.begin_frame(start, start);
   bool done = stop_requested_.load(std::memory_order_acquire);
-  if (!done) {
-    TickInfo info;
-    info.index = frame_index_;
-    info.grid_index = frame_index_;
-    info.scheduled_time = start;
-    info.start_time = start;
-    info.period_s = 1.0 / rate_hz_;
-    info.time_s = static_cast<double>(frame_index_) * info.period_s;
-    info.dt_s =
-        frame_index_ == 0 ? info.period_s : std::chrono::duration<double>(start - previous_start_).count();
-    try {
-      tick_(info);
-    } catch (const std::exception& e) {
-      thrown_ = e.what();
-      exit.callback_threw = true;
-    } catch (...) {
-      thrown_ = "an exception of unknown type";
-      exit.callback_threw = true;
-    }
-    done = exit.callback_threw;
-  }
+  if (!done) done = !run_.tick();
   if (done) {
     // the run's last act, inside this frame: the exit callback commands zero
-    exit.what = thrown_.c_str();
-    try {
-      if (on_exit_) on_exit_(exit);
-    } catch (...) {
-      // nothing to report to from the servo thread; forces go off below
-    }
+    run_.end();
     if (forces_on_) api.hdDisable(hd::kForceOutput);
     forces_on_ = false;
   }
   t_in_frame = false;
   api.hdEndFrame(hhd_);
   check_frame_errors("the servo frame");
-  const Clock::time_point end = Clock::now();
-  if (frame_index_ > 0 && start - previous_start_ > 2 * period_)
-    missed_.fetch_add(1, std::memory_order_relaxed);
-  recorder_.record(start, start, end, period_);
-  previous_start_ = start;
-  ++frame_index_;
+  run_.finish_frame(Clock::now());
   if (done) running_.store(false, std::memory_order_release);
   return done ? hd::kCallbackDone : hd::kCallbackContinue;
 }
@@ -396,13 +359,6 @@ void OpenHapticsDevice::stop() {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
-FixedRateLoopStats OpenHapticsDevice::stats() const {
-  FixedRateLoopStats s;
-  recorder_.fill(s);
-  s.missed_deadlines = missed_.load(std::memory_order_relaxed);
-  s.rate_hz = rate_hz_;
-  s.running = running();
-  return s;
-}
+FixedRateLoopStats OpenHapticsDevice::stats() const { return run_.stats(running()); }
 
 }  // namespace uh::devices

@@ -18,6 +18,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "haply_standin.hpp"
+
 #include "lens_reference.hpp"
 #include "uh/collette/ist_file.hpp"
 
@@ -536,16 +538,77 @@ TEST_F(CliTest, RunOnTheDeviceNamedOnTheCommandLine) {
   const CommandRun unknown =
       uh(fmt::format("run '{}' --device nope --stepped", scene.string()), with_standin(dir_));
   EXPECT_EQ(unknown.exit_code, 1);
-  EXPECT_EQ(unknown.err,
-            "uh: --device: unknown driver 'nope' (known drivers: forcedimension, openhaptics, sim-circle, "
-            "sim-hand, sim-line, "
-            "sim-raster, sim-replay)\n");
+  EXPECT_EQ(
+      unknown.err,
+      "uh: --device: unknown driver 'nope' (known drivers: forcedimension, haply, openhaptics, sim-circle, "
+      "sim-hand, sim-line, "
+      "sim-raster, sim-replay)\n");
   const CommandRun missing = uh(
       fmt::format("run '{}' --device forcedimension:serial=4 --stepped", scene.string()), with_standin(dir_));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("tool.device: forcedimension: no device with serial 4 (found: serial 11001)"),
             std::string::npos)
       << missing.err;
+}
+
+// the loopback Inverse Service (tests/devices/standins/) on a thread of this test, uh a child
+// process that finds it through UH_HAPLY_URL; its cursor rests at the origin, inside the bunny
+TEST_F(CliTest, DevicesAndRunOnHaplysService) {
+  devices::testing::HaplyStandinService service;
+  const std::string env = with_standin(dir_) + fmt::format("UH_HAPLY_URL='{}' ", service.url());
+  const CommandRun listed = uh("devices --json", env);
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  const auto j = nlohmann::json::parse(listed.out);
+  const nlohmann::json* haply = nullptr;
+  for (const auto& d : j["drivers"])
+    if (d["driver"] == "haply") haply = &d;
+  ASSERT_NE(haply, nullptr) << listed.out;
+  EXPECT_EQ((*haply)["runtime"], "Haply Inverse Service");
+  EXPECT_EQ((*haply)["looked_for"][0]["path"], service.url());
+  EXPECT_EQ((*haply)["looked_for"][0]["from"], "UH_HAPLY_URL");
+  EXPECT_EQ((*haply)["loaded_from"], service.url());
+  ASSERT_EQ((*haply)["devices"].size(), 1u) << listed.out;
+  const auto& dev = (*haply)["devices"][0];
+  EXPECT_EQ(dev["selector"], "haply:049D");
+  EXPECT_EQ(dev["model"], "Inverse3");
+  EXPECT_EQ(dev["serial"], "049D");
+  EXPECT_EQ(dev["dof_actuated"], 3);
+  EXPECT_EQ(dev["max_force_n"], 2.0);
+  const CommandRun text = uh("devices", env);
+  EXPECT_NE(text.out.find(fmt::format("  connected to {}\n", service.url())), std::string::npos) << text.out;
+  EXPECT_NE(
+      text.out.find("  haply:049D  Inverse3, serial 049D: 3-DOF sensed, 3-DOF force, max 2.0 N, workspace "
+                    "not reported, rate set by the client\n"),
+      std::string::npos)
+      << text.out;
+
+  // a threaded session clocked by the service's replies, with contact
+  const fs::path scene = write_small_device_scene(dir_);
+  const CommandRun r = uh(fmt::format("run '{}' --device haply --seconds 0.3 --json", scene.string()), env);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto run = nlohmann::json::parse(r.out);
+  EXPECT_GT(run["haptic"]["ticks"].get<int>(), 100);
+  EXPECT_GT(run["haptic"]["rate_hz"].get<double>(), 0.0);
+  EXPECT_GT(run["force"]["max_n"].get<double>(), 0.5);
+  EXPECT_LE(run["force"]["max_n"].get<double>(), 2.0);  // the device's limit, below the tool's 6 N
+  EXPECT_EQ(run["device"]["driver"], "haply");
+  EXPECT_EQ(run["device"]["name"], "haply Inverse3 049D");
+  EXPECT_EQ(run["device"]["serial"], "049D");
+
+  // the service fails mid-run: the session ends at once with the device and the service's words
+  devices::testing::HaplyStandinScript failing;
+  failing.fault = devices::testing::HaplyFault::kError;
+  failing.fault_after = 100;
+  service.set_script(failing);
+  const CommandRun failed =
+      uh(fmt::format("run '{}' --device haply:device_id=049D --seconds 30", scene.string()), env);
+  EXPECT_EQ(failed.exit_code, 1);
+  EXPECT_NE(
+      failed.err.find("device 'haply Inverse3 049D' faulted: the service reported an error: Inverse3 049D: "
+                      "the motors are too hot; it was sent zero force"),
+      std::string::npos)
+      << failed.err;
+  EXPECT_EQ(service.received().back(), Vec3{});
 }
 
 // ---- uh explore: the materials of scenes/materials.json recovered from the force trace ----

@@ -29,13 +29,7 @@ std::unique_ptr<haptico::HapticDevice> make(const DeviceConfig& config) {
   return testing::make_device("openhaptics", config);
 }
 
-// waits (without a time limit on the result: only on the test's patience) until `done` or 10 s
-template <typename Done>
-void wait_for(Done done) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!done() && std::chrono::steady_clock::now() < give_up)
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-}
+using testing::wait_for;
 
 TEST(OpenHapticsDevice, IsRegisteredAndRejectsBadSettings) {
   const haptico::DeviceRegistry registry = all_drivers();

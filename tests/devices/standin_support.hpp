@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "uh/devices/hardware_drivers.hpp"
@@ -19,6 +21,14 @@ inline std::unique_ptr<haptico::HapticDevice> make_device(const char* driver,
   auto device = all_drivers().create(driver, config);
   EXPECT_TRUE(device) << (device ? "" : device.error().message);
   return device ? std::move(device).value() : nullptr;
+}
+
+/// Waits until `done` (no time limit on the result, only on the test's patience: 10 s).
+template <typename Done>
+void wait_for(Done done) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
 }
 
 /// The stand-in library at `path`, as the test loads it (the loader hands out one instance per

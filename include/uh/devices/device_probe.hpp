@@ -44,7 +44,7 @@ std::vector<DriverFindings> probe_drivers(const haptico::DeviceRegistry& registr
 struct DeviceChoice {
   std::string driver{};
   /// The selection as config keys: SELECTOR is KEY=VALUE, or a bare VALUE for the driver's usual
-  /// key (forcedimension: index, openhaptics: name).
+  /// key (forcedimension: index, openhaptics: name, haply: device_id).
   haptico::DeviceConfig selection{};
 };
 

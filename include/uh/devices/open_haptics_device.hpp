@@ -11,6 +11,7 @@
 #include "uh/core/result.hpp"
 #include "uh/core/tick_recorder.hpp"
 #include "uh/devices/fault_note.hpp"
+#include "uh/devices/servo_run.hpp"
 #include "uh/devices/shared_library.hpp"
 #include "uh/haptico/device_config.hpp"
 #include "uh/haptico/servo_clock.hpp"
@@ -81,7 +82,7 @@ class OpenHapticsDevice final : public haptico::ClockedDevice, private haptico::
   void stop() override;
   bool running() const override { return running_.load(std::memory_order_acquire); }
   FixedRateLoopStats stats() const override;
-  std::uint64_t missed_deadlines() const override { return missed_.load(std::memory_order_relaxed); }
+  std::uint64_t missed_deadlines() const override { return run_.missed_deadlines(); }
 
   Status describe();
   // the HD error raised by the calls since the last check, as an Error naming `what` ("" = none)
@@ -112,18 +113,10 @@ class OpenHapticsDevice final : public haptico::ClockedDevice, private haptico::
   bool faulted_ = false;
   FaultNote fault_;
   // the run
-  FixedRateLoop::Callback tick_;
-  FixedRateLoop::ExitCallback on_exit_;
+  ServoRun run_;
   unsigned long handle_ = 0;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};
-  std::atomic<std::uint64_t> missed_{0};
-  double rate_hz_ = 1000.0;
-  std::chrono::nanoseconds period_{1'000'000};
-  std::uint64_t frame_index_ = 0;                     // servo thread
-  TickRecorder::Clock::time_point previous_start_{};  // servo thread
-  std::string thrown_;                                // servo thread, as the run ends
-  TickRecorder recorder_;
 };
 
 }  // namespace uh::devices
