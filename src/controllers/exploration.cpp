@@ -20,6 +20,10 @@ constexpr double kNormalTauS = 0.02;  // low-pass of the normal estimate [s]
 constexpr double kHoldS = 0.3;        // rest between strokes [s]
 constexpr double kClearM = 0.002;     // lift this far past the last contact [m]
 constexpr double kMaxSeconds = 40.0;  // the script's whole budget of simulated time [s]
+// the share of the contour's ripple a grating's plane wave must explain to count as periodic
+constexpr double kPlaneWaveShare = 0.45;
+// an axis whose strokes ripple less than this share of the other's may see the texture's slow component only
+constexpr double kSlowAxisRipple = 0.6;
 
 // Where the hand starts and how the strokes are turned (planned from the geometry before the run)
 struct ExplorePlan {
@@ -342,6 +346,7 @@ struct Slide {
   std::vector<double> travel;
   std::vector<double> normal_n;
   std::vector<double> friction_ratio;
+  std::vector<Vec3> position;
 };
 
 Slide slide_of(const ExploreTrace& trace, const std::vector<std::size_t>& idx) {
@@ -370,6 +375,7 @@ Slide slide_of(const ExploreTrace& trace, const std::vector<std::size_t>& idx) {
     s.travel.push_back(travel[j]);
     s.normal_n.push_back(pressing);
     s.friction_ratio.push_back(-along / pressing);
+    s.position.push_back(x[idx[j]].position);
   }
   return s;
 }
@@ -439,6 +445,146 @@ std::vector<double> ripple_of(const Slide& s, double from_m, double to_m, double
               u * (m[1][kTerms] / m[1][1] + u * (m[2][kTerms] / m[2][2] + u * m[3][kTerms] / m[3][3]));
   }
   return out;
+}
+
+// Least squares: the coefficients c minimising sum_i (y_i - sum_k c_k basis_i[k])^2 and the
+// residual sum of squares; empty when the columns are degenerate
+struct LeastSquares {
+  std::vector<double> coefficients;
+  double residual = 0.0;
+};
+
+LeastSquares least_squares(const std::vector<std::vector<double>>& basis, const std::vector<double>& y) {
+  LeastSquares out;
+  if (basis.empty()) return out;
+  const std::size_t n = basis.front().size();
+  std::vector<double> m(n * (n + 1), 0.0);  // the normal equations, augmented, row-major
+  for (std::size_t i = 0; i < basis.size(); ++i)
+    for (std::size_t r = 0; r < n; ++r) {
+      for (std::size_t c = 0; c < n; ++c) m[r * (n + 1) + c] += basis[i][r] * basis[i][c];
+      m[r * (n + 1) + n] += basis[i][r] * y[i];
+    }
+  for (std::size_t col = 0; col < n; ++col) {  // Gauss-Jordan with partial pivoting
+    std::size_t pivot = col;
+    for (std::size_t r = col + 1; r < n; ++r)
+      if (std::fabs(m[r * (n + 1) + col]) > std::fabs(m[pivot * (n + 1) + col])) pivot = r;
+    for (std::size_t c = 0; c <= n; ++c) std::swap(m[col * (n + 1) + c], m[pivot * (n + 1) + c]);
+    if (!(std::fabs(m[col * (n + 1) + col]) > 0.0)) return out;
+    for (std::size_t r = 0; r < n; ++r) {
+      if (r == col) continue;
+      const double q = m[r * (n + 1) + col] / m[col * (n + 1) + col];
+      for (std::size_t c = 0; c <= n; ++c) m[r * (n + 1) + c] -= q * m[col * (n + 1) + c];
+    }
+  }
+  out.coefficients.resize(n);
+  for (std::size_t r = 0; r < n; ++r) out.coefficients[r] = m[r * (n + 1) + n] / m[r * (n + 1) + r];
+  for (std::size_t i = 0; i < basis.size(); ++i) {
+    double fitted = 0.0;
+    for (std::size_t k = 0; k < n; ++k) fitted += out.coefficients[k] * basis[i][k];
+    out.residual += (y[i] - fitted) * (y[i] - fitted);
+  }
+  return out;
+}
+
+// How much of the ripple of the normal force along the contour one plane wave explains
+struct PlaneWaveFit {
+  double share = 0.0;         ///< of the ripple's power (after the circle's slow variation) [0, 1]
+  double f1 = 0.0, f2 = 0.0;  ///< the wave vector's spatial frequencies along e1, e2 [1/m]
+};
+
+// The candidates are the strokes' frequencies with either relative sign (a stroke sees |k . e|
+// only); an axis without a peak (its apparent period too long for a stroke) has its component
+// searched below the strokes' lowest frequency `f_low`
+//
+// The hand holds its force with a loop that follows slow bumps, so part of a texture shows in the
+// hand's height rather than in the force: the ripple fitted is the force plus the contact's
+// stiffness `stiffness` [N/m] times the hand's height along the normal (what the force would have
+// been had the hand not moved), averaged over a quarter millimetre (the passivity controller's
+// tick-to-tick cuts are no texture).
+//
+// The search trusts an axis only when the other axis's strokes ripple clearly less (a slow
+// component is mostly taken out with the strokes' drift; a random texture ripples alike along
+// both axes, and searching its contour would find some wave that fits by chance).
+PlaneWaveFit fit_plane_wave(const Slide& contour, const Vec3 (&axes)[2], const double (&f)[2], double f_low,
+                            double stiffness, const double (&ripple)[2]) {
+  PlaneWaveFit best;
+  const std::size_t n = contour.position.size();
+  if (n < 32) return best;
+  const double circle = contour.travel.back();
+  Vec3 centre{};
+  for (const Vec3& p : contour.position) centre += p;
+  centre = centre / static_cast<double>(n);
+  Vec3 normal = cross(axes[0], axes[1]);
+  if (normal.z < 0.0) normal = -1.0 * normal;
+  std::vector<double> unmoved(n);
+  for (std::size_t j = 0; j < n; ++j)
+    unmoved[j] = contour.normal_n[j] + stiffness * dot(contour.position[j] - centre, normal);
+  std::vector<double> smooth(n);
+  for (std::size_t j = 0, a = 0, b = 0; j < n; ++j) {
+    while (contour.travel[j] - contour.travel[a] > 1.25e-4) ++a;
+    while (b + 1 < n && contour.travel[b + 1] - contour.travel[j] <= 1.25e-4) ++b;
+    smooth[j] = std::accumulate(unmoved.begin() + static_cast<std::ptrdiff_t>(a),
+                                unmoved.begin() + static_cast<std::ptrdiff_t>(b) + 1, 0.0) /
+                static_cast<double>(b - a + 1);
+  }
+  // the slow part: the shape and the force loop vary once or twice per turn and drift along it
+  std::vector<std::vector<double>> slow;
+  std::vector<double> y, u1, u2;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (contour.travel[j] < 0.1 * circle) continue;  // the seat's transient
+    const Vec3 d = contour.position[j] - centre;
+    const double a = dot(d, axes[0]), b = dot(d, axes[1]), theta = std::atan2(b, a);
+    slow.push_back({1.0, std::cos(theta), std::sin(theta), std::cos(2.0 * theta), std::sin(2.0 * theta),
+                    contour.travel[j] / circle});
+    y.push_back(smooth[j]);
+    u1.push_back(a);
+    u2.push_back(b);
+  }
+  const LeastSquares base = least_squares(slow, y);
+  if (base.coefficients.empty() || !(base.residual > 0.0)) return best;
+  const auto share_of = [&](double g1, double g2) {
+    std::vector<std::vector<double>> basis = slow;
+    for (std::size_t i = 0; i < basis.size(); ++i) {
+      const double phase = 2.0 * kPi * (g1 * u1[i] + g2 * u2[i]);
+      basis[i].push_back(std::cos(phase));
+      basis[i].push_back(std::sin(phase));
+    }
+    const LeastSquares full = least_squares(basis, y);
+    return full.coefficients.empty() ? 0.0 : 1.0 - full.residual / base.residual;
+  };
+  const auto consider = [&](double g1, double g2) {
+    const double share = share_of(g1, g2);
+    if (share > best.share) best = {share, g1, g2};
+  };
+  if (f[0] > 0.0 && f[1] > 0.0) {
+    consider(f[0], f[1]);
+    consider(f[0], -f[1]);
+  }
+  // an axis may see no period because its apparent period is too long for a stroke (the
+  // component lies within (-f_low, f_low)), and then show a packing's grain instead: with each
+  // axis's frequency trusted alone, the other component is searched within (-f_low, f_low), in
+  // steps that keep the phase error over the circle's radius under half a radian, then finer
+  // around the best (a search over all frequencies would fit a random texture's contour by
+  // chance: the best of a hundred candidates)
+  const double radius = circle / (2.0 * kPi);
+  const double step = 0.5 / (2.0 * kPi * radius);
+  for (int axis = 0; axis < 2; ++axis) {
+    if (!(f[axis] > 0.0) || !(ripple[1 - axis] <= kSlowAxisRipple * ripple[axis])) continue;
+    const double reach = f_low;
+    const auto at = [&](double g) { return axis == 0 ? std::pair{f[0], g} : std::pair{g, f[1]}; };
+    PlaneWaveFit coarse;
+    for (double g = -reach; g <= reach; g += step) {
+      const auto [g1, g2] = at(g);
+      const double share = share_of(g1, g2);
+      if (share > coarse.share) coarse = {share, g1, g2};
+    }
+    const double found = axis == 0 ? coarse.f2 : coarse.f1;
+    for (double g = found - step; g <= found + step; g += step / 8.0) {
+      const auto [g1, g2] = at(g);
+      consider(g1, g2);
+    }
+  }
+  return best;
 }
 
 }  // namespace
@@ -511,11 +657,13 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     if (peak > -1e300) breakaway.push_back(peak);
     if (!slid.empty()) sliding.push_back(median(slid));
   }
+  Slide contour;
   {
     std::vector<std::size_t> idx;
     for (std::size_t i = 0; i < x.size(); ++i)
       if (x[i].phase == ExplorePhase::kContour) idx.push_back(i);
-    const Slide c = slide_of(trace, idx);
+    contour = slide_of(trace, idx);
+    const Slide& c = contour;
     std::vector<double> slid;
     const double circle = 2.0 * kPi * o.contour_radius_m;
     for (std::size_t j = 0; j < c.travel.size(); ++j)
@@ -535,7 +683,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
   const double ds = 2.5e-5;  // resampling step [m]: 40 samples per millimetre
   double sum_sq = 0.0;
   std::size_t count = 0;
-  double f_sq = 0.0;
+  double axis_frequency[2] = {0.0, 0.0};  // [1/m], 0 = no peak along that axis
   for (int axis = 0; axis < 2; ++axis) {
     Spectrum spectrum;
     const double span = to - from;
@@ -554,6 +702,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
       add_spectrum(r, ds, spectrum);
     }
     sum_sq += axis_sq;
+    if (axis_count > 0) e.ripple_axis_n[axis] = std::sqrt(axis_sq / static_cast<double>(axis_count));
     count += axis_count;
     // a ripple under 0.5 % of the stroke force is the hand's own wobble, not a texture
     if (axis_count == 0 || std::sqrt(axis_sq / static_cast<double>(axis_count)) < 0.005 * o.stroke_force_n)
@@ -577,10 +726,18 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     const double shift = denom != 0.0 ? 0.5 * (p0 - p2) / denom : 0.0;
     const double f = spectrum.frequency[peak] + shift * (spectrum.frequency[1] - spectrum.frequency[0]);
     e.period_axis_m[axis] = 1.0 / f;
-    f_sq += f * f;
+    axis_frequency[axis] = f;
   }
   if (count > 0) e.texture_ripple_n = std::sqrt(sum_sq / static_cast<double>(count));
-  if (f_sq > 0.0) e.texture_period_m = 1.0 / std::sqrt(f_sq);
+  if (axis_frequency[0] > 0.0 || axis_frequency[1] > 0.0) {
+    // a grating is one plane wave over the whole surface: the wave vector the strokes found must
+    // also explain the ripple along the contour, a third path; a random texture (or a packing's
+    // grain) has its strongest component differ from path to path, and then has no period
+    const PlaneWaveFit fit = fit_plane_wave(contour, trace.stroke_axes, axis_frequency, 2.5 / (to - from),
+                                            e.stiffness_n_per_mm.value_or(0.0) * 1e3, e.ripple_axis_n);
+    e.texture_wave_share = fit.share;
+    if (fit.share >= kPlaneWaveShare) e.texture_period_m = 1.0 / std::hypot(fit.f1, fit.f2);
+  }
   return e;
 }
 

@@ -8,6 +8,8 @@
 
 #include <cmath>
 
+#include "uh/forcecomp/material.hpp"
+
 namespace uh::controllers {
 namespace {
 
@@ -17,7 +19,18 @@ struct Synthetic {
   double mu_s = 0.5, mu_d = 0.3, stick = 500.0;
   double period = 0.002, ripple = 0.1;  // grating: period [m], normal force amplitude [N]
   Vec3 grating{std::cos(0.4), std::sin(0.4), 0.0};
+  // when set: a random texture read as the texture stage does, the normal force times
+  // (1 + h(p) / depth), instead of the grating
+  const forcecomp::Texture* random = nullptr;
+  double depth = 0.0016;  // [m]
 };
+
+// the normal force at surface point p while sliding at the stroke force
+double normal_force(const Synthetic& m, const ExploreOptions& o, const Vec3& p) {
+  if (m.random != nullptr)
+    return o.stroke_force_n * (1.0 + forcecomp::texture_height(*m.random, p) / m.depth);
+  return o.stroke_force_n + m.ripple * std::sin(2 * kPi * dot(m.grating, p) / m.period);
+}
 
 ExploreTrace synthetic_trace(const Synthetic& m) {
   ExploreTrace trace;
@@ -40,12 +53,21 @@ ExploreTrace synthetic_trace(const Synthetic& m) {
     bool slipping = false;
     for (double s = 0.0; s <= o.stroke_length_m; s += o.stroke_speed_m_per_s * dt) {
       const Vec3 p = start + s * dir;
-      const double normal = o.stroke_force_n + m.ripple * std::sin(2 * kPi * dot(m.grating, p) / m.period);
+      const double normal = normal_force(m, o, p);
       double friction = m.stick * s;
       if (friction > m.mu_s * normal) slipping = true;
       if (slipping) friction = m.mu_d * normal;
       trace.samples.push_back({t += dt, p, Vec3{0, 0, normal} - friction * dir, ExplorePhase::kStroke, leg});
     }
+  }
+  // the contour: one circle from the start, sliding at mu_d N throughout
+  const double radius = o.contour_radius_m;
+  for (double angle = 0.0; angle <= 2.0 * kPi; angle += o.stroke_speed_m_per_s * dt / radius) {
+    const Vec3 p = Vec3{radius * std::sin(angle), radius * (1.0 - std::cos(angle)), m.r};
+    const Vec3 dir{std::cos(angle), std::sin(angle), 0.0};
+    const double normal = normal_force(m, o, p);
+    trace.samples.push_back(
+        {t += dt, p, Vec3{0, 0, normal} - m.mu_d * normal * dir, ExplorePhase::kContour, -1});
   }
   return trace;
 }
@@ -75,6 +97,42 @@ TEST(Exploration, ASmoothFrictionlessTraceHasNoFrictionAndNoPeriod) {
   EXPECT_NEAR(*e.friction_dynamic, 0.0, 1e-9);
   EXPECT_FALSE(e.texture_period_m.has_value());
   EXPECT_LT(e.texture_ripple_n, 1e-9);
+}
+
+// A stationary random texture has no period: its strongest component along a stroke is not a
+// wave the contour sees too. Its ripple is the normal force times the RMS height over the depth,
+// h / depth, of the height's components short enough for a stroke (the cubic taken out of each
+// stroke removes the longer ones): for a Gaussian correlation of length l the height along a line
+// has the spectral density S(f) = sigma^2 sqrt(2 pi) l exp(-2 pi^2 l^2 f^2), and the strokes keep
+// about what lies above 2.5 periods per analysed stroke length, f_low. The reference integrates
+// S numerically above f_low.
+TEST(Exploration, ARandomTextureHasNoPeriodAndRipplesWithItsRoughness) {
+  const ExploreOptions o;
+  const double sigma = 3e-5, l = 1e-3;
+  const double span = (0.97 - 0.15) * o.stroke_length_m, f_low = 2.5 / span;
+  double kept = 0.0;  // the share of sigma^2 above f_low (both signs of f), by the midpoint rule
+  const double df = 0.05;
+  for (double f = f_low + 0.5 * df; f < 20.0 / l; f += df)
+    kept += 2.0 * std::sqrt(2.0 * kPi) * l * std::exp(-2.0 * kPi * kPi * l * l * f * f) * df;
+  double ratio_sum = 0.0;
+  const std::uint64_t seeds[] = {7, 8, 9, 10, 11, 12};
+  for (const std::uint64_t seed : seeds) {
+    const forcecomp::Texture rough = forcecomp::make_random_texture(sigma, l, seed);
+    const forcecomp::Texture rougher = forcecomp::make_random_texture(2.0 * sigma, l, seed);
+    Synthetic m;
+    m.random = &rough;
+    const MaterialEstimate e = estimate_material(synthetic_trace(m));
+    EXPECT_FALSE(e.texture_period_m.has_value())
+        << "seed " << seed << ": " << e.texture_period_m.value_or(0.0);
+    EXPECT_LT(e.texture_wave_share, 0.45) << "seed " << seed;
+    m.random = &rougher;
+    const MaterialEstimate twice = estimate_material(synthetic_trace(m));
+    EXPECT_NEAR(twice.texture_ripple_n, 2.0 * e.texture_ripple_n, 1e-6)
+        << "the ripple is linear in the roughness";
+    ratio_sum += e.texture_ripple_n / (o.stroke_force_n * sigma / m.depth * std::sqrt(kept));
+  }
+  // one realisation of 64 waves varies; their mean follows the spectrum
+  EXPECT_NEAR(ratio_sum / std::size(seeds), 1.0, 0.25);
 }
 
 TEST(Exploration, AnEmptyTraceGivesNoEstimates) {
