@@ -10,10 +10,14 @@ uh_build() {
   [ "${1:-}" = "--" ] && shift
   local launcher=()
   if command -v ccache >/dev/null 2>&1; then
-    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-    # paths relative to the checkout, so that another clone of the same sources reuses the cache
-    # (builds with debug information still hash their directory: their paths stay true)
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+    # Another clone of the same sources reuses the cache: ccache hashes paths relative to the
+    # checkout, the objects hold source paths relative to it (-ffile-prefix-map, also in the
+    # debug information, so builds with -g need not hash their directory either), and the tests'
+    # absolute paths live in one generated source (tests/support/test_paths.hpp).
     export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$uh_root}"
+    export CCACHE_NOHASHDIR=1
+    launcher+=("-DCMAKE_CXX_FLAGS=-ffile-prefix-map=$uh_root/=" "-DCMAKE_C_FLAGS=-ffile-prefix-map=$uh_root/=")
   fi
   cmake -S "$uh_root" -B "$uh_root/$dir" -G Ninja "${launcher[@]}" "$@" >/dev/null
   local target_args=()

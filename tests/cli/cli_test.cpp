@@ -21,6 +21,7 @@
 #include "haply_standin.hpp"
 
 #include "lens_reference.hpp"
+#include "test_paths.hpp"
 #include "uh/collette/ist_file.hpp"
 
 namespace uh {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include "test_paths.hpp"
 
 namespace uh {
 namespace {

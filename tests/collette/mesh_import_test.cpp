@@ -6,6 +6,7 @@
 #include <set>
 
 #include "mesh_test_support.hpp"
+#include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
 
 namespace uh::collette {

@@ -3,6 +3,7 @@
 #include <random>
 
 #include "mesh_test_support.hpp"
+#include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "uh/collette/mesh_inside.hpp"
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesh_test_support.hpp"
+#include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
 
 namespace uh::collette {

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "mesh_test_support.hpp"
+#include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "uh/collette/sphere_packing.hpp"
 

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "uh/collette/mesh_inside.hpp"
 #include "uh/collette/sphere_packing.hpp"

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "test_paths.hpp"
 #include "tree_test_support.hpp"
 #include "uh/collette/distance_query.hpp"
 #include "uh/collette/mesh_import.hpp"

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "test_paths.hpp"
 #include "uh/core/csv_reader.hpp"
 #include "uh/core/math.hpp"
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "standin_support.hpp"
+#include "test_paths.hpp"
 
 namespace uh::devices::testing {
 

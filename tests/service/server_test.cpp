@@ -21,6 +21,7 @@
 #include "mesh_binary.hpp"
 #include "protocol.hpp"
 #include "service_test_support.hpp"
+#include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "web_socket_test_client.hpp"
 

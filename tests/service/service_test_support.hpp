@@ -9,6 +9,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include "test_paths.hpp"
 
 namespace uh::service::testing {
 
