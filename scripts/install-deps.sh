@@ -14,6 +14,7 @@ packages=(
   pybind11-dev python3-dev python3-numpy python3-pytest
   g++-mingw-w64-x86-64-posix wine64
   godot3-server mono-mcs mono-runtime
+  rt-tests  # cyclictest, the reference of scripts/bench-latency.sh
 )
 
 # the live view's build (npm ci, esbuild) needs node and npm: Debian's, unless another node is there
