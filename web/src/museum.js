@@ -20,6 +20,7 @@ const kEyeHeight = 1.6;            // [m]
 const kWallHeight = 3.0;           // [m]
 const kWallCell = 0.25;            // wall blocks sample the floor plan at this step [m] (rooms lie on 0.5 m)
 const kInterpolationDelayS = 0.1;  // others are drawn this far in the past: two snapshots at 20 Hz
+const kPauseS = 0.3;               // snapshots this much later than the game clock says follow a pause
 const kSnapDistance = 1.5;         // a server position this far from the prediction is a jump (caught) [m]
 const kCorrectionPerSnapshot = 0.25;  // share of the prediction's error removed at each snapshot
 const kMouseRadiansPerPixel = 0.0025;
@@ -553,25 +554,36 @@ function send(message) {
 }
 
 // what `use` does where Vive stands: deliver at the table, else break or take at the nearest case
+// actions sent and not yet in a snapshot count as done, so a quick second press takes what the
+// first one's glass uncovered (the server applies queued actions one a tick)
+const sentActions = new Map();  // "break 3", "take 3" -> when sent [s]
+const kActionPendingS = 0.5;
+const pending = (action, i) => performance.now() / 1000 - (sentActions.get(`${action} ${i}`) ?? -Infinity) < kActionPendingS;
+
 function usableAction() {
   const s = museum.snapshot;
   if (!s || !museum.predicted || s.phase !== 'playing') return null;
   const [x, y] = museum.predicted;
   const near = (p) => Math.hypot(p[0] - x, p[1] - y) <= rules.reach;
   if (s.vive.carried.length > 0 && near(level.table)) return { action: 'deliver', text: 'deliver to Phantom' };
+  const broken = (i) => s.cases[i].broken || pending('break', i);
+  const holds = (i) => s.cases[i].item && !pending('take', i);
   let best = -1, bestD = Infinity;
   level.cases.forEach((p, i) => {
     const d = Math.hypot(p[0] - x, p[1] - y);
-    if (d <= rules.reach && d < bestD && (!s.cases[i].broken || s.cases[i].item)) { best = i; bestD = d; }
+    if (d <= rules.reach && d < bestD && (!broken(i) || holds(i))) { best = i; bestD = d; }
   });
   if (best < 0) return null;
-  if (!s.cases[best].broken) return { action: 'break', text: `break the case (heard within ${rules.glass_hear_radius} m)` };
+  if (!broken(best)) return { action: 'break', case: best, text: `break the case (heard within ${rules.glass_hear_radius} m)` };
   if (s.vive.carried.length >= rules.max_carried) return { action: null, text: `hands full (${rules.max_carried} pieces)` };
-  return { action: 'take', text: `take the ${s.cases[best].item.kind}` };
+  return { action: 'take', case: best, text: `take the ${s.cases[best].item.kind}` };
 }
 function useNearest() {
   const use = usableAction();
-  if (use && use.action) send({ type: 'action', action: use.action });
+  if (use && use.action) {
+    send({ type: 'action', action: use.action });
+    if (use.case !== undefined) sentActions.set(`${use.action} ${use.case}`, performance.now() / 1000);
+  }
   return use ? use.action : null;
 }
 museum.use = useNearest;  // what the use key does, for scripts: the action sent, or null
@@ -690,9 +702,11 @@ function onSnapshot(s) {
   if (museum.trace) museum.trace.push({ snapshot: s.guards.map((g) => [...g.pos]) });
   buffer.push({ t, snap: s });
   while (buffer.length > 40) buffer.shift();
-  // the offset follows a faster clock at once and a slower one (a pause, a late frame) gently
+  // the offset follows a faster clock at once, a late frame gently and a pause (game time stood
+  // while this clock ran on) at once
   const sample = now - t;
-  clockOffsetS = clockOffsetS === null || sample < clockOffsetS ? sample : clockOffsetS + (sample - clockOffsetS) * 0.05;
+  const behind = clockOffsetS === null ? 0 : sample - clockOffsetS;
+  clockOffsetS = clockOffsetS === null || behind < 0 || behind > kPauseS ? sample : clockOffsetS + behind * 0.05;
 
   // reconciliation: the server's position answers the moves sent about one round trip ago
   const [sx, sy] = s.vive.pos;
