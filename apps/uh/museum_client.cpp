@@ -1,5 +1,7 @@
 #include "museum_client.hpp"
 
+#include <iterator>
+
 #include <fmt/format.h>
 
 #include "uh/museum_artifacts/artifact.hpp"
@@ -14,13 +16,13 @@ std::string mesh_json(const std::string& kind, const collette::TriangleMesh& mes
   std::string out = fmt::format(R"({{"kind":"{}","vertices":[)", kind);
   const char* sep = "";
   for (const auto& v : mesh.vertices) {
-    out += fmt::format("{}{:.4f},{:.4f},{:.4f}", sep, v.x, v.y, v.z);
+    fmt::format_to(std::back_inserter(out), "{}{:.4f},{:.4f},{:.4f}", sep, v.x, v.y, v.z);
     sep = ",";
   }
   out += R"(],"triangles":[)";
   sep = "";
   for (const auto& t : mesh.triangles) {
-    out += fmt::format("{}{},{},{}", sep, t[0], t[1], t[2]);
+    fmt::format_to(std::back_inserter(out), "{}{},{},{}", sep, t[0], t[1], t[2]);
     sep = ",";
   }
   out += "]}";
@@ -33,6 +35,7 @@ MuseumClientFiles museum_client_files(const museum::Level& level) {
   MuseumClientFiles out;
   out.files = view::static_files("dist/museum");
   out.has_page = !out.files.empty();
+  if (!out.has_page) return out;  // nobody to draw the looks (and no second of meshing at start)
   out.texts.reserve(level.artifact_kinds.size());  // the files point into the texts: no reallocation
   for (const std::string& name : level.artifact_kinds) {
     const auto kind = museum_artifacts::artifact_kind(name);

@@ -19,8 +19,8 @@ struct MuseumClientFiles {
   bool has_page = false;  ///< whether the build bundled the page (UH_BUILD_VIEW)
 };
 
-/// The page (empty without UH_BUILD_VIEW) and the looks of `level`'s artifact kinds. A piece's
-/// genuine mesh stands for both: a forgery looks the same.
+/// The page and the looks of `level`'s artifact kinds (a piece's genuine mesh stands for both: a
+/// forgery looks the same); nothing without UH_BUILD_VIEW.
 MuseumClientFiles museum_client_files(const museum::Level& level);
 
 }  // namespace uh::cli
