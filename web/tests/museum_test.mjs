@@ -281,6 +281,8 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
         `keys remap: forward is now I (stored ${JSON.stringify(stored)}), Vive walks ${iWalked.toFixed(2)} m with it and W moves her ${dist(withW.at, withI.at).toFixed(3)} m`);
 
   // the end: the summary arrives and is shown
+  const leftAtEnd = await page.evaluate(() => window.uhMuseum.snapshot.time_left_s);
+  console.log(`     (${leftAtEnd.toFixed(1)} s of the round left when the checks were done)`);
   await waitFor('the summary', () => window.uhMuseum.summary, null, kRoundMinutes * 60 * 1000 + 15000);
   const summary = await page.evaluate(() => ({
     summary: window.uhMuseum.summary,
