@@ -338,7 +338,8 @@ function pictureOf(kind) {
   return museum.pictures[kind] || 'data:,';
 }
 
-async function loadLooks(kinds, targets) {
+async function loadLooks(allKinds, targets) {
+  const kinds = allKinds.filter((kind) => !museum.pictures[kind]);  // a reconnect fetches nothing again
   await Promise.all(kinds.map((kind) => fetchLook(kind).catch((error) => caption(error.message, 'bad'))));
   for (const kind of kinds) {
     if (pieceLooks[kind]) museum.pictures[kind] = renderPicture(kind);
