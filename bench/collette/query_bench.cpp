@@ -13,8 +13,9 @@
 // orientations (fixed seed), each moved along its own random direction until the packings overlap
 // by a quarter of the packing volume (bisection on the exact query's volume). Every iteration runs
 // the volume query and FCL's all-contacts query on the same pose, one after the other (alternating
-// which goes first), so both see the same machine load; each pose 10 times. Counters: median, p90 and max of
-// both over all poses and repetitions, and the ratio of the medians.
+// which goes first), so both see the same machine load, and the query's reference path
+// (`reference_kernel`: the scalar path before the SIMD kernels) on the same pose; each pose 10 times.
+// Counters: median, p90 and max of both over all poses and repetitions, and the ratio of the medians.
 
 #include <benchmark/benchmark.h>
 
@@ -440,12 +441,15 @@ BENCHMARK(BM_FclMeshMesh)->ArgsProduct({{0, 1}, {1, 0}})->UseManualTime()->Unit(
 void BM_DeepRandomPoses(benchmark::State& state) {
   const Scene& s = scene();
   VolumeQuery query;
+  VolumeQuery reference({.reference_kernel = true});
   fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
   fcl::CollisionObjectd b(s.fcl_model, fcl::Transform3d::Identity());
   const fcl::CollisionRequestd request(1000000, true);
-  std::vector<double> ours, fcl_times;
+  std::vector<double> ours, reference_times, fcl_times;
   ours.reserve(1 << 14);
+  reference_times.reserve(1 << 14);
   fcl_times.reserve(1 << 14);
+  std::int64_t mismatches = 0;
   std::size_t k = 0;
   double pairs = 0.0, node_pairs = 0.0, leaf_tests = 0.0, contacts = 0.0;
   std::int64_t pairs_min = std::numeric_limits<std::int64_t>::max(), pairs_max = 0;
@@ -462,6 +466,12 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       node_pairs += static_cast<double>(r.stats.node_pairs_visited);
       leaf_tests += static_cast<double>(r.stats.leaf_pairs_tested);
     };
+    const auto run_reference = [&] {
+      const auto t0 = Clock::now();
+      const VolumeQueryResult& r = reference.run(s.tree, s.tree, p);
+      reference_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      benchmark::DoNotOptimize(r.total_volume);
+    };
     const auto run_fcl = [&] {
       b.setTransform(to_fcl(p));
       fcl::CollisionResultd result;
@@ -470,19 +480,33 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       fcl_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       contacts += static_cast<double>(result.numContacts());
     };
-    if (k % 2 == 0) {
+    if (k % 3 == 0) {
       run_ours();
+      run_reference();
       run_fcl();
+    } else if (k % 3 == 1) {
+      run_reference();
+      run_fcl();
+      run_ours();
     } else {
       run_fcl();
       run_ours();
+      run_reference();
     }
+    // the fast path must give exactly the reference path's totals and pairs
+    if (query.result().total_volume != reference.result().total_volume ||
+        query.result().pair_count != reference.result().pair_count)
+      ++mismatches;
     state.SetIterationTime(ours.back());
     ++k;
   }
   const double n = static_cast<double>(std::max<std::size_t>(1, k));
   std::sort(ours.begin(), ours.end());
   std::sort(fcl_times.begin(), fcl_times.end());
+  std::sort(reference_times.begin(), reference_times.end());
+  state.counters["reference_median_us"] = quantile(reference_times, 0.5) * 1e6;
+  state.counters["reference_p90_us"] = quantile(reference_times, 0.9) * 1e6;
+  state.counters["mismatches"] = static_cast<double>(mismatches);
   state.counters["median_us"] = quantile(ours, 0.5) * 1e6;
   state.counters["p90_us"] = quantile(ours, 0.9) * 1e6;
   state.counters["max_us"] = ours.empty() ? 0.0 : ours.back() * 1e6;
@@ -504,6 +528,26 @@ void BM_DeepRandomPoses(benchmark::State& state) {
                  " random orientations, a quarter of the volume overlapping");
 }
 BENCHMARK(BM_DeepRandomPoses)->Iterations(10 * kDeepPoses)->UseManualTime()->Unit(benchmark::kMicrosecond);
+
+// Our query alone on the deep random poses (for profiling: `perf record` on this filter sees no FCL).
+void BM_IstVolumeQueryDeepRandom(benchmark::State& state) {
+  const Scene& s = scene();
+  VolumeQuery query;
+  std::vector<double> times;
+  times.reserve(1 << 16);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    const VolumeQueryResult& r = query.run(s.tree, s.tree, s.deep_random[k++ % s.deep_random.size()]);
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    benchmark::DoNotOptimize(r.total_volume);
+    state.SetIterationTime(dt);
+    times.push_back(dt);
+  }
+  report(state, times);
+  state.SetLabel("deep random orientations, ours alone");
+}
+BENCHMARK(BM_IstVolumeQueryDeepRandom)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
 struct CountContacts : btCollisionWorld::ContactResultCallback {
   int count = 0;

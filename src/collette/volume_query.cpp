@@ -1,15 +1,18 @@
 #include "uh/collette/volume_query.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
 
+#include "leaf_batch.hpp"
 #include "query_kernels.hpp"
 #include "uh/core/sphere_overlap.hpp"
 
@@ -26,9 +29,11 @@ struct Totals {
 
 }  // namespace
 
-VolumeQuery::VolumeQuery(const VolumeQueryOptions& options) : options_(options) {
+VolumeQuery::VolumeQuery(const VolumeQueryOptions& options)
+    : options_(options), batch_(std::make_unique<detail::LeafBatch>()) {
   options_.pair_capacity = std::max(0, options_.pair_capacity);
-  stack_.reserve(static_cast<std::size_t>(std::max(64, options_.stack_reserve)));
+  // the traversal keeps its own top: the vector is storage, sized to its capacity
+  stack_.resize(static_cast<std::size_t>(std::max(64, options_.stack_reserve)));
   if (options_.collect_pairs) pairs_.resize(static_cast<std::size_t>(options_.pair_capacity));
   options_.coherence_skin = std::isfinite(options_.coherence_skin) ? std::max(0.f, options_.coherence_skin) : 0.f;
   if (options_.coherence_skin > 0.f) {
@@ -37,7 +42,21 @@ VolumeQuery::VolumeQuery(const VolumeQueryOptions& options) : options_(options) 
   }
 }
 
+VolumeQuery::~VolumeQuery() = default;
+VolumeQuery::VolumeQuery(VolumeQuery&&) noexcept = default;
+VolumeQuery& VolumeQuery::operator=(VolumeQuery&&) noexcept = default;
+
 namespace {
+
+// byte j all ones when bit j of the index is set: spreads a child mask over the 8-bit rows of a
+// 64-bit child-pair mask
+constexpr auto kByteMask = [] {
+  std::array<std::uint64_t, 256> t{};
+  for (std::uint32_t m = 0; m < 256; ++m)
+    for (int j = 0; j < 8; ++j)
+      if ((m >> j) & 1u) t[m] |= std::uint64_t{0xff} << (8 * j);
+  return t;
+}();
 
 constexpr int popcount8(std::uint32_t m) {
   constexpr int kNibble[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
@@ -50,12 +69,14 @@ struct Traversal {
   SphereTree::Blocks a, b;
   const Sphere* leaves_a;
   detail::FloatTransform xf;
-  std::vector<VolumeQuery::StackEntry>* stack;
+  std::vector<VolumeQuery::StackEntry>* stack;  // storage (size = capacity); entries below `top` are live
+  std::size_t top = 0;
   PairOverlap* out;
   std::int32_t capacity;
   float margin;                // pairs closer than this but not overlapping are stored with volume 0
   float search_margin;         // node and leaf pairs closer than this are followed (margin, plus the skin when keeping)
   std::vector<VolumeQuery::Candidate>* candidates;  // keeping traversals: (A leaf, B leaf index) within search_margin
+  detail::LeafBatch* batch;  // leaf pairs waiting for the SIMD lens kernel (batched traversals)
   std::int32_t stored = 0;
   std::int64_t overlapping = 0;
   std::int64_t near = 0;       // stored-or-counted pairs within the margin that do not overlap
@@ -76,8 +97,14 @@ struct Traversal {
     }
     const float inv = d > 0.f ? 1.f / d : 0.f;
     const float nx = dx * inv, ny = dy * inv, nz = dz * inv;
-    const float cx = ax + nx * o.centroid_offset, cy = ay + ny * o.centroid_offset,
-                cz = az + nz * o.centroid_offset;
+    add_overlap(v, o.area, nx, ny, nz, ax + nx * o.centroid_offset, ay + ny * o.centroid_offset,
+                az + nz * o.centroid_offset, la, lb);
+  }
+
+  // an overlapping pair's lens (volume v > 0, disk area, unit normal, centroid) into the totals
+  // and the pair buffer
+  [[gnu::always_inline]] inline void add_overlap(float v, float area, float nx, float ny, float nz, float cx,
+                                                 float cy, float cz, std::int32_t la, std::int32_t lb) {
     const double vd = static_cast<double>(v);
     sum.volume += vd;
     sum.nx += vd * static_cast<double>(nx);
@@ -86,7 +113,7 @@ struct Traversal {
     sum.cx += vd * static_cast<double>(cx);
     sum.cy += vd * static_cast<double>(cy);
     sum.cz += vd * static_cast<double>(cz);
-    const double ad = static_cast<double>(o.area);
+    const double ad = static_cast<double>(area);
     sum.gx += ad * static_cast<double>(nx);
     sum.gy += ad * static_cast<double>(ny);
     sum.gz += ad * static_cast<double>(nz);
@@ -96,7 +123,7 @@ struct Traversal {
       p.leaf_a = la;
       p.leaf_b = lb;
       p.volume = v;
-      p.area = o.area;
+      p.area = area;
       p.normal[0] = nx;
       p.normal[1] = ny;
       p.normal[2] = nz;
@@ -125,6 +152,43 @@ struct Traversal {
     p.centroid[0] = ax + p.normal[0] * ar;
     p.centroid[1] = ay + p.normal[1] * ar;
     p.centroid[2] = az + p.normal[2] * ar;
+  }
+
+  // Evaluates the batched leaf pairs, in the order they were added (so pairs are stored and
+  // summed exactly as the scalar path would), and empties the batch.
+  void flush() {
+    detail::LeafBatch& lb = *batch;
+    lb.pad();
+    detail::LensLanes lanes;
+#if defined(__SSE2__)
+    constexpr int kGroup = 4;
+#else
+    constexpr int kGroup = 1;
+#endif
+    for (int i = 0; i < lb.count; i += kGroup) {
+      std::uint32_t near_lanes = 0;
+#if defined(__SSE2__)
+      const std::uint32_t hits = detail::lens_lanes4(lb, i, margin, lanes, near_lanes);
+#else
+      const std::uint32_t hits = detail::lens_lane1(lb, i, margin, lanes, near_lanes);
+#endif
+      const std::uint32_t valid = lb.count - i >= kGroup ? (1u << kGroup) - 1u : (1u << (lb.count - i)) - 1u;
+      std::uint32_t todo = (hits | near_lanes) & valid;
+      while (todo) {
+        const int j = std::countr_zero(todo);
+        todo &= todo - 1u;
+        const int k = i + j;
+        if ((hits >> j) & 1u) {
+          add_overlap(lanes.volume[j], lanes.area[j], lanes.nx[j], lanes.ny[j], lanes.nz[j], lanes.cx[j],
+                      lanes.cy[j], lanes.cz[j], lb.leaf_a[k], lb.leaf_b[k]);
+        } else {
+          const float dx = lb.bx[k] - lb.ax[k], dy = lb.by[k] - lb.ay[k], dz = lb.bz[k] - lb.az[k];
+          add_near_pair(dx, dy, dz, std::sqrt(dx * dx + dy * dy + dz * dz), lb.ax[k], lb.ay[k], lb.az[k],
+                        lb.ar[k], lb.leaf_a[k], lb.leaf_b[k]);
+        }
+      }
+    }
+    lb.count = 0;
   }
 
   // bit j set when lane j of the (x, y, z, r) lanes overlaps the sphere (px, py, pz, pr)
@@ -173,13 +237,45 @@ struct Traversal {
 #endif
   }
 
-  void push(std::int32_t ia, std::int32_t ib, float x, float y, float z, float r) { stack->push_back({ia, ib, x, y, z, r}); }
+  // a node pair: A's node sphere (ax, ay, az, ar) and B's (bx, by, bz, br), both in A's frame
+  void push(std::int32_t ia, std::int32_t ib, float ax, float ay, float az, float ar, float bx, float by,
+            float bz, float br) {
+    (*stack)[top++] = {ia, ib, ax, ay, az, ar, bx, by, bz, br};
+  }
+
+  // A pushed pair's blocks (or A's leaf sphere) into the cache, so that its visit does not wait for
+  // them: each visit's loads depend on the visit before, and without the prefetch the traversal is
+  // bound by that latency rather than by its arithmetic.
+  template <int WA, int WB>
+  void push_prefetched(std::int32_t ia, std::int32_t ib, float ax, float ay, float az, float ar, float bx,
+                       float by, float bz, float br) {
+#if defined(__SSE2__)
+    if (ia >= 0) {
+      const char* pa = reinterpret_cast<const char*>(a.bounds + static_cast<std::size_t>(ia) * 4 * WA);
+      _mm_prefetch(pa, _MM_HINT_T0);
+      if constexpr (WA == 8) _mm_prefetch(pa + 64, _MM_HINT_T0);
+    } else {
+      _mm_prefetch(reinterpret_cast<const char*>(leaves_a + ~ia), _MM_HINT_T0);
+    }
+    if (ib >= 0) {
+      const char* pb = reinterpret_cast<const char*>(b.bounds + static_cast<std::size_t>(ib) * 4 * WB);
+      _mm_prefetch(pb, _MM_HINT_T0);
+      if constexpr (WB == 8) _mm_prefetch(pb + 64, _MM_HINT_T0);
+    }
+#endif
+    push(ia, ib, ax, ay, az, ar, bx, by, bz, br);
+  }
+
+  // room for n more entries (grows, rarely, outside steady state)
+  void reserve_stack(std::size_t n) {
+    if (stack->size() - top < n) stack->resize(2 * stack->size() + n);
+  }
 
   // a leaf pair within search_margin: evaluated now, or kept as a candidate (B's leaf by index;
   // VolumeQuery::traverse turns it into a slot); grows only past every earlier run's need
   template <bool Keep>
-  [[gnu::always_inline]] inline void leaf_pair(float ax, float ay, float az, float ar, float bx, float by, float bz, float br, std::int32_t la,
-                 std::int32_t lb) {
+  [[gnu::always_inline]] inline void leaf_pair(float ax, float ay, float az, float ar, float bx, float by,
+                                               float bz, float br, std::int32_t la, std::int32_t lb) {
     if constexpr (Keep) {
       if (candidates->size() == candidates->capacity()) candidates->reserve(2 * candidates->capacity() + 1024);
       candidates->push_back({la, lb});
@@ -191,16 +287,16 @@ struct Traversal {
     }
   }
 
+  // The reference traversal (and the keeping one): one pair at a time with the scalar kernel, the
+  // hits of every child handled as they come.
   template <int WA, int WB, bool Keep>
   void run() {
-    std::vector<VolumeQuery::StackEntry>& st = *stack;
     alignas(16) float tb[4 * WB];
-    while (!st.empty()) {
-      const VolumeQuery::StackEntry e = st.back();
-      st.pop_back();
+    while (top > 0) {
+      const VolumeQuery::StackEntry e = (*stack)[--top];
       ++visited;
       // grow (rarely, outside steady state) before a batch of up to WA * WB pushes
-      if (st.capacity() - st.size() < static_cast<std::size_t>(WA * WB)) st.reserve(2 * st.capacity() + WA * WB);
+      reserve_stack(static_cast<std::size_t>(WA * WB));
       if (e.a < 0) {
         // A is a leaf: B's children against it
         const Sphere& s = leaves_a[~e.a];
@@ -214,9 +310,10 @@ struct Traversal {
           const int j = std::countr_zero(hits);
           hits &= hits - 1u;
           if ((leaf_b >> j) & 1u)
-            leaf_pair<Keep>(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
+            leaf_pair<Keep>(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a,
+                            ~cb[j]);
           else
-            push(e.a, cb[j], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
+            push(e.a, cb[j], e.ax, e.ay, e.az, e.ar, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
         }
         continue;
       }
@@ -231,9 +328,10 @@ struct Traversal {
           const int k = std::countr_zero(hits);
           hits &= hits - 1u;
           if ((leaf_a >> k) & 1u)
-            leaf_pair<Keep>(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
+            leaf_pair<Keep>(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k],
+                            ~e.b);
           else
-            push(ca[k], e.b, e.bx, e.by, e.bz, e.br);
+            push(ca[k], e.b, ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br);
         }
         continue;
       }
@@ -250,21 +348,132 @@ struct Traversal {
           const int k = std::countr_zero(hits);
           hits &= hits - 1u;
           if (b_leaf && ((leaf_a >> k) & 1u))
-            leaf_pair<Keep>(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~ca[k], ~cb[j]);
+            leaf_pair<Keep>(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j],
+                            tb[2 * WB + j], tb[3 * WB + j], ~ca[k], ~cb[j]);
           else
-            push(ca[k], cb[j], tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
+            push(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j],
+                 tb[2 * WB + j], tb[3 * WB + j]);
         }
       }
     }
   }
+
+  // The fast traversal: the same node pairs in the same order, and the same leaf pairs, but each
+  // visit first tests all its child pairs into one mask (8 bits per child of B), then appends
+  // the leaf pairs among the hits to the batch and pushes the rest, in two loops without
+  // data-dependent branches in their bodies (the reference's branch per hit mispredicted about
+  // once per hit). Leaf pairs are evaluated a SIMD group at a time by flush(). Within a visit,
+  // both the leaf pairs and the pushes come in the reference's (child of B, child of A) order, so
+  // pairs are found, stored and summed in the same order: the results are identical.
+  template <int WA, int WB>
+  void run_fast() {
+    static_assert(WA <= 8 && WB <= 8);
+    alignas(16) float tb[4 * WB];
+    detail::LeafBatch& lb = *batch;
+    while (top > 0) {
+      if (lb.count > detail::LeafBatch::kCapacity - WA * WB) flush();
+      const VolumeQuery::StackEntry e = (*stack)[--top];
+      ++visited;
+      reserve_stack(static_cast<std::size_t>(WA * WB));
+      if (e.a < 0) {
+        // A is a leaf: B's children against it
+        const Sphere& s = leaves_a[~e.a];
+        transform_block<WB>(e.b, tb);
+        const std::uint32_t leaf_b = b.leaf_mask[e.b];
+        const std::uint32_t hits =
+            overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius + search_margin) &
+            ((1u << b.count[e.b]) - 1u);
+        leaf_tests += popcount8(leaf_b);
+        const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
+        for (std::uint32_t m = hits & leaf_b; m; m &= m - 1u) {
+          const int j = std::countr_zero(m);
+          lb.add(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
+        }
+        for (std::uint32_t m = hits & ~leaf_b; m; m &= m - 1u) {
+          const int j = std::countr_zero(m);
+          push_prefetched<WA, WB>(e.a, cb[j], e.ax, e.ay, e.az, e.ar, tb[j], tb[WB + j], tb[2 * WB + j],
+                                  tb[3 * WB + j]);
+        }
+        continue;
+      }
+      const float* ab = a.bounds + static_cast<std::size_t>(e.a) * 4 * WA;
+      const std::int32_t* ca = a.child + static_cast<std::size_t>(e.a) * WA;
+      const std::uint32_t leaf_a = a.leaf_mask[e.a];
+      if (e.b < 0) {
+        // B is a leaf: A's children against it (padding lanes of A never overlap)
+        const std::uint32_t hits =
+            overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br + search_margin);
+        leaf_tests += popcount8(leaf_a);
+        for (std::uint32_t m = hits & leaf_a; m; m &= m - 1u) {
+          const int k = std::countr_zero(m);
+          lb.add(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
+        }
+        for (std::uint32_t m = hits & ~leaf_a; m; m &= m - 1u) {
+          const int k = std::countr_zero(m);
+          push_prefetched<WA, WB>(ca[k], e.b, ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by,
+                                  e.bz, e.br);
+        }
+        continue;
+      }
+      // both inner: every child of B (moved once) against all children of A; bit 8 j + k of the
+      // mask is child j of B against child k of A
+      transform_block<WB>(e.b, tb);
+      const std::uint32_t leaf_b = b.leaf_mask[e.b];
+      const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
+      leaf_tests += popcount8(leaf_a) * popcount8(leaf_b);
+      // only B's children that reach A's node sphere can reach a leaf below A: one test of all of
+      // them against it saves the row of tests of each that does not (a third to a half of them)
+      std::uint64_t hits = 0;
+      for (std::uint32_t m = overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, e.ax, e.ay, e.az,
+                                              e.ar + search_margin) &
+                             ((1u << b.count[e.b]) - 1u);
+           m; m &= m - 1u) {
+        const int j = std::countr_zero(m);
+        hits |= static_cast<std::uint64_t>(overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j],
+                                                            tb[WB + j], tb[2 * WB + j],
+                                                            tb[3 * WB + j] + search_margin))
+                << (8 * j);
+      }
+      const std::uint64_t leaf_pairs =
+          hits & kByteMask[leaf_b] & (static_cast<std::uint64_t>(leaf_a) * 0x0101010101010101ull);
+      for (std::uint64_t m = leaf_pairs; m; m &= m - 1u) {
+        const int bit = std::countr_zero(m), j = bit >> 3, k = bit & 7;
+        lb.add(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],
+               tb[3 * WB + j], ~ca[k], ~cb[j]);
+      }
+      for (std::uint64_t m = hits & ~leaf_pairs; m; m &= m - 1u) {
+        const int bit = std::countr_zero(m), j = bit >> 3, k = bit & 7;
+        push_prefetched<WA, WB>(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j],
+                                tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
+      }
+    }
+    flush();
+  }
 };
 
-Traversal make_traversal(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, const VolumeQueryOptions& options,
-                         std::vector<VolumeQuery::StackEntry>* stack, PairOverlap* pairs,
-                         std::vector<VolumeQuery::Candidate>* candidates) {
+Traversal make_traversal(const SphereTree& a, const SphereTree& b, const Pose& b_in_a,
+                         const VolumeQueryOptions& options, std::vector<VolumeQuery::StackEntry>* stack,
+                         PairOverlap* pairs, std::vector<VolumeQuery::Candidate>* candidates,
+                         detail::LeafBatch* batch) {
   const float margin = std::max(0.f, options.contact_margin);
-  return Traversal{a.blocks(), b.blocks(), a.leaves().data(), detail::FloatTransform::from(b_in_a), stack, pairs,
-                   options.collect_pairs ? options.pair_capacity : 0, margin, margin, candidates, 0, 0, 0, 0, 0, Totals{}};
+  return Traversal{a.blocks(),
+                   b.blocks(),
+                   a.leaves().data(),
+                   detail::FloatTransform::from(b_in_a),
+                   stack,
+                   0,
+                   pairs,
+                   options.collect_pairs ? options.pair_capacity : 0,
+                   margin,
+                   margin,
+                   candidates,
+                   batch,
+                   0,
+                   0,
+                   0,
+                   0,
+                   0,
+                   Totals{}};
 }
 
 // Fills a result from a finished traversal or candidate test.
@@ -285,12 +494,11 @@ void finish(const Traversal& t, bool collect_pairs, VolumeQueryResult& result) {
 }  // namespace
 
 void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, bool keep_candidates) {
-  Traversal t = make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_);
+  Traversal t = make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_, batch_.get());
   if (keep_candidates) {
     t.search_margin += options_.coherence_skin;
     candidates_.clear();
   }
-  stack_.clear();
 
   // the roots: A's and B's root spheres, B's moved into A's frame
   const SphereTreeNode& ra = a.root();
@@ -307,7 +515,7 @@ void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose&
       else
         t.add_pair(ra.x, ra.y, ra.z, ra.radius, x, y, z, rb.radius, ra.first, rb.first);
     } else {
-      t.push(t.a.root, t.b.root, x, y, z, rb.radius);
+      t.push(t.a.root, t.b.root, ra.x, ra.y, ra.z, ra.radius, x, y, z, rb.radius);
     }
   }
   // one loop per pair of block widths (trees built with arity <= 4 and > 4 can meet)
@@ -315,9 +523,14 @@ void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose&
   if (keep_candidates) {
     if (!wide_a) wide_b ? t.run<4, 8, true>() : t.run<4, 4, true>();
     else wide_b ? t.run<8, 8, true>() : t.run<8, 4, true>();
-  } else {
+  } else if (options_.reference_kernel) {
     if (!wide_a) wide_b ? t.run<4, 8, false>() : t.run<4, 4, false>();
     else wide_b ? t.run<8, 8, false>() : t.run<8, 4, false>();
+  } else {
+    if (!wide_a)
+      wide_b ? t.run_fast<4, 8>() : t.run_fast<4, 4>();
+    else
+      wide_b ? t.run_fast<8, 8>() : t.run_fast<8, 4>();
   }
   finish(t, options_.collect_pairs, result_);
   if (!keep_candidates) return;
@@ -366,7 +579,7 @@ bool VolumeQuery::candidates_hold(const SphereTree& a, const SphereTree& b, cons
 }
 
 void VolumeQuery::test_candidates(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) {
-  Traversal t = make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_);
+  Traversal t = make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_, batch_.get());
   // B's candidate leaves moved into A's frame once, with the traversal's float arithmetic (same
   // association as its SIMD transform), so that a pair's distance is bit for bit the traversal's
   const auto leaves_b = b.leaves();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <set>
@@ -21,6 +22,48 @@ using testing::Shape;
 
 Vec3 v3(const float f[3]) { return {static_cast<double>(f[0]), static_cast<double>(f[1]), static_cast<double>(f[2])}; }
 
+// The query's result at one pose against brute force over all leaf pairs (long double lens
+// reference, double sums). Returns false (after failing) when the pose's check failed.
+void expect_pose_matches_brute_force(VolumeQuery& query, const SphereTree& ta, const SphereTree& tb,
+                                     const std::vector<Sphere>& la, const std::vector<Sphere>& lb,
+                                     const Pose& pose, int k) {
+  const VolumeQueryResult& r = query.run(ta, tb, pose);
+  const testing::BruteVolume ref = brute_volume(la, lb, pose);
+  const double scale = std::max(ref.volume, 1e-9);
+  ASSERT_NEAR(r.total_volume, ref.volume, 1e-4 * scale + 1e-9) << "pose " << k;
+  ASSERT_EQ(r.stats.overlapping_pairs, r.pair_count);
+  if (ref.volume == 0.0) {
+    EXPECT_EQ(r.pair_count, 0);
+    return;
+  }
+  // the same pair set, up to pairs whose lens is at float round-off
+  std::set<std::pair<int, int>> got;
+  for (const PairOverlap& p : query.pairs()) got.emplace(p.leaf_a, p.leaf_b);
+  std::size_t missing = 0;
+  for (std::size_t i = 0; i < ref.pairs.size(); ++i)
+    if (!got.count(ref.pairs[i])) {
+      ++missing;
+      EXPECT_LT(ref.pair_volumes[i], 1e-6 * scale) << "pose " << k << " pair missing";
+    }
+  EXPECT_EQ(got.size(), query.pairs().size()) << "a pair reported twice";
+  EXPECT_LE(got.size(), ref.pairs.size() - missing + 2);
+  // weighted normal sum and centroid
+  const Vec3 dn = r.weighted_normal_sum - ref.normal_sum;
+  EXPECT_LT(norm(dn), 1e-4 * scale + 1e-4 * norm(ref.normal_sum)) << "pose " << k;
+  EXPECT_LT(norm(r.volume_centroid - ref.centroid_sum / ref.volume), 1e-4) << "pose " << k;
+  EXPECT_LT(norm(r.volume_gradient - ref.gradient), 1e-3 * norm(ref.gradient) + 1e-6) << "pose " << k;
+  // per-pair entries agree with the totals
+  double sum = 0.0;
+  Vec3 nsum{};
+  for (const PairOverlap& p : query.pairs()) {
+    sum += static_cast<double>(p.volume);
+    nsum += static_cast<double>(p.volume) * v3(p.normal);
+    EXPECT_NEAR(norm(v3(p.normal)), 1.0, 1e-5);
+  }
+  EXPECT_NEAR(sum, r.total_volume, 1e-5 * r.total_volume);
+  EXPECT_LT(norm(nsum - r.weighted_normal_sum), 1e-5 * r.total_volume);
+}
+
 void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector<Sphere>& lb, int arity_a, int arity_b,
                                 int poses, std::uint32_t seed) {
   const auto ta = build_sphere_tree(la, {.arity = arity_a});
@@ -31,44 +74,38 @@ void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector
   int overlapping_poses = 0;
   for (int k = 0; k < poses; ++k) {
     const Pose pose = testing::random_pose(rng, 1.2);
-    const VolumeQueryResult& r = query.run(*ta, *tb, pose);
-    const testing::BruteVolume ref = brute_volume(la, lb, pose);
-    const double scale = std::max(ref.volume, 1e-9);
-    ASSERT_NEAR(r.total_volume, ref.volume, 1e-4 * scale + 1e-9) << "pose " << k;
-    ASSERT_EQ(r.stats.overlapping_pairs, r.pair_count);
-    if (ref.volume == 0.0) {
-      EXPECT_EQ(r.pair_count, 0);
-      continue;
-    }
-    ++overlapping_poses;
-    // the same pair set, up to pairs whose lens is at float round-off
-    std::set<std::pair<int, int>> got;
-    for (const PairOverlap& p : query.pairs()) got.emplace(p.leaf_a, p.leaf_b);
-    std::size_t missing = 0;
-    for (std::size_t i = 0; i < ref.pairs.size(); ++i)
-      if (!got.count(ref.pairs[i])) {
-        ++missing;
-        EXPECT_LT(ref.pair_volumes[i], 1e-6 * scale) << "pose " << k << " pair missing";
-      }
-    EXPECT_EQ(got.size(), query.pairs().size()) << "a pair reported twice";
-    EXPECT_LE(got.size(), ref.pairs.size() - missing + 2);
-    // weighted normal sum and centroid
-    const Vec3 dn = r.weighted_normal_sum - ref.normal_sum;
-    EXPECT_LT(norm(dn), 1e-4 * scale + 1e-4 * norm(ref.normal_sum)) << "pose " << k;
-    EXPECT_LT(norm(r.volume_centroid - ref.centroid_sum / ref.volume), 1e-4) << "pose " << k;
-    EXPECT_LT(norm(r.volume_gradient - ref.gradient), 1e-3 * norm(ref.gradient) + 1e-6) << "pose " << k;
-    // per-pair entries agree with the totals
-    double sum = 0.0;
-    Vec3 nsum{};
-    for (const PairOverlap& p : query.pairs()) {
-      sum += static_cast<double>(p.volume);
-      nsum += static_cast<double>(p.volume) * v3(p.normal);
-      EXPECT_NEAR(norm(v3(p.normal)), 1.0, 1e-5);
-    }
-    EXPECT_NEAR(sum, r.total_volume, 1e-5 * r.total_volume);
-    EXPECT_LT(norm(nsum - r.weighted_normal_sum), 1e-5 * r.total_volume);
+    expect_pose_matches_brute_force(query, *ta, *tb, la, lb, pose, k);
+    if (query.result().total_volume > 0.0) ++overlapping_poses;
   }
   EXPECT_GT(overlapping_poses, poses / 3) << "the random poses hardly overlap: the test would prove little";
+}
+
+// Deep poses as in the query benchmark: B at random orientations, each moved along a random
+// direction until the packings overlap by half of what they overlap when centred on each other
+// (the benchmark's bunny packings are dense, 0.86, and there a quarter of the packing volume is
+// about half of it; the test packings are sparse). Bisection on the reference path's volume.
+std::vector<Pose> deep_poses(const SphereTree& ta, const SphereTree& tb, int count, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  VolumeQuery q({.collect_pairs = false, .reference_kernel = true});
+  const Vec3 ca = testing::centre({ta.root().x, ta.root().y, ta.root().z, 0.f});
+  const Vec3 cb = testing::centre({tb.root().x, tb.root().y, tb.root().z, 0.f});
+  const double reach = static_cast<double>(ta.root().radius + tb.root().radius);
+  std::vector<Pose> out;
+  while (static_cast<int>(out.size()) < count) {
+    const Quat rot = normalized(Quat{g(rng), g(rng), g(rng), g(rng)});
+    const Vec3 dir = normalized(Vec3{g(rng), g(rng), g(rng)});
+    const auto at = [&](double s) { return Pose{rot, ca + s * dir - rotate(rot, cb)}; };
+    const auto volume = [&](double s) { return q.run(ta, tb, at(s)).total_volume; };
+    const double target = 0.5 * volume(0.0);
+    double lo = 0.0, hi = reach;
+    for (int i = 0; i < 30; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (volume(mid) > target ? lo : hi) = mid;
+    }
+    out.push_back(at(lo));
+  }
+  return out;
 }
 
 TEST(VolumeQuery, MatchesBruteForceOnRandomPoses) {
@@ -160,6 +197,66 @@ TEST(VolumeQuery, TruncatesAtCapacityButKeepsTotals) {
   EXPECT_FALSE(n.truncated);
   EXPECT_DOUBLE_EQ(n.total_volume, all.total_volume);
 }
+
+TEST(VolumeQuery, DeepPosesMatchBruteForce) {
+  // a quarter of the volume overlapping: thousands of pairs, every visit type of the traversal
+  const auto la = make_packing(0.13, Shape::kBall, 71);
+  const auto lb = make_packing(0.11, Shape::kBox, 72);
+  for (const auto& [arity_a, arity_b] : {std::pair{8, 8}, std::pair{4, 8}, std::pair{8, 3}}) {
+    const auto ta = build_sphere_tree(la, {.arity = arity_a});
+    const auto tb = build_sphere_tree(lb, {.arity = arity_b});
+    ASSERT_TRUE(ta && tb);
+    VolumeQuery query;
+    const std::vector<Pose> poses =
+        deep_poses(*ta, *tb, 3, 300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      expect_pose_matches_brute_force(query, *ta, *tb, la, lb, poses[k], static_cast<int>(k));
+      EXPECT_GT(query.result().stats.overlapping_pairs, 300) << "not deep: the test would prove little";
+    }
+  }
+}
+
+// The fast path (SIMD node tests and lens kernel) against the reference path (the scalar path it
+// replaced): the same pairs in the same order with bit-identical volumes, areas, normals and
+// centroids, the same near pairs of a contact margin, and totals equal up to summation order.
+void expect_fast_equals_reference(float margin) {
+  const auto la = make_packing(0.11, Shape::kBall, 81);
+  const auto lb = make_packing(0.09, Shape::kRod, 82);
+  for (const auto& [arity_a, arity_b] : {std::pair{8, 8}, std::pair{8, 4}, std::pair{4, 4}}) {
+    const auto ta = build_sphere_tree(la, {.arity = arity_a});
+    const auto tb = build_sphere_tree(lb, {.arity = arity_b});
+    ASSERT_TRUE(ta && tb);
+    VolumeQuery fast({.contact_margin = margin});
+    VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
+    for (const Pose& pose :
+         deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {
+      const VolumeQueryResult f = fast.run(*ta, *tb, pose);
+      const VolumeQueryResult& r = reference.run(*ta, *tb, pose);
+      ASSERT_GT(r.pair_count, 150);
+      ASSERT_EQ(f.pair_count, r.pair_count);
+      ASSERT_EQ(f.stats.overlapping_pairs, r.stats.overlapping_pairs);
+      ASSERT_EQ(f.near_pairs, r.near_pairs);
+      if (margin > 0.f) {
+        EXPECT_GT(r.near_pairs, 0) << "the margin found no near pairs: the test would prove little";
+      }
+      for (int i = 0; i < r.pair_count; ++i) {
+        const PairOverlap& pf = fast.pairs()[static_cast<std::size_t>(i)];
+        const PairOverlap& pr = reference.pairs()[static_cast<std::size_t>(i)];
+        ASSERT_EQ(std::memcmp(&pf, &pr, sizeof(PairOverlap)), 0)
+            << "pair " << i << ": (" << pf.leaf_a << ", " << pf.leaf_b << ") volume " << pf.volume
+            << " against (" << pr.leaf_a << ", " << pr.leaf_b << ") volume " << pr.volume;
+      }
+      EXPECT_NEAR(f.total_volume, r.total_volume, 1e-12 * r.total_volume);
+      EXPECT_LT(norm(f.weighted_normal_sum - r.weighted_normal_sum), 1e-12 * r.total_volume);
+      EXPECT_LT(norm(f.volume_gradient - r.volume_gradient), 1e-12 * norm(r.volume_gradient));
+      EXPECT_LT(norm(f.volume_centroid - r.volume_centroid), 1e-12);
+    }
+  }
+}
+
+TEST(VolumeQuery, FastPathEqualsReferencePathOnDeepPoses) { expect_fast_equals_reference(0.f); }
+
+TEST(VolumeQuery, FastPathEqualsReferencePathWithContactMargin) { expect_fast_equals_reference(0.02f); }
 
 TEST(VolumeQuery, PrunesMostLeafPairs) {
   // the traversal must test far fewer leaf pairs than brute force (n_a * n_b)

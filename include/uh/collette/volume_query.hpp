@@ -19,6 +19,7 @@
 /// \endcode
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -29,6 +30,10 @@
 #include "uh/core/math.hpp"
 
 namespace uh::collette {
+
+namespace detail {
+struct LeafBatch;
+}
 
 /// One overlapping leaf pair as the query stores it, in A's mesh frame. 40 bytes.
 struct PairOverlap {
@@ -64,6 +69,10 @@ struct VolumeQueryOptions {
   /// the skin holds few more pairs than overlap: docs/collette-queries.md, "Coherence".
   float coherence_skin = 0.f;
   int candidate_reserve = 0;      ///< initial candidate entries (0: twice pair_capacity, at least 1024)
+  /// Evaluate leaf pairs one at a time with the scalar lens kernel, as before the SIMD kernels:
+  /// the reference that tests and benchmarks compare the fast path with. Same results (the same
+  /// pairs, bit for bit, and the same totals), slower.
+  bool reference_kernel = false;
 };
 
 /// Totals of one VolumeQuery::run, in A's mesh frame. Trivially copyable.
@@ -95,6 +104,9 @@ static_assert(std::is_trivially_copyable_v<VolumeQueryResult>);
 class VolumeQuery {
  public:
   explicit VolumeQuery(const VolumeQueryOptions& options = {});
+  ~VolumeQuery();
+  VolumeQuery(VolumeQuery&&) noexcept;
+  VolumeQuery& operator=(VolumeQuery&&) noexcept;
 
   /// Runs the query for B at pose `b_in_a` (maps B's mesh frame to A's mesh frame).
   /// Returns the totals (valid until the next run); pairs() holds the stored pairs.
@@ -127,11 +139,12 @@ class VolumeQuery {
   const VolumeQueryOptions& options() const { return options_; }
 
   /// One entry of the traversal stack: a node pair known to overlap, as traversal ids
-  /// (SphereTree::Blocks), with B's node sphere already in A's frame (so each B node is
+  /// (SphereTree::Blocks), with both node spheres, B's already in A's frame (so each B node is
   /// transformed once per visit).
   struct StackEntry {
     std::int32_t a;
     std::int32_t b;
+    float ax, ay, az, ar;
     float bx, by, bz, br;
   };
 
@@ -147,6 +160,7 @@ class VolumeQuery {
   bool candidates_hold(const SphereTree& a, const SphereTree& b, const Pose& b_in_a) const;
 
   VolumeQueryOptions options_;
+  std::unique_ptr<detail::LeafBatch> batch_;  // leaf pairs waiting for the SIMD lens kernel (10 KB)
   std::vector<StackEntry> stack_;
   std::vector<PairOverlap> pairs_;
   VolumeQueryResult result_;
