@@ -477,9 +477,8 @@ void HaplyDevice::run_loop() {
 }
 
 void HaplyDevice::stop() {
-  if (!running()) return;
   stop_requested_.store(true, std::memory_order_release);
-  // bounded: every exchange of the loop has its time limit
+  // bounded: every exchange of the loop has its time limit; a run that ended by itself is joined here
   join_thread();
 }
 

@@ -22,6 +22,9 @@ thread_local bool t_in_frame = false;
 
 // how long stop() waits for the servo thread to end the run before giving up on it
 constexpr auto kStopWait = std::chrono::seconds(2);
+// a run whose scheduler runs no frame for this long has stalled: the watchdog ends it, forces off
+// (250 servo periods at 1 kHz: far beyond any scheduling hiccup, short for a hand on the stylus)
+constexpr auto kStallLimit = std::chrono::milliseconds(250);
 
 // HD's frame (x right, y up, z toward the user) -> the field's (x toward the operator, y right, z up)
 constexpr int kFromHd[3] = {2, 0, 1};  // field axis i is HD axis kFromHd[i]
@@ -215,8 +218,7 @@ void OpenHapticsDevice::in_own_frame(Body&& body) {
 void OpenHapticsDevice::check_frame_errors(const char* where) {
   const hd::Api& api = *api_;
   const hd::HDErrorInfo e = api.hdGetError();
-  if (e.errorCode == hd::kSuccess || faulted_) return;
-  faulted_ = true;
+  if (e.errorCode == hd::kSuccess || faulted_.exchange(true)) return;
   // forces off at once; the HapticManager sends zero too from the next tick, which HD then ignores
   api.hdDisable(hd::kForceOutput);
   forces_on_ = false;
@@ -303,12 +305,15 @@ Status OpenHapticsDevice::start(double rate_hz, FixedRateLoop::Callback tick,
   api.hdSetSchedulerRate(static_cast<unsigned long>(std::lround(rate_hz)));
   api.hdStartScheduler();
   if (Status s = setup_error(fmt::format("setting the servo rate to {} Hz", rate_hz).c_str()); !s) return s;
+  last_frame_ns_.store(Clock::now().time_since_epoch().count(), std::memory_order_relaxed);
   running_.store(true, std::memory_order_release);
   handle_ = api.hdScheduleAsynchronous(&OpenHapticsDevice::servo_frame, this, hd::kMaxSchedulerPriority);
   if (Status s = setup_error("scheduling the haptic tick (hdScheduleAsynchronous)"); !s) {
     running_.store(false, std::memory_order_release);
     return s;
   }
+  watchdog_stop_.store(false, std::memory_order_relaxed);
+  watchdog_ = std::thread([this] { watch(); });
   return Ok{};
 }
 
@@ -319,6 +324,7 @@ unsigned int OpenHapticsDevice::servo_frame(void* self) {
 unsigned int OpenHapticsDevice::run_frame() {
   const hd::Api& api = *api_;
   const Clock::time_point start = Clock::now();
+  last_frame_ns_.store(start.time_since_epoch().count(), std::memory_order_relaxed);
   api.hdBeginFrame(hhd_);
   t_in_frame = true;
   run_.begin_frame(start, start);
@@ -338,7 +344,33 @@ unsigned int OpenHapticsDevice::run_frame() {
   return done ? hd::kCallbackDone : hd::kCallbackContinue;
 }
 
+void OpenHapticsDevice::watch() {
+  while (!watchdog_stop_.load(std::memory_order_acquire) && running()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    const Clock::time_point last{Clock::duration(last_frame_ns_.load(std::memory_order_relaxed))};
+    if (Clock::now() - last < kStallLimit || !running()) continue;
+    // the scheduler no longer runs frames: forces off without it, no more frames asked of it, and
+    // the run over, so that the session ends now (the HapticManager latches it as a device fault)
+    const hd::Api& api = *api_;
+    api.hdUnschedule(handle_);
+    api.hdDisable(hd::kForceOutput);
+    servo_dead_.store(true);
+    if (!faulted_.exchange(true))
+      fault_.note("the HD scheduler stopped running servo frames",
+                  "no frame for 250 ms; forces were disabled");
+    running_.store(false, std::memory_order_release);
+    return;
+  }
+}
+
+void OpenHapticsDevice::stop_watchdog() {
+  watchdog_stop_.store(true, std::memory_order_release);
+  if (watchdog_.joinable()) watchdog_.join();
+}
+
 void OpenHapticsDevice::stop() {
+  // the watchdog first: from here only this thread decides about the run
+  stop_watchdog();
   if (!running()) return;
   const hd::Api& api = *api_;
   stop_requested_.store(true, std::memory_order_release);
@@ -348,9 +380,9 @@ void OpenHapticsDevice::stop() {
     // the scheduler no longer runs frames: forces off without it, and no more frames asked of it
     api.hdUnschedule(handle_);
     api.hdDisable(hd::kForceOutput);
-    servo_dead_ = true;
-    faulted_ = true;
-    fault_.note("the HD scheduler stopped running servo frames", "no frame for 2 s; forces were disabled");
+    servo_dead_.store(true);
+    if (!faulted_.exchange(true))
+      fault_.note("the HD scheduler stopped running servo frames", "no frame for 2 s; forces were disabled");
     running_.store(false, std::memory_order_release);
     return;
   }

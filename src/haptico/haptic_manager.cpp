@@ -120,6 +120,7 @@ Status HapticManager::start() {
   auto on_exit = [this](const LoopExit& exit) { on_loop_exit(exit); };
   Status started =
       servo_ != nullptr ? servo_->start(options_.rate_hz, on_tick, on_exit) : loop_.start(on_tick, on_exit);
+  servo_run_started_ = servo_ != nullptr && started;
   if (!started) allow_binding();
   return started;
 }
@@ -155,11 +156,12 @@ std::uint64_t HapticManager::missed_deadlines() const {
 }
 
 void HapticManager::stop() {
-  if (servo_ != nullptr && servo_->running()) {
+  if (servo_ != nullptr && servo_run_started_) {
     servo_->stop();
     // a run whose last frame never came: the device's servo thread stopped answering (the clock
-    // gave up on it and turned forces off); latched like any device fault
+    // gave up on it and turned forces off, maybe before this stop); latched like any device fault
     if (!ended_with_zero_) faulted_.store(true, std::memory_order_release);
+    servo_run_started_ = false;
   }
   loop_.stop();
   // the haptic thread is joined: this thread may talk to the device and bind delegates now

@@ -92,12 +92,15 @@ struct Interrupt {
   // uh run --device forcedimension:0 on the stand-in DHD library (its handle rests at the origin,
   // inside the bunny): the driver's path from the signal to the zero, not only the simulated one's
   bool force_dimension = false;
+  // uh run --device openhaptics on the stand-in libHD: the tick runs on the library's own servo
+  // thread, and the stand-in records what the device was last commanded as uh released it
+  bool open_haptics = false;
 };
 
 // names the case in test output (instead of the struct's bytes)
 void PrintTo(const Interrupt& i, std::ostream* out) {
   *out << (i.signal_number == SIGINT ? "SIGINT" : "SIGTERM") << (i.view ? " with --view" : "")
-       << (i.force_dimension ? " on forcedimension" : "");
+       << (i.force_dimension ? " on forcedimension" : "") << (i.open_haptics ? " on openhaptics" : "");
 }
 
 class RunSignalTest : public ::testing::TestWithParam<Interrupt> {};
@@ -106,13 +109,17 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   const int signal_number = GetParam().signal_number;
   const bool view = GetParam().view;
   const bool force_dimension = GetParam().force_dimension;
+  const bool open_haptics = GetParam().open_haptics;
   const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
-  const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}{}", ::getpid(), signal_number,
-                                                               view ? "_view" : "", force_dimension ? "_dhd" : "");
+  const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}{}", ::getpid(),
+                                                               signal_number, view ? "_view" : "",
+                                                               force_dimension ? "_dhd"
+                                                               : open_haptics  ? "_hd"
+                                                                               : "");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.json", trace = dir / "trace.csv", out = dir / "stdout.txt",
-                 err = dir / "stderr.txt";
+                 err = dir / "stderr.txt", hd_record = dir / "hd_release.txt";
   std::ofstream(scene) << long_scene_json(fs::path(UH_TEST_DATA_DIR));
 
   // everything the child needs is prepared before fork(): it only redirects and execs
@@ -121,15 +128,21 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
                                    "--trace",   trace.string(), "--no-realtime"};
   if (view) args.insert(args.end(), {"--view", "--port", "0"});
   if (force_dimension) args.insert(args.end(), {"--device", "forcedimension:0"});
+  if (open_haptics) args.insert(args.end(), {"--device", "openhaptics"});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   std::vector<std::string> env_storage = {cache_env, "CI=1"};
   if (force_dimension) env_storage.push_back(std::string("UH_FORCEDIMENSION_LIBRARY=") + UH_STANDIN_DHD);
+  if (open_haptics) {
+    env_storage.push_back(std::string("UH_OPENHAPTICS_LIBRARY=") + UH_STANDIN_HD);
+    env_storage.push_back("UH_STANDIN_HD_RECORD=" + hd_record.string());
+  }
   for (char** e = environ; *e != nullptr; ++e) {
     const std::string entry(*e);
     if (entry.rfind("UH_CACHE_DIR=", 0) != 0 && entry.rfind("CI=", 0) != 0 &&
-        entry.rfind("UH_FORCEDIMENSION_LIBRARY=", 0) != 0)
+        entry.rfind("UH_FORCEDIMENSION_LIBRARY=", 0) != 0 && entry.rfind("UH_OPENHAPTICS_LIBRARY=", 0) != 0 &&
+        entry.rfind("UH_STANDIN_HD_RECORD=", 0) != 0)
       env_storage.push_back(entry);
   }
   std::vector<char*> envp;
@@ -147,14 +160,19 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
     _exit(121);
   }
 
-  // running: the haptic thread exists (the handlers are in place before it starts); then some
+  // running: the haptic thread exists (the handlers are in place before it starts; on openhaptics
+  // the haptic tick runs on HD's servo thread, the collision thread starts with it); then some
   // ticks in contact, so that there is a force to take away
+  const auto running = [&] {
+    return open_haptics ? has_thread(pid, "uh-collision") && has_thread(pid, "hd-servo")
+                        : has_thread(pid, "uh-haptic");
+  };
   const auto deadline = std::chrono::steady_clock::now() + 60s;
-  while (!has_thread(pid, "uh-haptic") && std::chrono::steady_clock::now() < deadline) {
+  while (!running() && std::chrono::steady_clock::now() < deadline) {
     if (waitpid(pid, nullptr, WNOHANG) != 0) FAIL() << "uh run ended before it ran: " << read_text(err);
     std::this_thread::sleep_for(5ms);
   }
-  ASSERT_TRUE(has_thread(pid, "uh-haptic")) << "uh run never started its haptic thread: " << read_text(err);
+  ASSERT_TRUE(running()) << "uh run never started its haptic thread: " << read_text(err);
   std::this_thread::sleep_for(400ms);
   ASSERT_EQ(kill(pid, signal_number), 0);
   const auto signalled = std::chrono::steady_clock::now();
@@ -217,17 +235,34 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   EXPECT_NE(static_cast<unsigned>(v[column("flags")]) & 1024u, 0u)
       << "the zero sent as the haptic thread ended: " << last;
   EXPECT_GT(max_force, 0.1) << "the stylus pressed into the bunny before the signal";
+  if (open_haptics) {
+    // what the device itself was left with as uh released it: zero commanded, forces off
+    std::istringstream record(read_text(hd_record));
+    std::string key;
+    double fx = 1.0, fy = 1.0, fz = 1.0, largest = 0.0;
+    int force_output = 1;
+    record >> key >> fx >> fy >> fz >> key >> force_output >> key >> largest;
+    ASSERT_TRUE(record) << "the stand-in's record at release: '" << read_text(hd_record) << "'";
+    EXPECT_EQ(fx, 0.0);
+    EXPECT_EQ(fy, 0.0);
+    EXPECT_EQ(fz, 0.0);
+    EXPECT_EQ(force_output, 0);
+    EXPECT_GT(largest, 0.1) << "the device rendered the contact force before the signal";
+  }
   fs::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest,
                          ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false},
                                            Interrupt{SIGINT, true}, Interrupt{SIGTERM, true},
-                                           Interrupt{SIGINT, false, true}, Interrupt{SIGTERM, false, true}),
+                                           Interrupt{SIGINT, false, true}, Interrupt{SIGTERM, false, true},
+                                           Interrupt{SIGINT, false, false, true},
+                                           Interrupt{SIGTERM, false, false, true}),
                          [](const ::testing::TestParamInfo<Interrupt>& p) {
                            return std::string(p.param.signal_number == SIGINT ? "Sigint" : "Sigterm") +
                                   (p.param.view ? "WithView" : "") +
-                                  (p.param.force_dimension ? "OnForceDimension" : "");
+                                  (p.param.force_dimension ? "OnForceDimension" : "") +
+                                  (p.param.open_haptics ? "OnOpenHaptics" : "");
                          });
 
 }  // namespace

@@ -1,5 +1,5 @@
 // Tests on a real device, run only when UH_HARDWARE names its driver (see docs/devices.md):
-//   UH_HARDWARE=forcedimension (or openhaptics) ctest --test-dir build/release -L hardware
+//   UH_HARDWARE=forcedimension (or openhaptics, haply) ctest --test-dir build/release -L hardware
 //   --output-on-failure
 // Hold the handle lightly: the forces are small (at most 1 N) and pull toward the workspace centre.
 #include <gtest/gtest.h>
@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "uh/devices/force_dimension_device.hpp"
+#include "uh/devices/haply_device.hpp"
 #include "uh/devices/hardware_drivers.hpp"
 #include "uh/devices/open_haptics_device.hpp"
 #include "uh/haptico/haptic_manager.hpp"
@@ -120,6 +121,65 @@ TEST(Hardware, OpenHapticsRendersAGentleSpringOnHdsClock) {
   EXPECT_GT(stats.loop.achieved_rate_hz, 500.0);
   std::printf("  HD scheduler %.0f Hz over %llu ticks, jitter p99 %.0f us\n", stats.loop.achieved_rate_hz,
               static_cast<unsigned long long>(stats.ticks), stats.loop.period_error.p99_ns * 1e-3);
+}
+
+// Haply: the Inverse Service running (Haply Hub) with the Inverse3 listed; UH_HAPLY_URL for another
+// address. The service reports no workspace: the states are checked against 0.5 m, a bound no
+// desk device exceeds, and printed so that the axes can be checked by moving the handle.
+TEST(Hardware, HaplyDescribesItselfAndReadsLiveStates) {
+  UH_REQUIRE_HARDWARE("haply");
+  auto created = all_drivers().create("haply", {});
+  ASSERT_TRUE(created) << created.error().message;
+  auto& device = **created;
+  const Status opened = device.open();
+  ASSERT_TRUE(opened) << opened.error().message;
+  const haptico::DeviceInfo info = device.info();
+  std::printf("  %s at %s, %d-DOF sensed, the service lists %zu Inverse3\n", info.name.c_str(),
+              dynamic_cast<HaplyDevice&>(device).url().path.c_str(), info.dof_sensed,
+              dynamic_cast<HaplyDevice&>(device).inventory().size());
+  double last_time = -1.0;
+  for (int i = 0; i < 2000; ++i) {
+    device.command({});  // outside a run each command is one exchange: a zero force, a fresh state
+    const DeviceState s = device.read_state();
+    ASSERT_EQ(s.status, DeviceStatus::kOk) << device.fault_reason();
+    EXPECT_GT(s.time_s, last_time);
+    last_time = s.time_s;
+    EXPECT_LE(norm(s.position), 0.5);
+    if (i % 250 == 0)
+      std::printf("  position %+.4f %+.4f %+.4f m, buttons %u\n", s.position.x, s.position.y, s.position.z,
+                  s.buttons);
+  }
+  EXPECT_TRUE(device.close());
+}
+
+TEST(Hardware, HaplyRendersAGentleSpringOnTheServicesClock) {
+  UH_REQUIRE_HARDWARE("haply");
+  auto created = all_drivers().create("haply", {{"max_force_n", "1"}});
+  ASSERT_TRUE(created) << created.error().message;
+  haptico::HapticManager manager(std::move(created).value(), {.rate_hz = 1000.0});
+  ASSERT_TRUE(manager.open());
+  // the service's origin is not the workspace's centre: the spring pulls toward where the handle was
+  Vec3 anchor{};
+  bool anchored = false;
+  manager.move_on_haptic_tick().add_delegate([&](const DeviceState& s) {
+    if (!anchored) anchor = s.position;
+    anchored = true;
+  });
+  manager.force_on_haptic_tick().add_delegate([&](const DeviceState& s, DeviceCommand& c) {
+    c.force = -50.0 * (s.position - anchor) - 2.0 * s.linear_velocity;
+  });
+  const Status started = manager.start();
+  ASSERT_TRUE(started) << started.error().message;
+  while (manager.ticks() < 2000 && manager.running())
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  manager.stop();
+  const Status device = manager.device_status();
+  EXPECT_TRUE(device) << device.error().message;
+  const haptico::HapticStats stats = manager.stats();
+  EXPECT_GE(stats.ticks, 2000u);
+  std::printf("  the service's replies at %.0f Hz over %llu ticks, jitter p99 %.0f us\n",
+              stats.loop.achieved_rate_hz, static_cast<unsigned long long>(stats.ticks),
+              stats.loop.period_error.p99_ns * 1e-3);
 }
 
 }  // namespace

@@ -266,5 +266,29 @@ TEST(OpenHapticsDevice, ASchedulerThatStopsAnsweringEndsWithForcesOffAndAFault) 
       "forces were disabled; it was sent zero force");
 }
 
+// a scheduler that stops running frames mid-run, with nobody stopping the run: the watchdog ends
+// it at once, forces off, and the manager reports the device's fault when the session stops it
+TEST(OpenHapticsDevice, AStallMidRunEndsTheRunAtOnceWithForcesOff) {
+  testing::HdStandin standin;
+  HapticManager manager(make(standin_config()), {.rate_hz = 1000.0});
+  manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& c) {
+    c.force = {0.0, 0.0, 1.0};
+  });
+  ASSERT_TRUE(manager.start());
+  wait_for([&] { return standin.get("force_output") == 1.0; });
+  ASSERT_EQ(standin.get("force_output"), 1.0);
+  standin.set("freeze", 1);
+  wait_for([&] { return !manager.running(); });
+  ASSERT_FALSE(manager.running()) << "the run ended by itself";
+  EXPECT_EQ(standin.get("force_output"), 0.0);
+  manager.stop();
+  const Status status = manager.device_status();
+  ASSERT_FALSE(status);
+  EXPECT_EQ(
+      status.error().message,
+      "device 'openhaptics Touch' faulted: the HD scheduler stopped running servo frames: no frame for 250 "
+      "ms; forces were disabled; it was sent zero force");
+}
+
 }  // namespace
 }  // namespace uh::devices

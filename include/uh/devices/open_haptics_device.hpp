@@ -7,6 +7,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "uh/core/result.hpp"
 #include "uh/core/tick_recorder.hpp"
@@ -96,6 +97,9 @@ class OpenHapticsDevice final : public haptico::ClockedDevice, private haptico::
   template <typename Body>
   void in_own_frame(Body&& body);
   void release();
+  // the watchdog thread: a scheduler without a frame for kStallLimit ends the run, forces off
+  void watch();
+  void stop_watchdog();
 
   haptico::DeviceConfig config_;
   Selection selection_;
@@ -107,13 +111,18 @@ class OpenHapticsDevice final : public haptico::ClockedDevice, private haptico::
   std::string serial_;
   double centre_mm_[3] = {0.0, 0.0, 0.0};  // centre of the usable workspace, HD frame
   bool open_ = false;
-  bool servo_dead_ = false;  // the scheduler stopped answering: no more synchronous frames
+  // the scheduler stopped answering: no more synchronous frames (the watchdog or stop() decides)
+  std::atomic<bool> servo_dead_{false};
   // servo thread (and the controlling thread while no frame runs)
   bool forces_on_ = false;
-  bool faulted_ = false;
+  std::atomic<bool> faulted_{false};  // also claimed by the watchdog: the first to set it notes why
   FaultNote fault_;
   // the run
   ServoRun run_;
+  // during a run: a frame's start (steady clock, ns), and the thread that ends a run whose frames stop
+  std::atomic<std::int64_t> last_frame_ns_{0};
+  std::thread watchdog_;
+  std::atomic<bool> watchdog_stop_{false};
   unsigned long handle_ = 0;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> running_{false};

@@ -213,6 +213,7 @@ class HapticManager {
   TickPhase phase_ = TickPhase::kIdle;  // haptic thread
   DeviceState last_state_{};            // haptic thread: the state of the last tick
   bool ended_with_zero_ = false;        // no tick since the last final zero
+  bool servo_run_started_ = false;      // a run on the device's clock started and stop() has not seen it end
   std::string failure_;                 // written by the haptic thread as it ends (thread_status())
   std::int64_t fade_count_ = 0;
   int frozen_ticks_ = 0;          // consecutive ticks with the same device time (haptic thread)

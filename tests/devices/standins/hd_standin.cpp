@@ -4,12 +4,15 @@
 // frame (millimetres; x right, y up, z toward the user) moved by the force of each frame, and fails
 // on script (standin_hd_set). Tests load it through the driver's real loading path and drive the
 // script through the standin_hd_* functions.
+#include <pthread.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <string>
@@ -167,6 +170,8 @@ class Scheduler {
     return false;
   }
   void run() {
+    // a name a test of a whole program can wait for (as HD's servo thread, it is not the program's)
+    pthread_setname_np(pthread_self(), "hd-servo");
     auto next = std::chrono::steady_clock::now();
     for (;;) {
       next += period_;
@@ -264,8 +269,26 @@ UH_EXPORT HHD hdInitDevice(const char* name) {
   return 1;
 }
 
+// For tests of whole programs (uh run stopped by a signal): when UH_STANDIN_HD_RECORD names a file,
+// releasing the device writes there what it was last commanded, whether forces were still on, and
+// the largest force it rendered
+static void record_release_locked() {
+  const char* path = std::getenv("UH_STANDIN_HD_RECORD");
+  if (path == nullptr || *path == '\0') return;
+  const Device& d = g_world.device;
+  double largest = 0.0;
+  for (const auto& f : d.received)
+    largest = std::max(largest, std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+  if (std::FILE* out = std::fopen(path, "w"); out != nullptr) {
+    std::fprintf(out, "force %.17g %.17g %.17g\nforce_output %d\nlargest_rendered %.17g\nframes %ld\n",
+                 d.force[0], d.force[1], d.force[2], d.force_output ? 1 : 0, largest, g_world.frames);
+    std::fclose(out);
+  }
+}
+
 UH_EXPORT void hdDisableDevice(HHD) {
   const std::lock_guard lock(g_mutex);
+  record_release_locked();
   g_world.device.initialised = false;
   g_world.device.force_output = false;
 }
