@@ -430,10 +430,10 @@ class Session {
     call_released([&] { return uh_session_start(session_); });
   }
 
-  State state() const {
+  State state(int tool) const {
     uh_state st{};
     st.struct_size = sizeof st;
-    check(uh_session_poll(session_, &st));
+    check(uh_session_tool_state(session_, tool, &st));
     return State{st.time_s,
                  vector_array(st.tool_position, 3),
                  vector_array(st.tool_orientation, 4),
@@ -481,16 +481,23 @@ class Session {
     return json_loads(json);
   }
 
+  std::vector<std::string> tool_names() const { return names(uh_session_tool_count, uh_session_tool_name); }
   std::vector<std::string> object_names() const {
+    return names(uh_session_object_count, uh_session_object_name);
+  }
+
+  // the session's objects' or tools' names, by their count and name functions
+  std::vector<std::string> names(uh_status (*count)(uh_session*, int32_t*),
+                                 uh_status (*name_of)(uh_session*, int32_t, const char**)) const {
     int32_t n = 0;
-    check(uh_session_object_count(session_, &n));
-    std::vector<std::string> names;
+    check(count(session_, &n));
+    std::vector<std::string> out;
     for (int32_t i = 0; i < n; ++i) {
       const char* name = nullptr;
-      check(uh_session_object_name(session_, i, &name));
-      names.emplace_back(name);
+      check(name_of(session_, i, &name));
+      out.emplace_back(name);
     }
-    return names;
+    return out;
   }
 
   // stops (zero force, joins every thread) and frees; idempotent
@@ -616,7 +623,8 @@ PYBIND11_MODULE(unrealhaptics, m) {
                   py::arg("collision_hz") = -1.0, py::arg("raise_priority") = false,
                   "Opens a session of a scene file path, a Scene, or None (the default scene).")
       .def("start", &Session::start, "Starts the haptic, collision and monitor threads; returns at once.")
-      .def("state", &Session::state, "The newest state (never waits for the haptic thread).")
+      .def("state", &Session::state, py::arg("tool") = 0,
+           "The newest state of a tool (the first by default; never waits for its haptic thread).")
       .def("events", &Session::events, "Contact events queued since the last call, oldest first.")
       .def("set_object_pose", &Session::set_object_pose, py::arg("object"), py::arg("position"),
            py::arg("orientation"))
@@ -626,6 +634,7 @@ PYBIND11_MODULE(unrealhaptics, m) {
            "Runs deterministically on this thread in simulated time; returns the report.")
       .def("report", &Session::report)
       .def_property_readonly("object_names", &Session::object_names)
+      .def_property_readonly("tool_names", &Session::tool_names, "The scene's tools, each on its own device.")
       .def("close", &Session::close, "Stops and frees the session. Idempotent.")
       .def(
           "__enter__", [](Session& s) -> Session& { return s; }, py::return_value_policy::reference)

@@ -81,27 +81,26 @@ struct RunArgs {
   std::string device;
 };
 
-void print_summary(const controllers::SessionReport& r) {
-  std::printf("scene %s: %.1f s%s%s\n", r.scene.c_str(), r.seconds, r.stepped ? " (stepped, simulated time)" : "",
-              r.stopped_early ? " (stopped early)" : "");
+// one device's lines of the summary; `label` names the tool in several-tool sessions
+void print_tool_summary(const controllers::ToolReport& r, bool stepped, const std::string& label) {
   const controllers::DeviceReport& d = r.device;
-  std::printf("  device    %s%s%s, max %.1f N%s\n", d.name.c_str(),
+  std::printf("  device    %s%s%s%s, max %.1f N%s\n", label.c_str(), d.name.c_str(),
               d.serial.empty() ? "" : fmt::format(", serial {}", d.serial).c_str(),
               d.name.rfind(d.driver, 0) == 0 ? "" : fmt::format(" (driver {})", d.driver).c_str(),
               d.max_force_n,
               d.com_rate_hz > 0.0 ? fmt::format(", communication {:.0f} Hz", d.com_rate_hz).c_str() : "");
-  std::printf("  haptic    %.1f Hz (target %.0f), %llu ticks, %llu missed deadlines, jitter p50 %.1f us, p99 %.1f us, max %.1f us\n",
-              r.haptic_rate_hz, r.haptic_target_hz, static_cast<unsigned long long>(r.haptic_ticks),
-              static_cast<unsigned long long>(r.haptic_missed_deadlines), r.jitter_p50_us, r.jitter_p99_us, r.jitter_max_us);
-  std::printf("  collision median %.0f Hz, min %.0f Hz (target %.0f); query median %.1f us, p99 %.1f us, max %.1f us; up to %lld pairs\n",
-              r.collision_rate_median_hz, r.collision_rate_min_hz, r.collision_target_hz, r.query_median_us, r.query_p99_us,
-              r.query_max_us, static_cast<long long>(r.max_pairs));
+  std::printf(
+      "  haptic    %.1f Hz (target %.0f), %llu ticks, %llu missed deadlines, jitter p50 %.1f us, p99 %.1f "
+      "us, max %.1f us\n",
+      r.haptic_rate_hz, r.haptic_target_hz, static_cast<unsigned long long>(r.haptic_ticks),
+      static_cast<unsigned long long>(r.haptic_missed_deadlines), r.jitter_p50_us, r.jitter_p99_us,
+      r.jitter_max_us);
   std::printf(
       "  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu non-finite\n",
       r.force_max_n, r.torque_max_nm, r.force_max_step_n,
       !r.multi_rate ? "held forces" : (r.tick_force == "model" ? "local model" : "every pair re-evaluated"),
       static_cast<unsigned long long>(r.force_nonfinite));
-  if (!r.stepped)
+  if (!stepped)
     std::printf("  tick      p50 %.1f us, p99 %.1f us, max %.1f us\n", r.tick_p50_us, r.tick_p99_us,
                 r.tick_max_us);
   if (r.multi_rate && r.tick_force == "model")
@@ -120,6 +119,19 @@ void print_summary(const controllers::SessionReport& r) {
               static_cast<unsigned long long>(r.contact_ticks), r.work_on_hand_j, r.coupling ? " (virtual coupling)" : "");
 }
 
+void print_summary(const controllers::SessionReport& r) {
+  std::printf("scene %s: %.1f s%s%s\n", r.scene.c_str(), r.seconds,
+              r.stepped ? " (stepped, simulated time)" : "", r.stopped_early ? " (stopped early)" : "");
+  std::printf(
+      "  collision median %.0f Hz, min %.0f Hz (target %.0f); query median %.1f us, p99 %.1f us, max %.1f "
+      "us; up to %lld pairs\n",
+      r.collision_rate_median_hz, r.collision_rate_min_hz, r.collision_target_hz, r.query_median_us,
+      r.query_p99_us, r.query_max_us, static_cast<long long>(r.max_pairs));
+  // one block per device; a one-tool session's block is as it always was
+  for (const controllers::ToolReport& t : r.tools)
+    print_tool_summary(t, r.stepped, r.tools.size() > 1 ? fmt::format("tool '{}': ", t.tool) : std::string());
+}
+
 int run_session(const RunArgs& args) {
   const std::filesystem::path cache = controllers::default_cache_dir();
   auto scene = args.scene.empty() ? controllers::default_scene(cache) : controllers::load_scene(args.scene);
@@ -128,9 +140,15 @@ int run_session(const RunArgs& args) {
     auto choice = devices::parse_device_choice(args.device, devices::all_drivers());
     if (!choice) return fail(choice.error().message);
     // another driver does not share the scene's settings; the same one keeps them, with the selection on top
-    if (choice->driver != scene->tool.device.driver) scene->tool.device.config = {};
-    scene->tool.device.driver = choice->driver;
-    for (const auto& [key, value] : choice->selection.values()) scene->tool.device.config.set(key, value);
+    if (scene->tools.size() > 1)
+      return fail(
+          fmt::format("{}: --device replaces the device of a one-tool scene; this scene has {} tools "
+                      "(set each one's device in its tools[i].device)",
+                      scene->source, scene->tools.size()));
+    controllers::SceneDevice& device = scene->tool().device;
+    if (choice->driver != device.driver) device.config = {};
+    device.driver = choice->driver;
+    for (const auto& [key, value] : choice->selection.values()) device.config.set(key, value);
   }
 
   controllers::SessionOptions options;

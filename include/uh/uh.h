@@ -259,7 +259,7 @@ typedef struct uh_session_def {
 
 UH_API uh_session_def uh_default_session_def(void);
 
-/* The newest state, as the haptic thread sent it in its last tick. */
+/* The newest state of a tool, as its haptic thread sent it in its last tick. */
 typedef struct uh_state {
   uint32_t struct_size;        /* sizeof(uh_state), set by the caller */
   double time_s;               /* that tick's time since start [s] (stepped: simulated time) */
@@ -316,10 +316,17 @@ UH_API uh_status uh_session_start(uh_session* s);
  * offline work). Returns when done; the session is then stopped. */
 UH_API uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_per_collision_step);
 
-/* Copies the newest state into `out` (out->struct_size set by the caller). Any thread; never
- * waits for the haptic thread. Before the first tick: zeros. After stop: the last state, with
- * the zero force the device got. */
+/* Copies the newest state of the (first) tool into `out` (out->struct_size set by the caller).
+ * Any thread; never waits for the haptic thread. Before the first tick: zeros. After stop: the last state,
+ * with the zero force the device got. */
 UH_API uh_status uh_session_poll(uh_session* s, uh_state* out);
+
+/* Tools of the session's scene (a scene may hold several, each on its own device and haptic
+ * thread): their count, names (valid until close) and each one's newest state, as
+ * uh_session_poll gives the first tool's (`tool` from 0 to count - 1; any thread, never waits). */
+UH_API uh_status uh_session_tool_count(uh_session* s, int32_t* out);
+UH_API uh_status uh_session_tool_name(uh_session* s, int32_t tool, const char** out);
+UH_API uh_status uh_session_tool_state(uh_session* s, int32_t tool, uh_state* out);
 
 /* Takes the oldest contact event not yet taken: *has_event is 1 and `out` filled, or 0 when none
  * is waiting. Events queue up (1024; more are dropped) from start on. */

@@ -137,3 +137,30 @@ def test_bad_input_raises_with_a_message(scene):
         scene.set_tool(vertices=CUBE_VERTICES, triangles=CUBE_TRIANGLES, spheres=50, law="volume")
     with pytest.raises(ValueError):
         uh.Session.open(scene).set_object_pose(0, (0, 0), (1, 0, 0, 0))
+
+
+def test_two_tools_each_with_its_state(tmp_path):
+    assets = pathlib.Path(__file__).resolve().parents[2] / "assets" / "meshes"
+    tool = {"mesh": str(assets / "stylus.obj"), "meters_per_unit": 0.01, "spheres": 150,
+            "force": {"mode": "3dof", "stiffness": 1.6e4, "max_force_n": 6.0}}
+    scene = {"name": "two-python",
+             "objects": [{"name": "bunny", "mesh": str(assets / "bunny_npm_3674.obj"), "meters_per_unit": 0.01,
+                          "spheres": 600, "pose": {"rotation": [0.70710678, 0.70710678, 0, 0]}},
+                         {"name": "ball", "mesh": str(assets / "ball.obj"), "meters_per_unit": 0.03, "spheres": 200,
+                          "pose": {"position": [0.15, 0, 0.03]}}],
+             "tools": [dict(tool, name="left", device={"driver": "sim-line",
+                                                       "config": {"start": [0, 0, 0.1], "end": [0, 0, 0.045]}}),
+                       dict(tool, name="right", device={"driver": "sim-line",
+                                                        "config": {"start": [0.15, 0, 0.1], "end": [0.15, 0, 0.048]}})]}
+    path = tmp_path / "two.json"
+    path.write_text(json.dumps(scene))
+    with uh.Session.open(str(path)) as s:
+        assert s.tool_names == ["left", "right"]
+        report = s.run_stepped(1.0, 4)
+        left, right, first = s.state(0), s.state(1), s.state()
+        with pytest.raises(uh.UhError, match="there is no tool 2"):
+            s.state(2)
+    assert [t["tool"] for t in report["tools"]] == ["left", "right"]
+    assert all(t["contact"]["ticks"] > 0 for t in report["tools"])
+    assert right.haptic_ticks == 1000 and abs(right.tool_position[0] - 0.15) < 1e-9
+    assert first.haptic_ticks == left.haptic_ticks and abs(left.tool_position[0]) < 1e-9

@@ -311,7 +311,7 @@ uh_status uh_scene_set_tool(uh_scene* scene, const uh_tool_def* def) {
     tool.device = {.driver = def->device_driver, .config = std::move(config).value()};
     tool.workspace = {
         .world_from_device_base = *workspace, .scale = def->workspace_scale, .handle_from_tool = {}};
-    box->scene.tool = std::move(tool);
+    box->scene.tool() = std::move(tool);
     return UH_OK;
   });
 }

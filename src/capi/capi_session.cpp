@@ -10,11 +10,13 @@
 namespace uh::capi {
 
 /// A session and what the C side hands out from it. `mutex` serialises the owner's calls
-/// (everything but uh_session_poll, which HapticSession::state() makes safe on its own).
+/// (everything but uh_session_poll and uh_session_tool_state, which HapticSession::state() makes
+/// safe on its own).
 struct SessionBox {
   std::mutex mutex;
   std::unique_ptr<controllers::HapticSession> session;
   std::vector<std::string> object_names;
+  std::vector<std::string> tool_names;
   std::string report_json;
   bool stopped = false;
   uh_tick_fn tick_fn = nullptr;
@@ -71,7 +73,7 @@ uh_status check_version(const char* function, int32_t api_version) {
 
 uh_status open_session(const char* function, const controllers::Scene& scene, const uh_session_def& def,
                        uh_session** out) {
-  if (scene.tool.shape.mesh.empty() && scene.tool.shape.ist.empty() && !scene.tool.shape.tree)
+  if (scene.tool().shape.mesh.empty() && scene.tool().shape.ist.empty() && !scene.tool().shape.tree)
     return fail(UH_ERROR_INVALID_ARGUMENT,
                 fmt::format("{}: {} has no tool (uh_scene_set_tool)", function, scene.source));
   controllers::SessionOptions options;
@@ -85,6 +87,7 @@ uh_status open_session(const char* function, const controllers::Scene& scene, co
   auto box = std::make_shared<SessionBox>();
   box->session = std::move(session).value();
   for (const auto& o : scene.objects) box->object_names.push_back(o.name);
+  for (const auto& t : scene.tools) box->tool_names.push_back(t.name);
   const std::uintptr_t handle = session_table().insert(std::move(box));
   if (handle == 0) return fail(UH_ERROR_FAILED, "too many sessions are open at once");
   *out = as_handle<uh_session>(handle);
@@ -99,6 +102,35 @@ uh_status with_session(const char* function, uh_session* s, Body&& body) {
     if (!box) return stale(function, "session");
     const std::lock_guard lock(box->mutex);
     return body(*box);
+  });
+}
+
+// uh_session_poll and uh_session_tool_state: without the owner lock (HapticSession::state() is
+// safe on its own, and the tools are fixed at open)
+uh_status poll_tool(const char* fn, uh_session* s, int32_t tool, uh_state* out) {
+  return guarded(fn, [&]() -> uh_status {
+    if (auto c = check_struct(fn, "out", out); c != UH_OK) return c;
+    const auto box = session_table().find(handle_value(s));
+    if (!box) return stale(fn, "session");
+    if (tool < 0 || static_cast<std::size_t>(tool) >= box->tool_names.size())
+      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: there is no tool {} (the scene has {})", fn,
+                                                         tool, box->tool_names.size()));
+    fill_state(box->session->state(static_cast<std::size_t>(tool)), *out);
+    return UH_OK;
+  });
+}
+
+// uh_session_object_name and uh_session_tool_name: entry `index` of the box's `names`
+uh_status name_at(const char* fn, uh_session* s, std::vector<std::string> SessionBox::*names,
+                  const char* kind, int32_t index, const char** out) {
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    const std::vector<std::string>& list = box.*names;
+    if (index < 0 || static_cast<std::size_t>(index) >= list.size())
+      return fail(UH_ERROR_INVALID_ARGUMENT,
+                  fmt::format("{}: there is no {} {} (the scene has {})", fn, kind, index, list.size()));
+    *out = list[static_cast<std::size_t>(index)].c_str();
+    return UH_OK;
   });
 }
 
@@ -187,15 +219,23 @@ uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_pe
   });
 }
 
-uh_status uh_session_poll(uh_session* s, uh_state* out) {
+uh_status uh_session_poll(uh_session* s, uh_state* out) { return poll_tool(__func__, s, 0, out); }
+
+uh_status uh_session_tool_state(uh_session* s, int32_t tool, uh_state* out) {
+  return poll_tool(__func__, s, tool, out);
+}
+
+uh_status uh_session_tool_count(uh_session* s, int32_t* out) {
   const char* const fn = __func__;
-  return guarded(fn, [&]() -> uh_status {
-    if (auto c = check_struct(fn, "out", out); c != UH_OK) return c;
-    const auto box = session_table().find(handle_value(s));
-    if (!box) return stale(fn, "session");
-    fill_state(box->session->state(), *out);
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    *out = static_cast<int32_t>(box.tool_names.size());
     return UH_OK;
   });
+}
+
+uh_status uh_session_tool_name(uh_session* s, int32_t tool, const char** out) {
+  return name_at(__func__, s, &SessionBox::tool_names, "tool", tool, out);
 }
 
 uh_status uh_session_poll_event(uh_session* s, uh_contact_event* out, int32_t* has_event) {
@@ -271,15 +311,7 @@ uh_status uh_session_object_count(uh_session* s, int32_t* out) {
 }
 
 uh_status uh_session_object_name(uh_session* s, int32_t object, const char** out) {
-  const char* const fn = __func__;
-  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
-    if (out == nullptr) return null_argument(fn, "out");
-    if (object < 0 || static_cast<std::size_t>(object) >= box.object_names.size())
-      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: there is no object {} (the scene has {})", fn,
-                                                         object, box.object_names.size()));
-    *out = box.object_names[static_cast<std::size_t>(object)].c_str();
-    return UH_OK;
-  });
+  return name_at(__func__, s, &SessionBox::object_names, "object", object, out);
 }
 
 void uh_session_close(uh_session* s) {

@@ -757,22 +757,23 @@ Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const s
     Scene alone = scene;
     alone.objects = {object};
     alone.watch = {object.name};
-    alone.tool.device = {.driver = "explorer", .config = {}};
-    alone.tool.workspace = {};  // the device frame is the world frame
+    alone.tools.resize(1);  // the first tool explores
+    alone.tool().device = {.driver = "explorer", .config = {}};
+    alone.tool().workspace = {};  // the device frame is the world frame
 
     auto object_tree = load_shape_tree(object.shape, cache, session_options.build_progress);
     if (!object_tree)
       return Error{
           fmt::format("{}: object '{}': {}", scene.source, object.name, object_tree.error().message)};
-    auto tool_tree = load_shape_tree(scene.tool.shape, cache, session_options.build_progress);
+    auto tool_tree = load_shape_tree(scene.tool().shape, cache, session_options.build_progress);
     if (!tool_tree)
       return Error{
-          fmt::format("{}: tool '{}': {}", scene.source, scene.tool.name, tool_tree.error().message)};
+          fmt::format("{}: tool '{}': {}", scene.source, scene.tool().name, tool_tree.error().message)};
     auto plan = plan_exploration(*object_tree->tree, object.pose, *tool_tree->tree, options);
     if (!plan)
       return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, plan.error().message)};
-    alone.tool.shape.tree = tool_tree->tree;  // loaded once
-    alone.tool.shape.coverage = tool_tree->coverage;
+    alone.tool().shape.tree = tool_tree->tree;  // loaded once
+    alone.tool().shape.coverage = tool_tree->coverage;
     alone.objects[0].shape.tree = object_tree->tree;
     alone.objects[0].shape.coverage = object_tree->coverage;
 

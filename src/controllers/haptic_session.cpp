@@ -1,6 +1,7 @@
 #include "uh/controllers/haptic_session.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -29,6 +30,57 @@ double steady_seconds() {
 
 }  // namespace
 
+// One tool: its device's manager (its own haptic loop and limit chain), its controllers, what
+// its haptic thread publishes and what the monitor accumulates of its run.
+struct HapticSession::ToolRig {
+  HapticSession* session = nullptr;
+  std::int32_t index = 0;
+  std::string path;  // the tool's place in the scene file, for messages: "tool" or "tools[i]"
+  collette::ObjectId tool_id = -1;
+  std::unique_ptr<haptico::HapticManager> manager;
+  std::unique_ptr<ForceController> force_controller;
+  std::unique_ptr<BridgingController> bridging_controller;
+  ScopedConnection sent_connection;
+
+  // haptic thread -> readers of state()
+  Delegator<const SessionState&> tick_event;
+  LatestValue<SessionState> state_out;
+  SessionState last_state{};  // guarded by the session's state_readers_
+  std::uint64_t ticks_at_start = 0;
+  std::atomic<double> haptic_rate_hz{0.0};  // monitor thread -> haptic thread
+
+  // the monitor thread's (then the owner's) account of the run
+  ToolReport report;
+  haptico::DeviceCommand last_sent{};
+  Vec3 last_sent_position{};  // the handle when last_sent was sent [m, device frame]
+  bool have_last_sent = false;
+
+  // collision thread: per scene object, whether this tool touches it
+  std::vector<std::uint8_t> touching;
+  std::vector<std::uint8_t> touching_now;  // scratch of on_collision
+
+  void on_tick_sent(const haptico::TraceSample& sample) {
+    // haptic thread: one snapshot per tick through the triple buffer, no lock, no allocation
+    SessionState& s = state_out.write_buffer();
+    const WorkspaceMapping& mapping = bridging_controller->mapping();
+    const Pose& tool = bridging_controller->last_pose();
+    s.tool = index;
+    s.time_s = sample.tick_time_s - session->t0_s_;
+    s.tool_position_world = tool.position;
+    s.tool_orientation_world = tool.rotation;
+    s.force_world = mapping.to_world(sample.sent.force);
+    s.torque_world = mapping.to_world(sample.sent.torque);
+    s.contact_pairs = force_controller->last_pairs();
+    s.haptic_ticks = manager->ticks() - ticks_at_start;
+    s.missed_deadlines = manager->missed_deadlines();
+    s.haptic_rate_hz = haptic_rate_hz.load(std::memory_order_relaxed);
+    s.collision_rate_hz = session->collision_rate_hz_.load(std::memory_order_relaxed);
+    s.buttons = sample.state.buttons;
+    tick_event.broadcast(s);
+    state_out.publish();
+  }
+};
+
 HapticSession::HapticSession() = default;
 
 HapticSession::~HapticSession() {
@@ -46,6 +98,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     return Error{fmt::format("{}: haptic rate {} Hz is outside (0, 10000]", scene.source, session->haptic_hz_)};
   if (session->collision_hz_ < 0.0 || session->collision_hz_ > 10000.0)
     return Error{fmt::format("{}: collision rate {} Hz is outside [0, 10000]", scene.source, session->collision_hz_)};
+  if (scene.tools.empty()) return Error{fmt::format("{}: the scene has no tool", scene.source)};
   ForceControllerOptions force_options = scene.force;
   if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
   if (options.tick_force) force_options.tick_force = *options.tick_force;
@@ -63,16 +116,16 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   std::vector<double> object_coverages;
   // objects of one shape share its tree (a room repeats a few meshes): loaded once
   std::map<std::tuple<std::string, std::string, std::int64_t, double>, ShapeTree> loaded;
+  const auto load_shared = [&](const SceneShape& shape) -> Result<ShapeTree> {
+    const auto key =
+        std::make_tuple(shape.mesh.string(), shape.ist.string(), shape.spheres, shape.meters_per_unit);
+    if (const auto it = loaded.find(key); it != loaded.end() && !shape.tree) return it->second;
+    auto tree = load_shape_tree(shape, cache, options.build_progress);
+    if (tree && !shape.tree) loaded.emplace(key, *tree);
+    return tree;
+  };
   for (const SceneObject& object : scene.objects) {
-    const auto key = std::make_tuple(object.shape.mesh.string(), object.shape.ist.string(),
-                                     object.shape.spheres, object.shape.meters_per_unit);
-    Result<ShapeTree> tree = Error{""};
-    if (const auto it = loaded.find(key); it != loaded.end() && !object.shape.tree) {
-      tree = it->second;
-    } else {
-      tree = load_shape_tree(object.shape, cache, options.build_progress);
-      if (tree && !object.shape.tree) loaded.emplace(key, *tree);
-    }
+    auto tree = load_shared(object.shape);
     if (!tree) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message)};
     auto id = world.add_object({.tree = tree->tree,
                                 .world_from_object = object.pose,
@@ -82,149 +135,162 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     object_ids.push_back(*id);
     object_coverages.push_back(tree->coverage);
   }
-  auto tool_tree = load_shape_tree(scene.tool.shape, cache, options.build_progress);
-  if (!tool_tree) return Error{fmt::format("{}: tool '{}': {}", scene.source, scene.tool.name, tool_tree.error().message)};
-  // the tool's pose comes from the device on the first haptic tick (BridgingController)
-  auto tool_id = world.add_object({.tree = tool_tree->tree,
-                                   .has_initial_pose = false,
-                                   .coverage = tool_tree->coverage,
-                                   .name = scene.tool.name});
-  if (!tool_id) return tool_id.error();
-  session->tool_id_ = *tool_id;
-
-  // a simulated device advances its own time by one period per tick: it runs at the haptic rate
-  // unless the scene says otherwise (else a 4 kHz session would play its script four times too fast)
-  haptico::DeviceConfig device_config = scene.tool.device.config;
-  if (scene.tool.device.driver.rfind("sim-", 0) == 0 && !device_config.has("rate_hz"))
-    device_config.set("rate_hz", session->haptic_hz_);
-  auto device = registry.create(scene.tool.device.driver, device_config);
-  if (!device) return Error{fmt::format("{}: tool.device: {}", scene.source, device.error().message)};
-  const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, session->haptic_hz_ * 0.5));
-  session->manager_ = std::make_unique<haptico::HapticManager>(
-      std::move(device).value(),
-      haptico::HapticManagerOptions{.rate_hz = session->haptic_hz_,
-                                    .raise_priority = options.raise_priority,
-                                    .trace_capacity = trace_capacity,
-                                    .limits = {.tool = {.max_force_n = scene.tool.force.max_force_n,
-                                                        .max_torque_nm = scene.tool.force.max_torque_nm},
-                                               .safety = scene.safety_limits,
-                                               .rate = scene.rate_limit}});
-  if (auto opened = session->manager_->open(); !opened)
-    return Error{fmt::format("{}: tool.device: {}", scene.source, opened.error().message)};
-
-  const forcecomp::ForceComponent component({.params = scene.tool.force, .mode = scene.tool.mode,
-                                             .side = forcecomp::ContactSide::kB});
-  session->force_controller_ =
-      std::make_unique<ForceController>(session->tool_id_, component, scene.tool.workspace, force_options);
   // the tool is B of every watcher: the frames' forces push it out of the objects. Watching every
   // object is one watcher of the tool against everything (the broad phase picks the objects it
   // touches); a coherence skin keeps one watcher per pair (the kept candidates belong to a pair).
+  // A tool against everything also meets the other tools: the force controller renders only its
+  // watched objects, so tools pass through each other.
   const bool watch_all = scene.watch.size() == scene.objects.size() && !scene.objects.empty() &&
                          !(options.coherence_skin.value_or(scene.coherence_skin) > 0.0);
-  if (watch_all) {
-    auto w = world.add_tool_watcher(session->tool_id_);
-    if (!w) return w.error();
-    session->force_controller_->read_frames_of(*w);
-  }
-  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-    if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end()) continue;
-    if (!watch_all) {
-      auto w = world.add_collision_watcher(object_ids[i], session->tool_id_);
+  const bool several = scene.tools.size() > 1;
+  for (std::size_t t = 0; t < scene.tools.size(); ++t) {
+    const SceneTool& tool = scene.tools[t];
+    auto rig = std::make_unique<ToolRig>();
+    rig->session = session.get();
+    rig->index = static_cast<std::int32_t>(t);
+    rig->path = several ? fmt::format("tools[{}]", t) : std::string("tool");
+    auto tool_tree = load_shared(tool.shape);
+    if (!tool_tree)
+      return Error{fmt::format("{}: tool '{}': {}", scene.source, tool.name, tool_tree.error().message)};
+    // the tool's pose comes from its device on its first haptic tick (BridgingController)
+    auto tool_id = world.add_object({.tree = tool_tree->tree,
+                                     .has_initial_pose = false,
+                                     .coverage = tool_tree->coverage,
+                                     .name = tool.name});
+    if (!tool_id) return tool_id.error();
+    rig->tool_id = *tool_id;
+
+    // a simulated device advances its own time by one period per tick: it runs at the haptic rate
+    // unless the scene says otherwise (else a 4 kHz session would play its script four times too fast)
+    haptico::DeviceConfig device_config = tool.device.config;
+    if (tool.device.driver.rfind("sim-", 0) == 0 && !device_config.has("rate_hz"))
+      device_config.set("rate_hz", session->haptic_hz_);
+    auto device = registry.create(tool.device.driver, device_config);
+    if (!device)
+      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, device.error().message)};
+    const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, session->haptic_hz_ * 0.5));
+    rig->manager = std::make_unique<haptico::HapticManager>(
+        std::move(device).value(),
+        haptico::HapticManagerOptions{.rate_hz = session->haptic_hz_,
+                                      .raise_priority = options.raise_priority,
+                                      .trace_capacity = trace_capacity,
+                                      .limits = {.tool = {.max_force_n = tool.force.max_force_n,
+                                                          .max_torque_nm = tool.force.max_torque_nm},
+                                                 .safety = scene.safety_limits,
+                                                 .rate = scene.rate_limit},
+                                      .fault_group = &session->fault_group_});
+    if (auto opened = rig->manager->open(); !opened)
+      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, opened.error().message)};
+
+    const forcecomp::ForceComponent component(
+        {.params = tool.force, .mode = tool.mode, .side = forcecomp::ContactSide::kB});
+    rig->force_controller =
+        std::make_unique<ForceController>(rig->tool_id, component, tool.workspace, force_options);
+    if (watch_all) {
+      auto w = world.add_tool_watcher(rig->tool_id);
       if (!w) return w.error();
-      session->force_controller_->read_frames_of(*w);
+      rig->force_controller->read_frames_of(*w);
     }
-    const forcecomp::ContactMaterial material =
-        forcecomp::combine_materials(scene.objects[i].material, scene.tool.material, scene.tool.force);
-    session->force_controller_->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage,
-                                            &material);
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end())
+        continue;
+      if (!watch_all) {
+        auto w = world.add_collision_watcher(object_ids[i], rig->tool_id);
+        if (!w) return w.error();
+        rig->force_controller->read_frames_of(*w);
+      }
+      const forcecomp::ContactMaterial material =
+          forcecomp::combine_materials(scene.objects[i].material, tool.material, tool.force);
+      rig->force_controller->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage, &material);
+    }
+    rig->bridging_controller = std::make_unique<BridgingController>(world, rig->tool_id, tool.workspace,
+                                                                    rig->force_controller.get());
+    rig->bridging_controller->bind(*rig->manager);
+    rig->force_controller->bind(world, *rig->manager);
+    ToolRig& r = *rig;
+    r.sent_connection = r.manager->sent_on_haptic_tick().connect<&ToolRig::on_tick_sent>(r);
+    r.touching.assign(scene.objects.size(), 0);
+    r.touching_now.assign(scene.objects.size(), 0);
+    r.report.tool = tool.name;
+    session->rigs_.push_back(std::move(rig));
   }
-  session->bridging_controller_ = std::make_unique<BridgingController>(
-      world, session->tool_id_, scene.tool.workspace, session->force_controller_.get());
-  session->bridging_controller_->bind(*session->manager_);
-  session->force_controller_->bind(world, *session->manager_);
   HapticSession& self = *session;
-  self.sent_connection_ = self.manager_->sent_on_haptic_tick().connect<&HapticSession::on_tick_sent>(self);
   self.collision_connection_ = world.on_collision().connect<&HapticSession::on_collision>(self);
-  self.touching_.assign(scene.objects.size(), 0);
-  self.touching_now_.assign(scene.objects.size(), 0);
   self.object_ids_ = object_ids;
   self.report_.scene = scene.name;
   return session;
 }
 
+DelegateSink<const SessionState&> HapticSession::on_haptic_tick(std::size_t tool) {
+  assert(tool < rigs_.size() && "uh::controllers::HapticSession::on_haptic_tick(): no such tool");
+  return DelegateSink{rigs_[tool]->tick_event};
+}
+
 Status HapticSession::begin_run() {
   if (phase_ != Phase::kReady)
     return Error{"HapticSession: a session runs once; create a new one to run again"};
-  report_.timeline.clear();
   report_.collision_rates.clear();
-  report_.force_max_step_n = 0.0;
-  report_.force_max_n = 0.0;
-  report_.torque_max_nm = 0.0;
-  report_.work_on_hand_j = 0.0;
-  have_last_sent_ = false;
-  ticks_at_start_ = manager_->ticks();
+  for (auto& rig : rigs_) {
+    rig->report.timeline.clear();
+    rig->report.force_max_step_n = 0.0;
+    rig->report.force_max_n = 0.0;
+    rig->report.torque_max_nm = 0.0;
+    rig->report.work_on_hand_j = 0.0;
+    rig->have_last_sent = false;
+    rig->ticks_at_start = rig->manager->ticks();
+  }
   return Ok{};
-}
-
-void HapticSession::on_tick_sent(const haptico::TraceSample& sample) {
-  // haptic thread: one snapshot per tick through the triple buffer, no lock, no allocation
-  SessionState& s = state_out_.write_buffer();
-  const WorkspaceMapping& mapping = bridging_controller_->mapping();
-  const Pose& tool = bridging_controller_->last_pose();
-  s.time_s = sample.tick_time_s - t0_s_;
-  s.tool_position_world = tool.position;
-  s.tool_orientation_world = tool.rotation;
-  s.force_world = mapping.to_world(sample.sent.force);
-  s.torque_world = mapping.to_world(sample.sent.torque);
-  s.contact_pairs = force_controller_->last_pairs();
-  s.haptic_ticks = manager_->ticks() - ticks_at_start_;
-  s.missed_deadlines = manager_->missed_deadlines();
-  s.haptic_rate_hz = haptic_rate_hz_.load(std::memory_order_relaxed);
-  s.collision_rate_hz = collision_rate_hz_.load(std::memory_order_relaxed);
-  s.buttons = sample.state.buttons;
-  tick_event_.broadcast(s);
-  state_out_.publish();
 }
 
 void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
   // collision thread: edges of the overlap become events for the owner. The session registered
   // its objects first, so an object's world id is its index in the scene.
-  if (b != tool_id_) return;
+  ToolRig* rig = nullptr;
+  for (auto& r : rigs_)
+    if (r->tool_id == b) rig = r.get();
+  if (rig == nullptr) return;
+  auto& touching = rig->touching;
   if (a != ContactFrame::kEveryObject) {
-    if (a < 0 || static_cast<std::size_t>(a) >= touching_.size()) return;
-    const bool touching = frame.total_volume > 0.0;
-    contact_edge(a, touching, frame.time_s, touching ? frame.total_volume : 0.0,
-                 touching ? frame.pair_count : 0);
+    if (a < 0 || static_cast<std::size_t>(a) >= touching.size()) return;
+    const bool now = frame.total_volume > 0.0;
+    contact_edge(*rig, a, now, frame.time_s, now ? frame.total_volume : 0.0, now ? frame.pair_count : 0);
     return;
   }
-  // the tool against everything: a section per object it touches; the others are apart
-  std::fill(touching_now_.begin(), touching_now_.end(), std::uint8_t{0});
+  // the tool against everything: a section per object it touches; the others are apart (a
+  // section of another tool is no scene object: not an event)
+  auto& now = rig->touching_now;
+  std::fill(now.begin(), now.end(), std::uint8_t{0});
   for (const ContactSection& s : frame.sections()) {
-    if (s.object_a < 0 || static_cast<std::size_t>(s.object_a) >= touching_.size() || !(s.total_volume > 0.0))
+    if (s.object_a < 0 || static_cast<std::size_t>(s.object_a) >= touching.size() || !(s.total_volume > 0.0))
       continue;
-    touching_now_[static_cast<std::size_t>(s.object_a)] = 1;
-    contact_edge(s.object_a, true, frame.time_s, s.total_volume, s.pair_count);
+    now[static_cast<std::size_t>(s.object_a)] = 1;
+    contact_edge(*rig, s.object_a, true, frame.time_s, s.total_volume, s.pair_count);
   }
-  for (std::size_t i = 0; i < touching_.size(); ++i)
-    if (touching_now_[i] == 0) contact_edge(static_cast<collette::ObjectId>(i), false, frame.time_s, 0.0, 0);
+  for (std::size_t i = 0; i < touching.size(); ++i)
+    if (now[i] == 0) contact_edge(*rig, static_cast<collette::ObjectId>(i), false, frame.time_s, 0.0, 0);
 }
 
-void HapticSession::contact_edge(collette::ObjectId object, bool touching, double time_s, double volume,
-                                 std::int32_t pairs) {
-  if (touching == (touching_[static_cast<std::size_t>(object)] != 0)) return;
-  touching_[static_cast<std::size_t>(object)] = touching ? 1 : 0;
+void HapticSession::contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s,
+                                 double volume, std::int32_t pairs) {
+  std::uint8_t& was = rig.touching[static_cast<std::size_t>(object)];
+  if (touching == (was != 0)) return;
+  was = touching ? 1 : 0;
   const ContactEvent event{.kind = touching ? ContactEventKind::kBegin : ContactEventKind::kEnd,
                            .object = object,
+                           .tool = rig.index,
                            .time_s = time_s - t0_s_,
                            .volume = volume,
                            .pairs = pairs};
   if (!events_.try_push(event)) dropped_events_.increment();
 }
 
-SessionState HapticSession::state() {
+SessionState HapticSession::state(std::size_t tool) {
+  assert(tool < rigs_.size() && "uh::controllers::HapticSession::state(): no such tool");
   const std::lock_guard lock(state_readers_);
-  if (state_out_.update()) last_state_ = state_out_.read_buffer();
-  return last_state_;
+  ToolRig& rig = *rigs_[tool];
+  if (rig.state_out.update()) rig.last_state = rig.state_out.read_buffer();
+  rig.last_state.tool = rig.index;  // also before the first tick
+  return rig.last_state;
 }
 
 Status HapticSession::set_object_pose(std::int32_t object, const Pose& world_from_object) {
@@ -237,30 +303,31 @@ Status HapticSession::set_object_pose(std::int32_t object, const Pose& world_fro
 
 bool HapticSession::poll_event(ContactEvent& out) { return events_.try_pop(out); }
 
-void HapticSession::take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace) {
+void HapticSession::take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace) {
   buffer.clear();
-  manager_->drain_trace(buffer);
+  rig.manager->drain_trace(buffer);
   const double halted_at_s = halted_at_s_.load(std::memory_order_relaxed);
+  ToolReport& report = rig.report;
   for (const auto& s : buffer) {
     if (trace != nullptr) haptico::write_trace_row(*trace, s);
     // the ticks after stop() asked for zero force, and the zero sent as the haptic loop ended,
     // are in the trace, not in the report: the report describes the run, not its end
     if (s.tick_time_s >= halted_at_s || (s.flags & haptico::kTraceStopped) != 0) continue;
-    if (have_last_sent_) {
-      report_.force_max_step_n = std::max(report_.force_max_step_n, norm(s.sent.force - last_sent_.force));
+    if (rig.have_last_sent) {
+      report.force_max_step_n = std::max(report.force_max_step_n, norm(s.sent.force - rig.last_sent.force));
       // energy the device put into the hand over the last period: the force it held then (as
       // sent, after every limit) times the handle's displacement since. Exact for a zero-order
       // hold; F . v dt at the sample instant would miss the sampled-data energy gain that makes a
       // too stiff coupling active
-      const double work = dot(last_sent_.force, s.state.position - last_sent_position_);
-      if (std::isfinite(work)) report_.work_on_hand_j += work;
+      const double work = dot(rig.last_sent.force, s.state.position - rig.last_sent_position);
+      if (std::isfinite(work)) report.work_on_hand_j += work;
     }
-    last_sent_ = s.sent;
-    last_sent_position_ = s.state.position;
-    have_last_sent_ = true;
-    report_.force_max_n = std::max(report_.force_max_n, norm(s.sent.force));
-    report_.torque_max_nm = std::max(report_.torque_max_nm, norm(s.sent.torque));
-    report_.timeline.push_back(
+    rig.last_sent = s.sent;
+    rig.last_sent_position = s.state.position;
+    rig.have_last_sent = true;
+    report.force_max_n = std::max(report.force_max_n, norm(s.sent.force));
+    report.torque_max_nm = std::max(report.torque_max_nm, norm(s.sent.torque));
+    report.timeline.push_back(
         {.time_s = s.tick_time_s - t0_s_, .force_n = norm(s.sent.force), .torque_nm = norm(s.sent.torque)});
   }
 }
@@ -272,25 +339,30 @@ void HapticSession::monitor(std::stop_token stop) {
   std::condition_variable_any wake;
   const double start_s = started_s_;
   std::uint64_t last_steps = 0;
-  std::uint64_t last_ticks = manager_->ticks();
+  std::vector<std::uint64_t> last_ticks;
+  for (const auto& rig : rigs_) last_ticks.push_back(rig->manager->ticks());
   double last_window_s = 0.0;
   while (!stop.stop_requested()) {
     {
       std::unique_lock lock(wake_mutex);
       wake.wait_for(lock, stop, std::chrono::milliseconds(20), [] { return false; });
     }
-    take_trace(buffer, trace_);
+    // the CSV trace is the first tool's (its columns describe one device)
+    for (std::size_t t = 0; t < rigs_.size(); ++t) take_trace(*rigs_[t], buffer, t == 0 ? trace_ : nullptr);
     const double now_s = steady_seconds() - start_s;
     if (now_s - last_window_s >= 0.1) {
       const std::uint64_t steps = world_->stats().steps;
-      const std::uint64_t ticks = manager_->ticks();
       const double window = now_s - last_window_s;
       const double collision_rate = static_cast<double>(steps - last_steps) / window;
       report_.collision_rates.push_back({.time_s = now_s, .rate_hz = collision_rate});
       collision_rate_hz_.store(collision_rate, std::memory_order_relaxed);
-      haptic_rate_hz_.store(static_cast<double>(ticks - last_ticks) / window, std::memory_order_relaxed);
+      for (std::size_t t = 0; t < rigs_.size(); ++t) {
+        const std::uint64_t ticks = rigs_[t]->manager->ticks();
+        rigs_[t]->haptic_rate_hz.store(static_cast<double>(ticks - last_ticks[t]) / window,
+                                       std::memory_order_relaxed);
+        last_ticks[t] = ticks;
+      }
       last_steps = steps;
-      last_ticks = ticks;
       last_window_s = now_s;
     }
   }
@@ -298,18 +370,57 @@ void HapticSession::monitor(std::stop_token stop) {
 
 Status HapticSession::start(std::ostream* trace) {
   if (auto ready = begin_run(); !ready) return ready;
-  report_.timeline.reserve(static_cast<std::size_t>(10.0 * haptic_hz_) + 16);
+  for (auto& rig : rigs_) rig->report.timeline.reserve(static_cast<std::size_t>(10.0 * haptic_hz_) + 16);
   trace_ = trace;
   if (trace != nullptr) haptico::write_trace_header(*trace);
   started_s_ = steady_seconds();
   t0_s_ = started_s_;
   if (auto started = world_->start(); !started) return started;
-  if (auto started = manager_->start(); !started) {
-    world_->stop();
-    return started;
+  for (std::size_t t = 0; t < rigs_.size(); ++t) {
+    if (auto started = rigs_[t]->manager->start(); !started) {
+      // the loops already running end with zero
+      for (std::size_t u = 0; u < t; ++u) rigs_[u]->manager->stop();
+      world_->stop();
+      if (rigs_.size() == 1) return started;
+      return Error{fmt::format("{}: {}.device: {}", scene_.source, rigs_[t]->path, started.error().message)};
+    }
   }
   phase_ = Phase::kRunning;
   monitor_thread_ = std::jthread([this](std::stop_token stop) { monitor(stop); });
+  return Ok{};
+}
+
+bool HapticSession::any_fault() const {
+  return std::any_of(rigs_.begin(), rigs_.end(), [](const auto& rig) { return rig->manager->faulted(); });
+}
+
+bool HapticSession::haptic_threads_running() const {
+  return std::all_of(rigs_.begin(), rigs_.end(), [](const auto& rig) { return rig->manager->running(); });
+}
+
+std::string HapticSession::tool_label(std::int32_t tool) const {
+  // one-tool sessions say nothing more (their messages are as they always were)
+  if (rigs_.size() == 1) return {};
+  return fmt::format("{} '{}': ", rigs_[static_cast<std::size_t>(tool)]->path,
+                     scene_.tools[static_cast<std::size_t>(tool)].name);
+}
+
+Status HapticSession::thread_error() const {
+  // the first haptic thread that ended by a throw (the others were zeroed with it)
+  for (const auto& rig : rigs_)
+    if (Status s = rig->manager->thread_status(); !s)
+      return Error{fmt::format("{}: {}{}", scene_.source, tool_label(rig->index), s.error().message)};
+  return Ok{};
+}
+
+Status HapticSession::device_error() const {
+  // the first device that faulted (the others were zeroed with it); in several-tool scenes the
+  // message names the tool too
+  for (const auto& rig : rigs_) {
+    if (Status device = rig->manager->device_status(); !device)
+      return Error{fmt::format("{}: {}{}{}", scene_.source, tool_label(rig->index), device.error().message,
+                               rigs_.size() > 1 ? "; every device was sent zero force" : "")};
+  }
   return Ok{};
 }
 
@@ -318,27 +429,30 @@ Status HapticSession::stop() {
   // zero force from the next tick on, before anything that takes time
   const double halted_at_s = steady_seconds();
   halted_at_s_.store(halted_at_s, std::memory_order_relaxed);
-  manager_->halt();
-  const bool haptic_alive = manager_->running();
+  for (auto& rig : rigs_) rig->manager->halt();
+  const bool haptic_alive = haptic_threads_running();
   const bool collision_alive = world_->running();
   const double seconds = halted_at_s - started_s_;
   monitor_thread_.request_stop();
   monitor_thread_.join();
   collect_report(seconds, false);  // before the loops stop: their statistics describe the run itself
-  manager_->stop();
+  for (auto& rig : rigs_) rig->manager->stop();
   world_->stop();
-  // the haptic thread is joined and the device got zero: this thread becomes the state's writer
-  SessionState last = state();
-  last.force_world = {};
-  last.torque_world = {};
-  state_out_.write(last);
+  // the haptic threads are joined and the devices got zero: this thread becomes the states' writer
+  for (std::size_t t = 0; t < rigs_.size(); ++t) {
+    SessionState last = state(t);
+    last.force_world = {};
+    last.torque_world = {};
+    rigs_[t]->state_out.write(last);
+  }
   std::vector<haptico::TraceSample> buffer;
-  take_trace(buffer, trace_);
+  for (std::size_t t = 0; t < rigs_.size(); ++t) take_trace(*rigs_[t], buffer, t == 0 ? trace_ : nullptr);
+  publish_report();
   phase_ = Phase::kStopped;
-  if (Status haptic = manager_->thread_status(); !haptic)
-    stopped_ = Error{fmt::format("{}: {}", scene_.source, haptic.error().message)};
-  else if (Status device = manager_->device_status(); !device)
-    stopped_ = Error{fmt::format("{}: {}", scene_.source, device.error().message)};
+  if (Status haptic = thread_error(); !haptic)
+    stopped_ = haptic;
+  else if (Status device = device_error(); !device)
+    stopped_ = device;
   else if (!haptic_alive)
     stopped_ = Error{"the haptic thread ended before the session was stopped"};
   else if (!collision_alive)
@@ -362,9 +476,9 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
                                std::chrono::duration<double>(seconds));
   auto next_status = begin + std::chrono::milliseconds(250);
   // a stop request is seen within 20 ms; a thread that ended by itself (the haptic one has sent
-  // zero already), or a device fault (the device gets zero from its tick on), ends the run as well
+  // zero already), or a device fault (every device gets zero from its next tick on), ends the run
   while (std::chrono::steady_clock::now() < end && !stop_requested_.load(std::memory_order_relaxed) &&
-         manager_->running() && world_->running() && !manager_->faulted()) {
+         haptic_threads_running() && world_->running() && !any_fault()) {
     const auto soon = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
     std::this_thread::sleep_until(std::min({end, next_status, soon}));
     if (on_status && std::chrono::steady_clock::now() >= next_status) {
@@ -374,7 +488,7 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
   }
   // a stop request or a device fault ended it before its time
   const bool early = std::chrono::steady_clock::now() < end &&
-                     (stop_requested_.load(std::memory_order_relaxed) || manager_->faulted());
+                     (stop_requested_.load(std::memory_order_relaxed) || any_fault());
   Status stopped = stop();
   report_.stopped_early = early;
   return stopped;
@@ -388,58 +502,82 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
         fmt::format("ticks per collision step must be at least 1 (got {})", ticks_per_collision_step)};
   if (auto ready = begin_run(); !ready) return ready;
   t0_s_ = 0.0;
-  haptic_rate_hz_.store(haptic_hz_, std::memory_order_relaxed);
+  for (auto& rig : rigs_) rig->haptic_rate_hz.store(haptic_hz_, std::memory_order_relaxed);
   collision_rate_hz_.store(haptic_hz_ / ticks_per_collision_step, std::memory_order_relaxed);
   if (trace != nullptr) haptico::write_trace_header(*trace);
   std::vector<haptico::TraceSample> buffer;
+  const auto drain = [&] {
+    for (std::size_t t = 0; t < rigs_.size(); ++t) take_trace(*rigs_[t], buffer, t == 0 ? trace : nullptr);
+  };
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
   std::int64_t k = 0;
-  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed) && !manager_->faulted(); ++k) {
+  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed) && !any_fault(); ++k) {
     const double t = static_cast<double>(k) / haptic_hz_;
-    // the collision step sees the tool pose of the previous tick, as the threaded world would
+    // the collision step sees the tool poses of the previous tick, as the threaded world would
     if (k % ticks_per_collision_step == 0) world_->step(t);
-    manager_->step(t);
-    if (k % 256 == 255) take_trace(buffer, trace);
+    for (auto& rig : rigs_) rig->manager->step(t);
+    if (k % 256 == 255) drain();
   }
-  manager_->stop();  // a stepped run ends like a threaded one: zero to the device, traced
-  take_trace(buffer, trace);
+  // a stepped run ends like a threaded one: zero to every device, traced
+  for (auto& rig : rigs_) rig->manager->stop();
+  drain();
   collision_hz_ = haptic_hz_ / ticks_per_collision_step;
   collect_report(static_cast<double>(k) / haptic_hz_, true);
+  publish_report();
   report_.stopped_early = k < ticks;
   phase_ = Phase::kStopped;
-  if (Status device = manager_->device_status(); !device)
-    return Error{fmt::format("{}: {}", scene_.source, device.error().message)};
-  return Ok{};
+  return device_error();
 }
 
 void HapticSession::collect_report(double seconds, bool stepped) {
   SessionReport& r = report_;
   r.stepped = stepped;
   r.seconds = seconds;
-  const haptico::HapticStats hs = manager_->stats();
-  r.haptic_target_hz = haptic_hz_;
-  r.haptic_ticks = hs.ticks;
-  const haptico::DeviceInfo& info = manager_->device_info();
-  r.device = {.driver = scene_.tool.device.driver,
-              .name = info.name,
-              .model = info.model,
-              .serial = info.serial,
-              .max_force_n = info.max_force_n};
-  if (const auto* fd = dynamic_cast<const devices::ForceDimensionDevice*>(&manager_->device()))
-    r.device.com_rate_hz = fd->com_rate_hz();
-  if (stepped) {
-    r.haptic_rate_hz = haptic_hz_;
-  } else {
-    r.haptic_rate_hz = hs.loop.achieved_rate_hz;
-    r.haptic_missed_deadlines = hs.loop.missed_deadlines;
-    r.jitter_p50_us = hs.loop.period_error.p50_ns * 1e-3;
-    r.jitter_p99_us = hs.loop.period_error.p99_ns * 1e-3;
-    r.jitter_p999_us = hs.loop.period_error.p999_ns * 1e-3;
-    r.jitter_max_us = hs.loop.period_error.max_ns * 1e-3;
-    r.tick_p50_us = hs.loop.callback_duration.p50_ns * 1e-3;
-    r.tick_p99_us = hs.loop.callback_duration.p99_ns * 1e-3;
-    r.tick_max_us = hs.loop.callback_duration.max_ns * 1e-3;
-    r.haptic_priority_raised = hs.loop.priority_raised;
+  for (auto& rig : rigs_) {
+    ToolReport& t = rig->report;
+    const haptico::HapticStats hs = rig->manager->stats();
+    t.haptic_target_hz = haptic_hz_;
+    t.haptic_ticks = hs.ticks;
+    const haptico::DeviceInfo& info = rig->manager->device_info();
+    t.device = {.driver = scene_.tools[static_cast<std::size_t>(rig->index)].device.driver,
+                .name = info.name,
+                .model = info.model,
+                .serial = info.serial,
+                .max_force_n = info.max_force_n};
+    if (const auto* fd = dynamic_cast<const devices::ForceDimensionDevice*>(&rig->manager->device()))
+      t.device.com_rate_hz = fd->com_rate_hz();
+    if (stepped) {
+      t.haptic_rate_hz = haptic_hz_;
+    } else {
+      t.haptic_rate_hz = hs.loop.achieved_rate_hz;
+      t.haptic_missed_deadlines = hs.loop.missed_deadlines;
+      t.jitter_p50_us = hs.loop.period_error.p50_ns * 1e-3;
+      t.jitter_p99_us = hs.loop.period_error.p99_ns * 1e-3;
+      t.jitter_p999_us = hs.loop.period_error.p999_ns * 1e-3;
+      t.jitter_max_us = hs.loop.period_error.max_ns * 1e-3;
+      t.tick_p50_us = hs.loop.callback_duration.p50_ns * 1e-3;
+      t.tick_p99_us = hs.loop.callback_duration.p99_ns * 1e-3;
+      t.tick_max_us = hs.loop.callback_duration.max_ns * 1e-3;
+      t.haptic_priority_raised = hs.loop.priority_raised;
+    }
+    const ForceController& fcon = *rig->force_controller;
+    const ForceControllerStats fc = fcon.stats();
+    t.force_max_raw_step_n = fc.max_force_step_n;
+    t.force_nonfinite = fc.safety.nonfinite + hs.nonfinite;
+    t.force_clamped = hs.force_clamped;
+    t.torque_clamped = hs.torque_clamped;
+    t.limits = hs.limits;
+    t.zeroed_ticks = hs.zeroed_ticks;
+    t.stale_ticks = fc.safety.stale_ticks;
+    t.contact_ticks = fc.contact_ticks;
+    t.multi_rate = fcon.options().multi_rate;
+    t.tick_force = fcon.options().tick_force == TickForce::kModel ? "model" : "exact";
+    t.model_clamped_ticks = fc.model_clamped_ticks;
+    t.model_held_ticks = fc.model_held_ticks;
+    t.model_checked_ticks = fc.model_checked_ticks;
+    t.model_error_rms_n = fc.model_error_rms_n;
+    t.model_error_max_n = fc.model_error_max_n;
+    t.coupling = fcon.options().use_coupling;
   }
   const collette::CollisionWorldStats ws = world_->stats();
   r.collision_target_hz = collision_hz_;
@@ -467,88 +605,93 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     r.collision_rate_median_hz = median_of(rates);
     r.collision_rate_mean_hz = ws.rate_hz;
   }
-  const ForceControllerStats fc = force_controller_->stats();
-  r.force_max_raw_step_n = fc.max_force_step_n;
-  r.force_nonfinite = fc.safety.nonfinite + hs.nonfinite;
-  r.force_clamped = hs.force_clamped;
-  r.torque_clamped = hs.torque_clamped;
-  r.limits = hs.limits;
-  r.stale_ticks = fc.safety.stale_ticks;
-  r.contact_ticks = fc.contact_ticks;
-  r.multi_rate = force_controller_->options().multi_rate;
-  r.tick_force = force_controller_->options().tick_force == TickForce::kModel ? "model" : "exact";
-  r.model_clamped_ticks = fc.model_clamped_ticks;
-  r.model_held_ticks = fc.model_held_ticks;
-  r.model_checked_ticks = fc.model_checked_ticks;
-  r.model_error_rms_n = fc.model_error_rms_n;
-  r.model_error_max_n = fc.model_error_max_n;
-  r.coupling = force_controller_->options().use_coupling;
 }
 
+void HapticSession::publish_report() {
+  report_.tools.clear();
+  for (const auto& rig : rigs_) report_.tools.push_back(rig->report);
+  static_cast<ToolReport&>(report_) = report_.tools.front();
+}
+
+namespace {
+
+// a tool's part of the report: device.*, haptic.*, force.*, contact.*, energy.*
+nlohmann::json tool_report_json(const ToolReport& r) {
+  return {{"tool", r.tool},
+          {"device",
+           {{"driver", r.device.driver},
+            {"name", r.device.name},
+            {"model", r.device.model},
+            {"serial", r.device.serial},
+            {"max_force_n", r.device.max_force_n},
+            {"com_rate_hz", r.device.com_rate_hz}}},
+          {"haptic",
+           {{"target_hz", r.haptic_target_hz},
+            {"rate_hz", r.haptic_rate_hz},
+            {"ticks", r.haptic_ticks},
+            {"missed_deadlines", r.haptic_missed_deadlines},
+            {"priority_raised", r.haptic_priority_raised},
+            {"jitter_us",
+             {{"p50", r.jitter_p50_us},
+              {"p99", r.jitter_p99_us},
+              {"p999", r.jitter_p999_us},
+              {"max", r.jitter_max_us}}},
+            {"tick_us", {{"p50", r.tick_p50_us}, {"p99", r.tick_p99_us}, {"max", r.tick_max_us}}}}},
+          {"force",
+           {{"max_n", r.force_max_n},
+            {"max_torque_nm", r.torque_max_nm},
+            {"max_step_n", r.force_max_step_n},
+            {"max_raw_step_n", r.force_max_raw_step_n},
+            {"nonfinite", r.force_nonfinite},
+            {"clamped", r.force_clamped},
+            {"torque_clamped", r.torque_clamped},
+            {"limited",
+             {{"device", r.limits.device},
+              {"tool", r.limits.tool},
+              {"safety", r.limits.safety},
+              {"rate", r.limits.rate}}},
+            {"zeroed_ticks", r.zeroed_ticks},
+            {"stale_ticks", r.stale_ticks},
+            {"multi_rate", r.multi_rate},
+            {"tick_force", r.tick_force},
+            {"model",
+             {{"clamped_ticks", r.model_clamped_ticks},
+              {"held_ticks", r.model_held_ticks},
+              {"checked_ticks", r.model_checked_ticks},
+              {"error_rms_n", r.model_error_rms_n},
+              {"error_max_n", r.model_error_max_n}}},
+            {"coupling", r.coupling}}},
+          {"contact", {{"ticks", r.contact_ticks}}},
+          {"energy", {{"work_on_hand_j", r.work_on_hand_j}}}};
+}
+
+}  // namespace
+
 std::string session_report_json(const SessionReport& r) {
-  nlohmann::json j = {
-      {"scene", r.scene},
-      {"mode", r.stepped ? "stepped" : "threaded"},
-      {"seconds", r.seconds},
-      {"stopped_early", r.stopped_early},
-      {"device",
-       {{"driver", r.device.driver},
-        {"name", r.device.name},
-        {"model", r.device.model},
-        {"serial", r.device.serial},
-        {"max_force_n", r.device.max_force_n},
-        {"com_rate_hz", r.device.com_rate_hz}}},
-      {"haptic",
-       {{"target_hz", r.haptic_target_hz},
-        {"rate_hz", r.haptic_rate_hz},
-        {"ticks", r.haptic_ticks},
-        {"missed_deadlines", r.haptic_missed_deadlines},
-        {"priority_raised", r.haptic_priority_raised},
-        {"jitter_us",
-         {{"p50", r.jitter_p50_us},
-          {"p99", r.jitter_p99_us},
-          {"p999", r.jitter_p999_us},
-          {"max", r.jitter_max_us}}},
-        {"tick_us", {{"p50", r.tick_p50_us}, {"p99", r.tick_p99_us}, {"max", r.tick_max_us}}}}},
-      {"collision",
-       {{"target_hz", r.collision_target_hz},
-        {"rate_hz",
-         {{"min", r.collision_rate_min_hz},
-          {"median", r.collision_rate_median_hz},
-          {"mean", r.collision_rate_mean_hz}}},
-        {"steps", r.collision_steps},
-        {"query_us", {{"median", r.query_median_us}, {"p99", r.query_p99_us}, {"max", r.query_max_us}}},
-        {"step_us", {{"median", r.step_median_us}, {"p99", r.step_p99_us}, {"max", r.step_max_us}}},
-        {"objects", r.objects},
-        {"frame_bytes", r.frame_bytes},
-        {"max_pairs", r.max_pairs},
-        {"truncated_frames", r.truncated_frames},
-        {"coherent_queries", r.coherent_queries}}},
-      {"force",
-       {{"max_n", r.force_max_n},
-        {"max_torque_nm", r.torque_max_nm},
-        {"max_step_n", r.force_max_step_n},
-        {"max_raw_step_n", r.force_max_raw_step_n},
-        {"nonfinite", r.force_nonfinite},
-        {"clamped", r.force_clamped},
-        {"torque_clamped", r.torque_clamped},
-        {"limited",
-         {{"device", r.limits.device},
-          {"tool", r.limits.tool},
-          {"safety", r.limits.safety},
-          {"rate", r.limits.rate}}},
-        {"stale_ticks", r.stale_ticks},
-        {"multi_rate", r.multi_rate},
-        {"tick_force", r.tick_force},
-        {"model",
-         {{"clamped_ticks", r.model_clamped_ticks},
-          {"held_ticks", r.model_held_ticks},
-          {"checked_ticks", r.model_checked_ticks},
-          {"error_rms_n", r.model_error_rms_n},
-          {"error_max_n", r.model_error_max_n}}},
-        {"coupling", r.coupling}}},
-      {"contact", {{"ticks", r.contact_ticks}}},
-      {"energy", {{"work_on_hand_j", r.work_on_hand_j}}}};
+  // the first tool's parts at the top level, as in one-tool sessions
+  nlohmann::json j = tool_report_json(r);
+  j.erase("tool");
+  j["scene"] = r.scene;
+  j["mode"] = r.stepped ? "stepped" : "threaded";
+  j["seconds"] = r.seconds;
+  j["stopped_early"] = r.stopped_early;
+  j["collision"] = {
+      {"target_hz", r.collision_target_hz},
+      {"rate_hz",
+       {{"min", r.collision_rate_min_hz},
+        {"median", r.collision_rate_median_hz},
+        {"mean", r.collision_rate_mean_hz}}},
+      {"steps", r.collision_steps},
+      {"query_us", {{"median", r.query_median_us}, {"p99", r.query_p99_us}, {"max", r.query_max_us}}},
+      {"step_us", {{"median", r.step_median_us}, {"p99", r.step_p99_us}, {"max", r.step_max_us}}},
+      {"objects", r.objects},
+      {"frame_bytes", r.frame_bytes},
+      {"max_pairs", r.max_pairs},
+      {"truncated_frames", r.truncated_frames},
+      {"coherent_queries", r.coherent_queries}};
+  nlohmann::json tools = nlohmann::json::array();
+  for (const ToolReport& t : r.tools) tools.push_back(tool_report_json(t));
+  j["tools"] = std::move(tools);
   return j.dump(2);
 }
 

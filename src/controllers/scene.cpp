@@ -412,11 +412,76 @@ Status read_material(const FieldReader& r, const json& parent, const std::string
 }
 
 // a material stiffness is the gradient law's k [N/m^2]: meaningless under the paper law
-Status check_material_law(const FieldReader& r, const Scene& scene, const std::string& path,
-                          const forcecomp::Material& m) {
-  if (scene.tool.force.law == forcecomp::ForceLaw::kPaper && m.has_stiffness)
-    return r.error(FieldReader::join(path, "material.stiffness"),
-                   "is the gradient law's stiffness [N/m^2]; this scene uses the paper law (tool.force.law)");
+Status check_material_law(const FieldReader& r, const SceneTool& tool, const std::string& tool_path,
+                          const std::string& path, const forcecomp::Material& m) {
+  if (tool.force.law == forcecomp::ForceLaw::kPaper && m.has_stiffness)
+    return r.error(
+        FieldReader::join(path, "material.stiffness"),
+        fmt::format("is the gradient law's stiffness [N/m^2]; this scene uses the paper law ({}.force.law)",
+                    tool_path));
+  return Ok{};
+}
+
+// one tool object (`tool`, or `tools[i]` at `path`)
+Status read_tool(const FieldReader& r, const json& j, const std::string& path,
+                 const std::filesystem::path& base_dir, const MaterialTable& materials, SceneTool& tool) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(
+      j, path,
+      {"name", "mesh", "ist", "spheres", "meters_per_unit", "force", "device", "workspace", "material"}));
+  UH_CHECK(r.string(j, path, "name", tool.name, false));
+  UH_CHECK(read_shape(r, j, path, base_dir, tool.shape));
+  if (const auto it = j.find("force"); it != j.end())
+    UH_CHECK(read_force_params(r, *it, FieldReader::join(path, "force"), tool));
+  UH_CHECK(read_material(r, j, path, materials, tool.material));
+  UH_CHECK(check_material_law(r, tool, path, path, tool.material));
+  const auto device = j.find("device");
+  if (device == j.end())
+    return r.error(FieldReader::join(path, "device"),
+                   "missing (expected {\"driver\": ..., \"config\": {...}})");
+  UH_CHECK(read_device(r, *device, FieldReader::join(path, "device"), base_dir, tool.device));
+  if (const auto it = j.find("workspace"); it != j.end())
+    UH_CHECK(read_workspace(r, *it, FieldReader::join(path, "workspace"), tool.workspace));
+  return Ok{};
+}
+
+// `tool` (one tool) or `tools` (a non-empty list), never both
+Status read_tools(const FieldReader& r, const json& root, const std::filesystem::path& base_dir,
+                  const MaterialTable& materials, Scene& scene) {
+  const auto one = root.find("tool");
+  const auto many = root.find("tools");
+  if (one != root.end() && many != root.end())
+    return r.error("tools", "a scene has either 'tool' (one tool) or 'tools' (a list of tools), not both");
+  if (one == root.end() && many == root.end())
+    return r.error("tool", "missing (expected the tool object, or 'tools': a list of tool objects)");
+  scene.tools.clear();
+  if (one != root.end()) {
+    UH_CHECK(read_tool(r, *one, "tool", base_dir, materials, scene.tools.emplace_back()));
+  } else {
+    if (!many->is_array() || many->empty())
+      return r.error("tools", fmt::format("expected a non-empty list of tool objects, got {}",
+                                          many->is_array() ? "an empty list" : many->type_name()));
+    for (std::size_t i = 0; i < many->size(); ++i) {
+      const std::string path = fmt::format("tools[{}]", i);
+      SceneTool tool;
+      tool.name = fmt::format("tool{}", i + 1);
+      UH_CHECK(read_tool(r, (*many)[i], path, base_dir, materials, tool));
+      for (const SceneTool& other : scene.tools)
+        if (other.name == tool.name)
+          return r.error(path + ".name", fmt::format("duplicate tool name '{}'", tool.name));
+      scene.tools.push_back(std::move(tool));
+    }
+  }
+  // names address objects and tools alike (the service's scene document, contact reports)
+  for (std::size_t i = 0; i < scene.tools.size(); ++i)
+    for (const SceneObject& o : scene.objects)
+      if (o.name == scene.tools[i].name)
+        return r.error(one != root.end() ? "tool.name" : fmt::format("tools[{}].name", i),
+                       fmt::format("'{}' is also an object's name", o.name));
+  for (std::size_t t = 0; t < scene.tools.size(); ++t)
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+      UH_CHECK(check_material_law(r, scene.tools[t], one != root.end() ? "tool" : fmt::format("tools[{}]", t),
+                                  fmt::format("objects[{}]", i), scene.objects[i].material));
   return Ok{};
 }
 
@@ -439,8 +504,8 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
   const FieldReader r(source);
   if (!root.is_object()) return Error{fmt::format("{}: expected a JSON object at the top level", source)};
   UH_CHECK(r.check_keys(root, "",
-                        {"name", "description", "rates", "seconds", "objects", "tool", "watch", "force",
-                         "collision", "materials"}));
+                        {"name", "description", "rates", "seconds", "objects", "tool", "tools", "watch",
+                         "force", "collision", "materials"}));
   MaterialTable materials;
   UH_CHECK(read_material_table(r, root, materials));
 
@@ -482,24 +547,7 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
     scene.objects.push_back(std::move(object));
   }
 
-  const auto tool = root.find("tool");
-  if (tool == root.end()) return r.error("tool", "missing (expected the tool object)");
-  UH_CHECK(r.require_object(*tool, "tool"));
-  UH_CHECK(r.check_keys(
-      *tool, "tool",
-      {"name", "mesh", "ist", "spheres", "meters_per_unit", "force", "device", "workspace", "material"}));
-  UH_CHECK(r.string(*tool, "tool", "name", scene.tool.name, false));
-  UH_CHECK(read_shape(r, *tool, "tool", base_dir, scene.tool.shape));
-  if (const auto it = tool->find("force"); it != tool->end()) UH_CHECK(read_force_params(r, *it, "tool.force", scene.tool));
-  UH_CHECK(read_material(r, *tool, "tool", materials, scene.tool.material));
-  UH_CHECK(check_material_law(r, scene, "tool", scene.tool.material));
-  for (std::size_t i = 0; i < scene.objects.size(); ++i)
-    UH_CHECK(check_material_law(r, scene, fmt::format("objects[{}]", i), scene.objects[i].material));
-  const auto device = tool->find("device");
-  if (device == tool->end()) return r.error("tool.device", "missing (expected {\"driver\": ..., \"config\": {...}})");
-  UH_CHECK(read_device(r, *device, "tool.device", base_dir, scene.tool.device));
-  if (const auto it = tool->find("workspace"); it != tool->end())
-    UH_CHECK(read_workspace(r, *it, "tool.workspace", scene.tool.workspace));
+  UH_CHECK(read_tools(r, root, base_dir, materials, scene));
 
   if (const auto it = root.find("watch"); it != root.end()) {
     if (!it->is_array()) return r.error("watch", "expected a list of object names");

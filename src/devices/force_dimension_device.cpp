@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <utility>
 
 #include "dhd_api.hpp"
@@ -27,6 +29,40 @@ constexpr Model kModels[] = {
     {63, 20.0, {0.2, 0.2, 0.13}, 3},        // delta.3: 400 mm x 260 mm
     {104, 20.0, {0.095, 0.095, 0.065}, 6},  // sigma.7 right: 190 mm x 130 mm
 };
+
+// The DHD devices this program holds open, by library and index, with their DHD IDs: a second
+// device object (two tools, two hands) must neither open one of them again nor close it while it
+// looks for a serial number. Setup only (open and close), any thread.
+class HeldDevices {
+ public:
+  // the ID of device `index` of `library` if this program holds it open, else -1
+  int id_of(const std::string& library, int index) {
+    const std::lock_guard lock(mutex_);
+    const auto it = held_.find({library, index});
+    return it == held_.end() ? -1 : it->second;
+  }
+  void hold(const std::string& library, int index, int id) {
+    const std::lock_guard lock(mutex_);
+    held_[{library, index}] = id;
+  }
+  void release(const std::string& library, int id) {
+    const std::lock_guard lock(mutex_);
+    for (auto it = held_.begin(); it != held_.end(); ++it)
+      if (it->first.first == library && it->second == id) {
+        held_.erase(it);
+        return;
+      }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::pair<std::string, int>, int> held_;
+};
+
+HeldDevices& held_devices() {
+  static HeldDevices held;
+  return held;
+}
 
 double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -126,16 +162,32 @@ Status ForceDimensionDevice::open_selected() {
     if (selection_.index >= count)
       return Error{fmt::format("forcedimension: index {} asked for, but {} device{} found", selection_.index,
                                count, count == 1 ? " is" : "s are")};
+    if (held_devices().id_of(library_.path(), selection_.index) >= 0)
+      return Error{
+          fmt::format("forcedimension: device {} is open already (another tool of this program drives it)",
+                      selection_.index)};
     const int id = api.dhdOpenID(static_cast<char>(selection_.index));
     if (id < 0)
       return Error{fmt::format("forcedimension: opening device {} failed: {}", selection_.index,
                                dhd::last_error(api))};
     id_ = static_cast<char>(id);
+    held_devices().hold(library_.path(), selection_.index, id);
     return Ok{};
   }
   // by serial: open each in turn, keep the one whose serial matches
   std::string seen;
   for (int i = 0; i < count; ++i) {
+    // a device this program drives already is read where it is, never opened or closed again
+    if (const int held = held_devices().id_of(library_.path(), i); held >= 0) {
+      unsigned short sn = 0;
+      if (api.dhdGetSerialNumber(&sn, static_cast<char>(held)) == 0 && sn == selection_.serial)
+        return Error{
+            fmt::format("forcedimension: the device with serial {} is open already (another tool of this "
+                        "program drives it)",
+                        selection_.serial)};
+      seen += fmt::format("{}serial {} (in use)", seen.empty() ? "" : ", ", sn);
+      continue;
+    }
     const int id = api.dhdOpenID(static_cast<char>(i));
     if (id < 0) {
       seen +=
@@ -146,6 +198,7 @@ Status ForceDimensionDevice::open_selected() {
     const bool read = api.dhdGetSerialNumber(&sn, static_cast<char>(id)) == 0;
     if (read && sn == selection_.serial) {
       id_ = static_cast<char>(id);
+      held_devices().hold(library_.path(), i, id);
       return Ok{};
     }
     seen += read ? fmt::format("{}serial {}", seen.empty() ? "" : ", ", sn)
@@ -199,6 +252,7 @@ Status ForceDimensionDevice::close() {
   const bool stopped = api.dhdStop(id_) >= 0;
   const std::string message = dhd::last_error(api);
   api.dhdClose(id_);
+  held_devices().release(library_.path(), id_);
   open_ = false;
   forces_on_ = false;
   id_ = -1;

@@ -129,6 +129,7 @@ void HapticManager::on_loop_exit(const LoopExit& exit) {
   // haptic thread, the loop is over: zero first, everything else after; a driver whose
   // read_state() threw is not asked again
   send_final_zero(steady_now_s(), !(exit.callback_threw && phase_ == TickPhase::kReadState));
+  if (exit.callback_threw && options_.fault_group != nullptr) options_.fault_group->trip();
   if (exit.callback_threw)
     failure_ = fmt::format("the haptic thread stopped: {} threw: {}; the device was sent zero force",
                            phase_name(phase_), exit.what);
@@ -160,7 +161,7 @@ void HapticManager::stop() {
     servo_->stop();
     // a run whose last frame never came: the device's servo thread stopped answering (the clock
     // gave up on it and turned forces off, maybe before this stop); latched like any device fault
-    if (!ended_with_zero_) faulted_.store(true, std::memory_order_release);
+    if (!ended_with_zero_) latch_fault();
     servo_run_started_ = false;
   }
   loop_.stop();
@@ -220,7 +221,7 @@ TraceSample HapticManager::tick(double now_s) {
   if (sample.state.status != DeviceStatus::kOk || frozen) {
     device_errors_.increment();
     if (!faulted_.load(std::memory_order_relaxed)) fault_was_freeze_.store(frozen, std::memory_order_relaxed);
-    faulted_.store(true, std::memory_order_release);
+    latch_fault();
     sample.flags |= kTraceDeviceError;
   } else {
     phase_ = TickPhase::kMove;
@@ -235,7 +236,8 @@ TraceSample HapticManager::tick(double now_s) {
   if (info_.dof_actuated < 6) out.torque = {};
   // the halt/fault state first: resume() and clear_fault() publish the fade restart before they
   // clear it, so a tick that sees it cleared also sees the restart
-  const bool zero = halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire);
+  const bool zero = halted_.load(std::memory_order_acquire) || faulted_.load(std::memory_order_acquire) ||
+                    (options_.fault_group != nullptr && options_.fault_group->tripped());
   if (restart_fade_.exchange(false, std::memory_order_acq_rel)) fade_count_ = 0;
   if (zero || nonfinite) {
     // zero at once, past the rate limit: the chain ramps up from it afterwards
@@ -265,6 +267,12 @@ TraceSample HapticManager::tick(double now_s) {
   sent_event_.broadcast(sample);
   phase_ = TickPhase::kIdle;
   return sample;
+}
+
+void HapticManager::latch_fault() {
+  faulted_.store(true, std::memory_order_release);
+  // the other devices of the group go to zero with this one
+  if (options_.fault_group != nullptr) options_.fault_group->trip();
 }
 
 void HapticManager::count(std::uint32_t flags) {

@@ -36,6 +36,23 @@ json state_json(const controllers::SessionState& s) {
       {"collision", {{"rate_hz", s.collision_rate_hz}}}};
 }
 
+// the first tool's state at the top level (as with one tool); with several tools also `tools`:
+// each one's state, named
+json session_state_json(controllers::HapticSession& session) {
+  json j = state_json(session.state());
+  if (session.tool_count() < 2) return j;
+  json tools = json::array();
+  for (std::size_t t = 0; t < session.tool_count(); ++t) {
+    json one = state_json(session.state(t));
+    one.erase("clock_s");
+    one.erase("collision");
+    one["name"] = session.scene().tools[t].name;
+    tools.push_back(std::move(one));
+  }
+  j["tools"] = std::move(tools);
+  return j;
+}
+
 // "add_object 'bunny'": names the request in messages about its binary frame.
 std::string add_object_label(const AddObject& add) {
   const auto name = add.object.find("name");
@@ -257,7 +274,7 @@ std::string Hub::on_open(ClientId id, const json& req_id, const Open& o) {
   json objects = json::array();
   for (const auto& object : scene.objects) objects.push_back(object.name);
   send_to(id, reply("opened", req_id,
-                    {{"scene", scene.name}, {"objects", std::move(objects)}, {"tool", scene.tool.name}}));
+                    {{"scene", scene.name}, {"objects", std::move(objects)}, {"tool", scene.tool().name}}));
   broadcast_session("opened");
   return {};
 }
@@ -340,7 +357,7 @@ json Hub::stop_session(Status* status_out, json* state_out) {
   poll_events();  // the events up to the stop
   event_timer_.cancel();
   // after the stop: the zero force the device was sent last
-  if (state_out != nullptr) *state_out = state_json(slot_->session->state());
+  if (state_out != nullptr) *state_out = session_state_json(*slot_->session);
   json report = json::parse(controllers::session_report_json(slot_->session->report()));
   slot_->phase = Phase::kOpen;
   slot_->session = nullptr;
@@ -430,7 +447,7 @@ void Hub::send_state(ClientId id) {
   if (!slot_ || slot_->phase != Phase::kRunning) return;
   const auto it = clients_.find(id);
   if (it == clients_.end()) return;
-  it->second.peer->send(reply("state", nullptr, state_json(slot_->session->state())), true);
+  it->second.peer->send(reply("state", nullptr, session_state_json(*slot_->session)), true);
 }
 
 void Hub::poll_events() {
@@ -443,6 +460,9 @@ void Hub::poll_events() {
         reply("contact", nullptr,
               {{"event", event.kind == controllers::ContactEventKind::kBegin ? "begin" : "end"},
                {"object", known ? scene.objects[static_cast<std::size_t>(event.object)].name : std::string()},
+               {"tool", static_cast<std::size_t>(event.tool) < scene.tools.size()
+                            ? scene.tools[static_cast<std::size_t>(event.tool)].name
+                            : std::string()},
                {"time_s", event.time_s},
                {"volume", event.volume},
                {"pairs", event.pairs}});
@@ -479,10 +499,10 @@ std::string Hub::on_edit(ClientId id, const json& req_id, const std::string& typ
     fields["objects"] = doc.scene().watch;
   } else if (const auto* d = std::get_if<SetDevice>(&body)) {
     done = doc.set_device(d->device, options_.working_dir);
-    fields["driver"] = doc.scene().tool.device.driver;
+    fields["driver"] = doc.scene().tool().device.driver;
   } else if (const auto* t = std::get_if<SetTool>(&body)) {
     done = doc.set_tool(t->tool, options_.working_dir);
-    fields["name"] = doc.scene().tool.name;
+    fields["name"] = doc.scene().tool().name;
   } else if (const auto* rates = std::get_if<SetRates>(&body)) {
     done = doc.set_rates(rates->haptic_hz, rates->collision_hz);
     fields["haptic_hz"] = doc.scene().haptic_hz;

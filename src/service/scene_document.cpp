@@ -170,9 +170,9 @@ json describe_scene(const controllers::Scene& scene) {
   return {{"name", scene.name},
           {"objects", std::move(objects)},
           {"tool",
-           {{"name", scene.tool.name},
-            {"has_mesh", !scene.tool.shape.mesh.empty()},
-            {"device", scene.tool.device.driver}}},
+           {{"name", scene.tool().name},
+            {"has_mesh", !scene.tool().shape.mesh.empty()},
+            {"device", scene.tool().device.driver}}},
           {"haptic_hz", scene.haptic_hz},
           {"collision_hz", scene.collision_hz}};
 }
@@ -181,7 +181,8 @@ Result<json> scene_mesh(const controllers::Scene& scene, const std::string& name
   const controllers::SceneShape* shape = nullptr;
   for (const auto& o : scene.objects)
     if (o.name == name) shape = &o.shape;
-  if (name == scene.tool.name) shape = &scene.tool.shape;
+  for (const auto& tool : scene.tools)
+    if (tool.name == name) shape = &tool.shape;
   if (shape == nullptr) return Error{fmt::format("no object or tool is named '{}'", name)};
   if (shape->mesh.empty())
     return Error{fmt::format("'{}' was given as a .ist file, which holds no mesh", name)};

@@ -571,6 +571,67 @@ static void test_mesh_formats(void) {
   }
 }
 
+/* A scene file with two tools, each on its own simulated device (the left stylus presses into
+ * the bunny, the right one into a ball): each tool's state through uh_session_tool_state, the
+ * first also through uh_session_poll, and each tool in the report. */
+static void test_two_tools(void) {
+  char path[512];
+  FILE* f;
+  uh_session* s = NULL;
+  int32_t count = 0;
+  const char* name = NULL;
+  const char* report = NULL;
+  uh_state first = {0}, left = {0}, right = {0};
+  snprintf(path, sizeof path, "%s/capi_two_tools.json", UH_TEST_TMP_DIR);
+  f = fopen(path, "w");
+  if (f == NULL) {
+    fprintf(stderr, "cannot write %s\n", path);
+    exit(1);
+  }
+  fprintf(
+      f,
+      "{\"name\": \"two-c\", \"objects\": ["
+      "{\"name\": \"bunny\", \"mesh\": \"%s/meshes/bunny_npm_3674.obj\", \"meters_per_unit\": 0.01,"
+      " \"spheres\": 600, \"pose\": {\"rotation\": [0.70710678, 0.70710678, 0, 0]}},"
+      "{\"name\": \"ball\", \"mesh\": \"%s/meshes/ball.obj\", \"meters_per_unit\": 0.03, \"spheres\": 200,"
+      " \"pose\": {\"position\": [0.15, 0, 0.03]}}],"
+      " \"tools\": ["
+      "{\"name\": \"left\", \"mesh\": \"%s/meshes/stylus.obj\", \"meters_per_unit\": 0.01, \"spheres\": 150,"
+      " \"force\": {\"mode\": \"3dof\", \"stiffness\": 1.6e4, \"max_force_n\": 6.0},"
+      " \"device\": {\"driver\": \"sim-line\", \"config\": {\"start\": [0, 0, 0.1], \"end\": [0, 0, "
+      "0.045]}}},"
+      "{\"name\": \"right\", \"mesh\": \"%s/meshes/stylus.obj\", \"meters_per_unit\": 0.01, \"spheres\": 150,"
+      " \"force\": {\"mode\": \"3dof\", \"stiffness\": 1.6e4, \"max_force_n\": 4.0},"
+      " \"device\": {\"driver\": \"sim-line\", \"config\": {\"start\": [0.15, 0, 0.1], \"end\": [0.15, 0, "
+      "0.048]}}}"
+      "]}",
+      UH_TEST_DATA_DIR, UH_TEST_DATA_DIR, UH_TEST_DATA_DIR, UH_TEST_DATA_DIR);
+  fclose(f);
+  REQUIRE_OK(uh_session_open(path, &s));
+  REQUIRE_OK(uh_session_tool_count(s, &count));
+  CHECK(count == 2);
+  REQUIRE_OK(uh_session_tool_name(s, 1, &name));
+  CHECK(strcmp(name, "right") == 0);
+  CHECK_STATUS(uh_session_tool_name(s, 2, &name), UH_ERROR_INVALID_ARGUMENT);
+  REQUIRE_OK(uh_session_run_stepped(s, 1.0, 4));
+  first.struct_size = left.struct_size = right.struct_size = sizeof(uh_state);
+  REQUIRE_OK(uh_session_poll(s, &first));
+  REQUIRE_OK(uh_session_tool_state(s, 0, &left));
+  REQUIRE_OK(uh_session_tool_state(s, 1, &right));
+  /* uh_session_poll is the first tool's */
+  CHECK(first.haptic_ticks == left.haptic_ticks && first.time_s == left.time_s);
+  CHECK(first.tool_position[0] == left.tool_position[0] && first.tool_position[2] == left.tool_position[2]);
+  CHECK(right.haptic_ticks == 1000);
+  CHECK(fabs(right.tool_position[0] - 0.15) < 1e-9 && fabs(left.tool_position[0]) < 1e-9);
+  CHECK_STATUS(uh_session_tool_state(s, 2, &right), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "uh_session_tool_state: there is no tool 2 (the scene has 2)") != NULL);
+  CHECK_STATUS(uh_session_tool_state(s, -1, &right), UH_ERROR_INVALID_ARGUMENT);
+  REQUIRE_OK(uh_session_report_json(s, &report));
+  CHECK(strstr(report, "\"tool\": \"right\"") != NULL);
+  uh_session_close(s);
+  remove(path);
+}
+
 int main(int argc, char** argv) {
   static const struct {
     const char* name;
@@ -582,7 +643,8 @@ int main(int argc, char** argv) {
                {"handle_misuse", test_handle_misuse},
                {"trees", test_trees},
                {"scene_building", test_scene_building},
-               {"mesh_formats", test_mesh_formats}};
+               {"mesh_formats", test_mesh_formats},
+               {"two_tools", test_two_tools}};
   size_t i;
   if (argc != 2) {
     fprintf(stderr, "usage: %s TEST\n", argv[0]);

@@ -612,6 +612,64 @@ TEST_F(CliTest, DevicesAndRunOnHaplysService) {
   EXPECT_EQ(service.received().back(), Vec3{});
 }
 
+// two devices of different drivers in one session, each on its stand-in: HD's Touch presses into
+// the bunny (its handle rests at the origin), the omega.3 into a ball 15 cm beside it (its
+// workspace moved there); HD's scheduler clocks one loop, the manager's own the other
+TEST_F(CliTest, RunsTwoDevicesOfDifferentDriversInOneSession) {
+  const fs::path meshes = fs::path(UH_TEST_DATA_DIR) / "meshes";
+  const fs::path scene = dir_ / "hands.json";
+  std::ofstream(scene) << fmt::format(R"({{
+  "name": "hands",
+  "seconds": 0.3,
+  "objects": [{{ "name": "bunny", "mesh": "{0}", "meters_per_unit": 0.01, "spheres": 600,
+               "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }},
+             {{ "name": "ball", "mesh": "{1}", "meters_per_unit": 0.03, "spheres": 200,
+               "pose": {{ "position": [0.15, 0, 0.03] }} }}],
+  "tools": [{{ "name": "left", "mesh": "{2}", "meters_per_unit": 0.01, "spheres": 150,
+             "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "max_force_n": 6.0 }},
+             "device": {{ "driver": "openhaptics" }} }},
+            {{ "name": "right", "mesh": "{2}", "meters_per_unit": 0.01, "spheres": 150,
+             "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "max_force_n": 6.0 }},
+             "device": {{ "driver": "forcedimension", "config": {{ "serial": 11001 }} }},
+             "workspace": {{ "offset": [0.15, 0, 0.03] }} }}]
+}})",
+                                      (meshes / "bunny_npm_3674.obj").string(),
+                                      (meshes / "ball.obj").string(), (meshes / "stylus.obj").string());
+  const CommandRun r = uh(fmt::format("run '{}' --json", scene.string()), with_standin(dir_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["tools"].size(), 2u) << r.out;
+  const auto& left = j["tools"][0];
+  const auto& right = j["tools"][1];
+  EXPECT_EQ(left["tool"], "left");
+  EXPECT_EQ(left["device"]["name"], "openhaptics Touch");
+  EXPECT_EQ(right["device"]["name"], "forcedimension omega.3");
+  EXPECT_EQ(right["device"]["serial"], "11001");
+  for (const auto* t : {&left, &right}) {
+    EXPECT_GT((*t)["haptic"]["ticks"].get<int>(), 100) << *t;
+    EXPECT_GT((*t)["contact"]["ticks"].get<int>(), 50) << *t;
+    EXPECT_GT((*t)["force"]["max_n"].get<double>(), 0.5) << *t;
+    EXPECT_EQ((*t)["force"]["nonfinite"], 0) << *t;
+  }
+  EXPECT_LE(left["force"]["max_n"].get<double>(), 3.3) << "the Touch's own limit";
+  EXPECT_LE(right["force"]["max_n"].get<double>(), 6.0) << "the tool's limit, below the omega.3's 12 N";
+  EXPECT_EQ(j["device"], left["device"]) << "the top level is the first tool's, as in one-tool sessions";
+
+  // the summary has a block per device
+  const CommandRun text = uh(fmt::format("run '{}' --seconds 0.2", scene.string()), with_standin(dir_));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("device    tool 'left': openhaptics Touch"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("device    tool 'right': forcedimension omega.3, serial 11001"), std::string::npos)
+      << text.out;
+  // --device names one device: refused for two
+  const CommandRun refused =
+      uh(fmt::format("run '{}' --device forcedimension --seconds 0.2", scene.string()), with_standin(dir_));
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("--device replaces the device of a one-tool scene; this scene has 2 tools"),
+            std::string::npos)
+      << refused.err;
+}
+
 // ---- uh explore: the materials of scenes/materials.json recovered from the force trace ----
 //
 // References from the scene file itself (not from the estimators) and textbook geometry: a ball

@@ -83,6 +83,84 @@ TEST(HapticSessionThreaded, ThrowingTickEndsTheRunWithZeroForceAndTheCause) {
   std::filesystem::remove_all(cache);
 }
 
+// Two tools, two haptic threads, one collision thread: both hands feel their contact while the
+// owner reads each tool's state; then the right hand's driver throws, and the left hand's force
+// goes to zero with it (its device keeps ticking, zeroed, until the session stops).
+TEST(HapticSessionThreaded, TwoToolsRunOnTwoHapticThreadsAndStopTogether) {
+  const auto cache = testing::fresh_cache("two-tools");
+  haptico::DeviceRegistry registry = haptico::DeviceRegistry::with_simulated_devices();
+  const haptico::DeviceRegistry simulated = haptico::DeviceRegistry::with_simulated_devices();
+  haptico::DeviceCommand right_last{.force = {1, 1, 1}};
+  int throw_at = -1;  // never, for the first session
+  ASSERT_TRUE(registry.register_driver(
+      "throwing-line",
+      [&](const haptico::DeviceConfig& config) -> Result<std::unique_ptr<haptico::HapticDevice>> {
+        auto inner = simulated.create("sim-line", config);
+        if (!inner) return inner.error();
+        return std::unique_ptr<haptico::HapticDevice>(
+            new ThrowingDevice(std::move(inner).value(), throw_at, &right_last));
+      }));
+  // the right hand's device is the second "sim-line" of the scene
+  std::string json = testing::two_hands_scene_json();
+  const auto second = json.find(R"("driver": "sim-line")", json.find(R"("driver": "sim-line")") + 1);
+  ASSERT_NE(second, std::string::npos);
+  json.replace(second, std::string(R"("driver": "sim-line")").size(), R"("driver": "throwing-line")");
+  auto scene = parse_scene(json, "hands.json", testing::test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  SessionOptions options;
+  options.cache_dir = cache;
+  {
+    auto session = HapticSession::create(*scene, options, registry);
+    ASSERT_TRUE(session.has_value()) << session.error().message;
+    ASSERT_EQ((*session)->tool_count(), 2u);
+    std::uint64_t right_ticks_seen = 0;
+    const Status ran = (*session)->run(1.0, [&](const SessionState& first) {
+      EXPECT_EQ(first.tool, 0);
+      const SessionState right = (*session)->state(1);  // the owner reads the other haptic thread's state
+      EXPECT_EQ(right.tool, 1);
+      EXPECT_GE(right.haptic_ticks, right_ticks_seen);
+      right_ticks_seen = right.haptic_ticks;
+    });
+    ASSERT_TRUE(ran) << ran.error().message;
+    const SessionReport& r = (*session)->report();
+    ASSERT_EQ(r.tools.size(), 2u);
+    for (const ToolReport& t : r.tools) {
+      EXPECT_GT(t.haptic_ticks, 250u) << t.tool << ": about 1000 ticks at 1 kHz; loose for sanitizer builds";
+      EXPECT_GT(t.contact_ticks, 0u) << t.tool;
+      EXPECT_EQ(t.force_nonfinite, 0u) << t.tool;
+    }
+    EXPECT_LE(r.tools[1].force_max_n, 4.0 + 1e-9);
+    EXPECT_EQ(right_last.force, Vec3{}) << "the end sent zero";
+    EXPECT_EQ(norm((*session)->state(0).force_world), 0.0);
+    EXPECT_EQ(norm((*session)->state(1).force_world), 0.0);
+  }
+
+  throw_at = 700;  // the right stylus is in the ball, pushed out with force, when its driver fails
+  auto session = HapticSession::create(*scene, options, registry);
+  ASSERT_TRUE(session.has_value()) << session.error().message;
+  const Status ran = (*session)->run(30.0);
+  ASSERT_FALSE(ran.has_value());
+  EXPECT_EQ(
+      ran.error().message,
+      "hands.json: tools[1] 'right': the haptic thread stopped: reading the device state threw: USB cable "
+      "pulled; the device was sent zero force");
+  EXPECT_LT((*session)->report().seconds, 30.0) << "the run ended when the right hand's thread did";
+  EXPECT_EQ(right_last.force, Vec3{});
+  EXPECT_EQ(norm((*session)->state(0).force_world), 0.0);
+  // the left hand's ticks after the throw (with a margin for the thread that threw to trip the
+  // group: 5 periods) and before the session stopped were all zeroed
+  const SessionReport& r = (*session)->report();
+  ASSERT_FALSE(r.tools[1].timeline.empty());
+  const double thrown_at_s = r.tools[1].timeline.back().time_s;
+  for (const TimelineSample& t : r.tools[0].timeline) {
+    if (t.time_s > thrown_at_s + 0.005) {
+      EXPECT_EQ(t.force_n, 0.0) << "left hand at " << t.time_s << " s";
+    }
+  }
+  EXPECT_GT(r.tools[0].zeroed_ticks, 0u);
+  std::filesystem::remove_all(cache);
+}
+
 // Runs the real three-thread pipeline (haptic, collision, application) for 2 s. Under
 // ThreadSanitizer this checks every cross-thread exchange of the pipeline.
 TEST(HapticSessionThreaded, TwoSecondSessionRunsAllThreadsAndEndsWithZeroForce) {

@@ -36,9 +36,9 @@ TEST(SceneMaterials, WithoutMaterialsNothingChanges) {
   const forcecomp::Material& m = scene->objects[0].material;
   EXPECT_FALSE(m.has_stiffness || m.has_damping || m.has_friction);
   EXPECT_EQ(m.texture.kind, forcecomp::TextureKind::kNone);
-  const auto combined = forcecomp::combine_materials(m, scene->tool.material, scene->tool.force);
-  EXPECT_EQ(combined.stiffness, scene->tool.force.stiffness);
-  EXPECT_EQ(combined.damping, scene->tool.force.damping);
+  const auto combined = forcecomp::combine_materials(m, scene->tool().material, scene->tool().force);
+  EXPECT_EQ(combined.stiffness, scene->tool().force.stiffness);
+  EXPECT_EQ(combined.damping, scene->tool().force.damping);
   EXPECT_FALSE(combined.has_friction() || combined.has_texture());
 }
 
@@ -63,7 +63,7 @@ TEST(SceneMaterials, ReadsInlineAndNamedMaterials) {
       parse(replaced(small_scene_json(), R"("name": "stylus",)",
                      R"("name": "stylus", "material": { "friction": { "static": 0.3, "dynamic": 0.3 } },)"));
   ASSERT_TRUE(tool.has_value()) << tool.error().message;
-  EXPECT_TRUE(tool->tool.material.has_friction);
+  EXPECT_TRUE(tool->tool().material.has_friction);
 }
 
 TEST(SceneMaterials, EveryBadValueIsRefusedWithTheFileAndTheField) {

@@ -32,10 +32,10 @@ TEST(Scene, ParsesTheSmallTestScene) {
   EXPECT_EQ(scene->objects[0].shape.spheres, 600);
   EXPECT_DOUBLE_EQ(scene->objects[0].shape.meters_per_unit, 0.01);
   EXPECT_NEAR(scene->objects[0].pose.rotation.x, std::sqrt(0.5), 1e-6);
-  EXPECT_EQ(scene->tool.device.driver, "sim-line");
-  EXPECT_EQ(scene->tool.device.config.text("end", ""), "0,0,0.045");
-  EXPECT_EQ(scene->tool.force.law, forcecomp::ForceLaw::kGradient) << "the gradient law is the default";
-  EXPECT_DOUBLE_EQ(scene->tool.force.stiffness, 1.6e4);
+  EXPECT_EQ(scene->tool().device.driver, "sim-line");
+  EXPECT_EQ(scene->tool().device.config.text("end", ""), "0,0,0.045");
+  EXPECT_EQ(scene->tool().force.law, forcecomp::ForceLaw::kGradient) << "the gradient law is the default";
+  EXPECT_DOUBLE_EQ(scene->tool().force.stiffness, 1.6e4);
   EXPECT_EQ(scene->watch, std::vector<std::string>{"bunny"});
   EXPECT_TRUE(scene->force.multi_rate);
   EXPECT_DOUBLE_EQ(scene->coherence_skin, 0.0) << "coherence is off unless a scene asks for it";
@@ -47,8 +47,8 @@ TEST(Scene, ReadsThePaperLawWithItsForceScale) {
                            R"("mode": "6dof")", R"("mode": "6dof", "law": "paper")"),
                   "small.json", test_assets());
   ASSERT_TRUE(scene.has_value()) << scene.error().message;
-  EXPECT_EQ(scene->tool.force.law, forcecomp::ForceLaw::kPaper);
-  EXPECT_DOUBLE_EQ(scene->tool.force.force_scale, 8.0e6);
+  EXPECT_EQ(scene->tool().force.law, forcecomp::ForceLaw::kPaper);
+  EXPECT_DOUBLE_EQ(scene->tool().force.force_scale, 8.0e6);
 }
 
 TEST(Scene, ReadsTheCollisionSection) {
@@ -139,12 +139,76 @@ TEST(Scene, ReadsTheSafetyLimitsAndTheRateLimit) {
   EXPECT_EQ(scene->safety_limits.max_torque_nm, 0.1);
   EXPECT_EQ(scene->rate_limit.max_force_n_per_s, 300.0);
   EXPECT_EQ(scene->rate_limit.max_torque_nm_per_s, 7.0);
-  EXPECT_EQ(scene->tool.force.max_force_n, 6.0);
+  EXPECT_EQ(scene->tool().force.max_force_n, 6.0);
   const auto bad = parse_scene(replaced(with_safety, "300", "0"), "small.json", test_assets());
   ASSERT_FALSE(bad.has_value());
   EXPECT_NE(bad.error().message.find("field 'force.safety.max_force_rate_n_per_s': expected a number in"),
             std::string::npos)
       << bad.error().message;
+}
+
+// `tools`: several tools, each with its own device; `tool` stays the one-tool spelling
+TEST(Scene, ReadsSeveralToolsEachWithItsDevice) {
+  const auto scene = parse_scene(testing::two_hands_scene_json(), "hands.json", test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  ASSERT_EQ(scene->tools.size(), 2u);
+  EXPECT_EQ(scene->tools[0].name, "left");
+  EXPECT_EQ(scene->tools[1].name, "right");
+  EXPECT_EQ(scene->tools[1].mode, forcecomp::ForceMode::k3Dof);
+  EXPECT_EQ(scene->tools[1].force.max_force_n, 4.0);
+  EXPECT_EQ(scene->tools[1].device.config.text("end", ""), "0.15,0,0.048");
+  EXPECT_EQ(&scene->tool(), &scene->tools[0]) << "the first tool is the tool";
+  const auto one = parse_scene(testing::two_hands_scene_json("right"), "hand.json", test_assets());
+  ASSERT_TRUE(one.has_value()) << one.error().message;
+  ASSERT_EQ(one->tools.size(), 1u);
+  EXPECT_EQ(one->tool().name, "right");
+}
+
+TEST(Scene, NamesTheBadFieldOfSeveralTools) {
+  const auto error_of = [](const std::string& json) {
+    const auto scene = parse_scene(json, "hands.json", test_assets());
+    return scene ? std::string("(parsed)") : scene.error().message;
+  };
+  const std::string both = testing::two_hands_scene_json();
+  // both spellings at once
+  EXPECT_EQ(error_of(testing::two_hands_scene_json("both", R"(, "tool": { "mesh": "meshes/stylus.obj" })")),
+            "hands.json: field 'tools': a scene has either 'tool' (one tool) or 'tools' (a list of tools), "
+            "not both");
+  // neither
+  EXPECT_EQ(
+      error_of(testing::replaced(both, R"("tools": [)", R"("tool_list": [)")),
+      "hands.json: field 'tool_list': unknown field (known here: name, description, rates, seconds, objects, "
+      "tool, tools, watch, force, collision, materials)");
+  EXPECT_EQ(
+      error_of(R"({ "objects": [{ "name": "ball", "mesh": "meshes/ball.obj" }] })"),
+      "hands.json: field 'tool': missing (expected the tool object, or 'tools': a list of tool objects)");
+  // an empty list, a list of something else
+  EXPECT_EQ(error_of(R"({ "objects": [{ "name": "ball", "mesh": "meshes/ball.obj" }], "tools": [] })"),
+            "hands.json: field 'tools': expected a non-empty list of tool objects, got an empty list");
+  EXPECT_EQ(error_of(R"({ "objects": [{ "name": "ball", "mesh": "meshes/ball.obj" }], "tools": {} })"),
+            "hands.json: field 'tools': expected a non-empty list of tool objects, got object");
+  // a field of the second tool, by its place in the list
+  EXPECT_EQ(error_of(testing::replaced(both, R"("driver": "sim-line",
+                "config": { "start": [0.15)",
+                                       R"("driver": 7,
+                "config": { "start": [0.15)")),
+            "hands.json: field 'tools[1].device.driver': expected a non-empty string, got 7");
+  EXPECT_NE(error_of(testing::replaced(both, R"("mode": "3dof")", R"("mode": "2dof")"))
+                .find("field 'tools[1].force.mode': expected \"3dof\" or \"6dof\""),
+            std::string::npos);
+  EXPECT_NE(error_of(testing::replaced(both, R"("name": "right", "mesh")", R"("name": "right", "meshes")"))
+                .find("field 'tools[1].meshes': unknown field"),
+            std::string::npos);
+  EXPECT_EQ(error_of(testing::replaced(both, R"("name": "right")", R"("name": "left")")),
+            "hands.json: field 'tools[1].name': duplicate tool name 'left'");
+  EXPECT_EQ(error_of(testing::replaced(both, R"("name": "right")", R"("name": "ball")")),
+            "hands.json: field 'tools[1].name': 'ball' is also an object's name");
+  EXPECT_EQ(error_of(testing::replaced(both, R"("device": { "driver": "sim-line",
+                "config": { "start": [0.15)",
+                                       R"("devices": { "driver": "sim-line",
+                "config": { "start": [0.15)")),
+            "hands.json: field 'tools[1].devices': unknown field (known here: name, mesh, ist, spheres, "
+            "meters_per_unit, force, device, workspace, material)");
 }
 
 TEST(Scene, LoadSceneNamesAMissingFile) {
@@ -186,7 +250,7 @@ TEST(Scene, DefaultSceneIsEmbeddedAndWritesItsMeshes) {
   ASSERT_TRUE(scene.has_value()) << scene.error().message;
   EXPECT_EQ(scene->name, "bunny-sweep");
   EXPECT_TRUE(std::filesystem::exists(scene->objects.at(0).shape.mesh));
-  EXPECT_TRUE(std::filesystem::exists(scene->tool.shape.mesh));
+  EXPECT_TRUE(std::filesystem::exists(scene->tool().shape.mesh));
   std::filesystem::remove_all(cache);
 }
 

@@ -60,6 +60,44 @@ inline std::string small_scene_json(bool multi_rate = true, bool coupling = fals
                      fmt::arg("coupling", coupling ? "true" : "false"));
 }
 
+/// Two hands: the bunny and a ball beside it (15 cm apart), a stylus on its own sim-line device
+/// pressing into each ("left" into the bunny, "right" into the ball, 6-DOF and 3-DOF).
+/// `tools` picks which: "both" (the list `tools`), "left" or "right" (that one alone, as `tool`):
+/// the one-tool sessions are the references of the two-tool one.
+inline std::string two_hands_scene_json(const std::string& tools = "both", const std::string& extra = "") {
+  const std::string left = R"({
+    "name": "left", "mesh": "meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
+    "force": { "mode": "6dof", "stiffness": 1.6e4, "damping": 1.0, "center_of_mass": [0, 0, 0.025],
+               "max_force_n": 6.0, "max_torque_nm": 0.3 },
+    "device": { "driver": "sim-line",
+                "config": { "start": [0.0, 0.0, 0.10], "end": [0.0, 0.0, 0.045], "duration_s": 0.5, "bounce": true,
+                            "dof_actuated": 6, "max_force_n": 6 } } })";
+  const std::string right = R"({
+    "name": "right", "mesh": "meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
+    "force": { "mode": "3dof", "stiffness": 1.0e4, "damping": 0.5, "center_of_mass": [0, 0, 0.025],
+               "max_force_n": 4.0 },
+    "device": { "driver": "sim-line",
+                "config": { "start": [0.15, 0.0, 0.10], "end": [0.15, 0.0, 0.048], "duration_s": 0.4, "bounce": true,
+                            "dof_actuated": 3, "max_force_n": 4 } } })";
+  const std::string tool_part = tools == "both"   ? fmt::format(R"("tools": [{}, {}])", left, right)
+                                : tools == "left" ? fmt::format(R"("tool": {})", left)
+                                                  : fmt::format(R"("tool": {})", right);
+  return fmt::format(R"({{
+  "name": "two-hands-test",
+  "rates": {{ "haptic_hz": 1000, "collision_hz": 1000 }},
+  "seconds": 1.0,
+  "objects": [{{
+    "name": "bunny", "mesh": "meshes/bunny_npm_3674.obj", "meters_per_unit": 0.01, "spheres": 600,
+    "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }}
+  }}, {{
+    "name": "ball", "mesh": "meshes/ball.obj", "meters_per_unit": 0.03, "spheres": 200,
+    "pose": {{ "position": [0.15, 0, 0.03], "rotation": [1, 0, 0, 0] }}
+  }}],
+  {tool_part}{extra}
+}})",
+                     fmt::arg("tool_part", tool_part), fmt::arg("extra", extra));
+}
+
 /// `text` with the first `from` replaced by `to`; a test failure if `from` is not there.
 inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);

@@ -161,18 +161,18 @@ TEST_F(SceneDocumentTest, EditsGoThroughTheSceneParser) {
   EXPECT_TRUE(doc_->scene().watch.empty()) << "removed from the watch list too";
 
   ASSERT_TRUE(doc_->set_device({{"driver", "sim-circle"}, {"config", {{"radius", 0.03}}}}, assets));
-  EXPECT_EQ(doc_->scene().tool.device.driver, "sim-circle");
+  EXPECT_EQ(doc_->scene().tool().device.driver, "sim-circle");
 
   // set_tool merges: the damping changes, the stiffness and the device stay
-  const double stiffness = doc_->scene().tool.force.stiffness;
+  const double stiffness = doc_->scene().tool().force.stiffness;
   ASSERT_TRUE(doc_->set_tool({{"force", {{"damping", 3.5}}}}, assets));
-  EXPECT_EQ(doc_->scene().tool.force.damping, 3.5);
-  EXPECT_EQ(doc_->scene().tool.force.stiffness, stiffness);
-  EXPECT_EQ(doc_->scene().tool.device.driver, "sim-circle");
+  EXPECT_EQ(doc_->scene().tool().force.damping, 3.5);
+  EXPECT_EQ(doc_->scene().tool().force.stiffness, stiffness);
+  EXPECT_EQ(doc_->scene().tool().device.driver, "sim-circle");
   ASSERT_TRUE(doc_->set_tool({{"mesh", "meshes/stylus.obj"}, {"spheres", 50}}, assets));
-  EXPECT_EQ(doc_->scene().tool.shape.mesh, assets / "meshes" / "stylus.obj");
+  EXPECT_EQ(doc_->scene().tool().shape.mesh, assets / "meshes" / "stylus.obj");
   EXPECT_FALSE(doc_->set_tool({{"force", {{"damping", "much"}}}}, assets).has_value());
-  EXPECT_EQ(doc_->scene().tool.force.damping, 3.5) << "a refused patch changes nothing";
+  EXPECT_EQ(doc_->scene().tool().force.damping, 3.5) << "a refused patch changes nothing";
 
   ASSERT_TRUE(doc_->set_rates(2000.0, std::nullopt));
   EXPECT_EQ(doc_->scene().haptic_hz, 2000.0);
@@ -200,7 +200,7 @@ TEST_F(SceneDocumentTest, RefusedEditsLeaveTheSceneAsItWas) {
   fails_with(doc_->set_device({{"config", {{"radius", 0.03}}}}, dir_), "tool.device.driver");
   EXPECT_EQ(doc_->scene().objects.size(), 1u);
   EXPECT_EQ(doc_->scene().objects[0].pose.position.x, 0.0);
-  EXPECT_EQ(doc_->scene().tool.device.driver, "sim-line");
+  EXPECT_EQ(doc_->scene().tool().device.driver, "sim-line");
 }
 
 TEST_F(SceneDocumentTest, MeshesAreInMetresInTheObjectFrame) {

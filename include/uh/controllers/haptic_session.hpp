@@ -73,14 +73,12 @@ struct DeviceReport {
   double com_rate_hz = 0.0;
 };
 
-/// What `uh run --json` prints, and more. Plain data.
-struct SessionReport {
-  std::string scene;
+/// One tool's part of a run: its device, its haptic loop and the forces sent to its device.
+/// Plain data.
+struct ToolReport {
+  std::string tool;  ///< SceneTool::name
   DeviceReport device{};
-  bool stepped = false;
-  double seconds = 0.0;                ///< the time run [s] (less than asked when stopped early)
-  bool stopped_early = false;          ///< request_stop() ended run() or run_stepped() before its time
-  // haptic thread
+  // haptic thread (the tool's device's loop)
   double haptic_target_hz = 0.0;
   double haptic_rate_hz = 0.0;
   std::uint64_t haptic_ticks = 0;
@@ -88,24 +86,13 @@ struct SessionReport {
   double jitter_p50_us = 0.0, jitter_p99_us = 0.0, jitter_p999_us = 0.0, jitter_max_us = 0.0;
   double tick_p50_us = 0.0, tick_p99_us = 0.0, tick_max_us = 0.0;  ///< haptic callback duration
   bool haptic_priority_raised = false;
-  // collision thread
-  double collision_target_hz = 0.0;
-  double collision_rate_min_hz = 0.0, collision_rate_median_hz = 0.0, collision_rate_mean_hz = 0.0;
-  std::uint64_t collision_steps = 0;
-  double query_median_us = 0.0, query_p99_us = 0.0, query_max_us = 0.0;
-  /// duration of a whole collision step (every watcher) [us]
-  double step_median_us = 0.0, step_p99_us = 0.0, step_max_us = 0.0;
-  std::int32_t objects = 0;      ///< objects in the collision world (the tool included)
-  std::int64_t frame_bytes = 0;  ///< heap bytes of the watchers' contact frames at the end of the run
-  std::int64_t max_pairs = 0;
-  std::uint64_t truncated_frames = 0;
-  std::uint64_t coherent_queries = 0;   ///< collision queries that reused their kept candidates
   // forces
   double force_max_n = 0.0, torque_max_nm = 0.0;  ///< largest |force|, |torque| sent to the device [N], [N m]
   double force_max_step_n = 0.0;       ///< largest tick-to-tick change of the force sent to the device [N]
   double force_max_raw_step_n = 0.0;   ///< same for the contact force before coupling, limits and fades [N]
   std::uint64_t force_nonfinite = 0, force_clamped = 0, torque_clamped = 0, stale_ticks = 0;
   haptico::LimitCounters limits{};     ///< ticks in which each limit of the chain engaged
+  std::uint64_t zeroed_ticks = 0;      ///< ticks sent zero by a halt or a fault (this device's or another's)
   std::uint64_t contact_ticks = 0;
   /// Energy the device put into the hand [J]: per tick, the force sent (held over the period)
   /// times the handle's displacement until the next tick; exact for a zero-order hold. Over a
@@ -118,20 +105,44 @@ struct SessionReport {
   double model_error_rms_n = 0.0, model_error_max_n = 0.0;  ///< with check_model
   bool coupling = false;
   std::vector<TimelineSample> timeline;
-  std::vector<RateSample> collision_rates;
 };
 
-/// The newest state of a session, as the haptic thread sent it in its last tick (plain data).
+/// What `uh run --json` prints, and more. Plain data. Its ToolReport part is the first tool's
+/// (the only one in one-tool scenes); `tools` has every tool's, the first included.
+struct SessionReport : ToolReport {
+  std::string scene;
+  bool stepped = false;
+  double seconds = 0.0;        ///< the time run [s] (less than asked when stopped early)
+  bool stopped_early = false;  ///< request_stop() ended run() or run_stepped() before its time
+  // collision thread
+  double collision_target_hz = 0.0;
+  double collision_rate_min_hz = 0.0, collision_rate_median_hz = 0.0, collision_rate_mean_hz = 0.0;
+  std::uint64_t collision_steps = 0;
+  double query_median_us = 0.0, query_p99_us = 0.0, query_max_us = 0.0;
+  /// duration of a whole collision step (every watcher) [us]
+  double step_median_us = 0.0, step_p99_us = 0.0, step_max_us = 0.0;
+  std::int32_t objects = 0;      ///< objects in the collision world (the tools included)
+  std::int64_t frame_bytes = 0;  ///< heap bytes of the watchers' contact frames at the end of the run
+  std::int64_t max_pairs = 0;
+  std::uint64_t truncated_frames = 0;
+  std::uint64_t coherent_queries = 0;  ///< collision queries that reused their kept candidates
+  std::vector<RateSample> collision_rates;
+  std::vector<ToolReport> tools;  ///< per tool, in Scene::tools order
+};
+
+/// The newest state of one tool of a session, as its haptic thread sent it in its last tick (plain
+/// data).
 struct SessionState {
+  std::int32_t tool = 0;               ///< the tool's index in Scene::tools
   double time_s = 0.0;                 ///< that tick's time since start() [s] (stepped: simulated time)
   Vec3 tool_position_world{};          ///< origin of the tool's mesh frame in the world [m]
   Quat tool_orientation_world{};       ///< the tool's orientation in the world (unit quaternion)
   Vec3 force_world{};                  ///< force sent to the device, in the world frame [N]
   Vec3 torque_world{};                 ///< torque sent to the device, in the world frame [N m]
   std::int32_t contact_pairs = 0;      ///< sphere pairs the force of that tick used
-  std::uint64_t haptic_ticks = 0;      ///< haptic ticks since start()
-  std::uint64_t missed_deadlines = 0;  ///< haptic ticks that started more than a period late
-  double haptic_rate_hz = 0.0;         ///< haptic ticks per second over the last ~100 ms [Hz]
+  std::uint64_t haptic_ticks = 0;      ///< the tool's haptic ticks since start()
+  std::uint64_t missed_deadlines = 0;  ///< the tool's haptic ticks that started more than a period late
+  double haptic_rate_hz = 0.0;         ///< the tool's haptic ticks per second over the last ~100 ms [Hz]
   double collision_rate_hz = 0.0;      ///< collision steps per second over the last ~100 ms [Hz]
   std::uint32_t buttons = 0;           ///< the device's buttons as read that tick (bit i: button i)
 };
@@ -142,10 +153,11 @@ enum class ContactEventKind : std::uint8_t {
   kEnd,    ///< the overlap ended
 };
 
-/// A contact between the tool and a watched object began or ended (plain data).
+/// A contact between a tool and a watched object began or ended (plain data).
 struct ContactEvent {
   ContactEventKind kind = ContactEventKind::kBegin;
   std::int32_t object = -1;  ///< index of the object in Scene::objects
+  std::int32_t tool = 0;     ///< index of the tool in Scene::tools
   double time_s = 0.0;       ///< time of the collision step that saw it, since start() [s]
   double volume = 0.0;       ///< overlap volume of that step [m^3] (0 for kEnd)
   std::int32_t pairs = 0;    ///< overlapping sphere pairs of that step (0 for kEnd)
@@ -153,8 +165,11 @@ struct ContactEvent {
 
 class HapticSession {
  public:
-  /// Builds everything a scene needs (loads or builds the sphere trees, creates and opens the
-  /// device through the registry), without starting threads. Errors name the scene and the part.
+  /// Builds everything a scene needs (loads or builds the sphere trees, creates and opens each
+  /// tool's device through the registry), without starting threads. Errors name the scene and
+  /// the part. Each tool gets its own HapticManager (its own haptic loop, limit chain and device
+  /// limits); the tools share the collision world and its thread, and one FaultGroup: a fault of
+  /// any device zeroes every device's force.
   static Result<std::unique_ptr<HapticSession>> create(
       const Scene& scene, const SessionOptions& options = {},
       const haptico::DeviceRegistry& registry = devices::all_drivers());
@@ -162,16 +177,20 @@ class HapticSession {
   HapticSession(const HapticSession&) = delete;
   HapticSession& operator=(const HapticSession&) = delete;
 
-  /// Starts the haptic and collision threads and a monitor thread, and returns. The monitor
-  /// drains the haptic trace every 20 ms into the report's timeline (and as CSV into `trace`,
-  /// which must outlive stop()) and samples the rates every 100 ms. A session runs once: start()
+  /// Starts the haptic threads (one per tool), the collision thread and a monitor thread, and
+  /// returns. The monitor drains the haptic traces every 20 ms into the report's timelines (and
+  /// the first tool's as CSV into `trace`, which must outlive stop()) and samples the rates every
+  /// 100 ms. A session runs once: start()
   /// after a run is an error. Owner thread.
   Status start(std::ostream* trace = nullptr);
 
-  /// The newest state (see SessionState); before the first tick, a zero state. Any thread but the
-  /// haptic and collision threads; never blocks them (they only publish through a LatestValue);
-  /// concurrent callers are serialised among themselves.
-  SessionState state();
+  /// The newest state of tool `tool` (see SessionState; the first tool by default); before its
+  /// first tick, a zero state. `tool` must be below tool_count(). Any thread but the haptic and
+  /// collision threads; never blocks them (they only publish through a LatestValue); concurrent
+  /// callers are serialised among themselves.
+  SessionState state(std::size_t tool = 0);
+  /// The scene's tools (Scene::tools.size()), each with its own device.
+  std::size_t tool_count() const { return rigs_.size(); }
 
   /// Takes the oldest contact event not yet taken; false when none is waiting. Events queue up
   /// (up to kEventCapacity; more are dropped and counted) from start() or run_stepped() on.
@@ -185,10 +204,10 @@ class HapticSession {
   /// collision thread uses it from its next step. One thread per object (the owner); real-time safe.
   Status set_object_pose(std::int32_t object, const Pose& world_from_object);
 
-  /// Binding side of OnHapticTick(const SessionState&): each tick's state as it is published, on
-  /// the haptic thread (the calling thread in stepped runs). Delegates must be real-time safe.
-  /// Bind before start(), from the owner thread.
-  DelegateSink<const SessionState&> on_haptic_tick() { return DelegateSink{tick_event_}; }
+  /// Binding side of OnHapticTick(const SessionState&) of tool `tool` (below tool_count()): each of
+  /// its ticks' state as it is published, on its haptic thread (the calling thread in stepped
+  /// runs). Delegates must be real-time safe. Bind before start(), from the owner thread.
+  DelegateSink<const SessionState&> on_haptic_tick(std::size_t tool = 0);
 
   /// Sends zero force at once, stops and joins all threads, and completes the report. Idempotent:
   /// later calls return what the first returned. An error says which thread ended on its own or
@@ -199,9 +218,9 @@ class HapticSession {
   bool running() const { return phase_ == Phase::kRunning; }
 
   /// start(), then calls `on_status` on this thread about every 250 ms for `seconds`, then stop().
-  /// Ends early (within 20 ms) on request_stop(), or when the haptic or collision thread ended by
-  /// itself (stop() then returns the cause, e.g. what a tick threw). stop() also runs when
-  /// `on_status` throws.
+  /// Ends early (within 20 ms) on request_stop(), on a device fault, or when a haptic or the
+  /// collision thread ended by itself (stop() then returns the cause, e.g. what a tick threw). stop() also
+  /// runs when `on_status` throws.
   Status run(double seconds, const std::function<void(const SessionState&)>& on_status = {},
              std::ostream* trace = nullptr);
 
@@ -222,30 +241,32 @@ class HapticSession {
 
  private:
   enum class Phase : std::uint8_t { kReady, kRunning, kStopped };
+  struct ToolRig;  // one tool with its device, its loop, its controllers and its published state
 
   HapticSession();
   Status begin_run();
+  // the run's statistics into each tool's report (before the loops stop), then (after the last
+  // trace is taken) the tools' reports into report_
   void collect_report(double seconds, bool stepped);
-  void take_trace(std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
+  void publish_report();
+  void take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
   void monitor(std::stop_token stop);
-  void on_tick_sent(const haptico::TraceSample& sample);
   void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
-  void contact_edge(collette::ObjectId object, bool touching, double time_s, double volume,
+  void contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s, double volume,
                     std::int32_t pairs);
+  bool any_fault() const;
+  bool haptic_threads_running() const;
+  Status device_error() const;
+  Status thread_error() const;
+  std::string tool_label(std::int32_t tool) const;
 
   Scene scene_;
-  haptico::DeviceCommand last_sent_{};
-  Vec3 last_sent_position_{};  // the handle when last_sent_ was sent [m, device frame]
-  bool have_last_sent_ = false;
   double haptic_hz_ = 1000.0;
   double collision_hz_ = 1000.0;
   std::unique_ptr<collette::CollisionWorld> world_;
-  std::unique_ptr<haptico::HapticManager> manager_;
-  std::unique_ptr<ForceController> force_controller_;
-  std::unique_ptr<BridgingController> bridging_controller_;
-  collette::ObjectId tool_id_ = -1;
+  haptico::FaultGroup fault_group_;  // before the rigs: their managers use it to the end
+  std::vector<std::unique_ptr<ToolRig>> rigs_;
   SessionReport report_;
-  ScopedConnection sent_connection_;
   ScopedConnection collision_connection_;
 
   static_assert(std::atomic<bool>::is_always_lock_free, "request_stop() must be async-signal-safe");
@@ -255,20 +276,12 @@ class HapticSession {
   double t0_s_ = 0.0;       // steady-clock time of start() (0 in stepped runs) [s]
   double started_s_ = 0.0;  // steady-clock time of start(), for the report's duration [s]
 
-  // haptic thread -> readers of state()
-  Delegator<const SessionState&> tick_event_;
-  LatestValue<SessionState> state_out_;
-  std::mutex state_readers_;   // serialises state() callers; the haptic thread never takes it
-  SessionState last_state_{};  // guarded by state_readers_
-  std::uint64_t ticks_at_start_ = 0;
-  std::atomic<double> haptic_rate_hz_{0.0};     // monitor thread -> haptic thread
-  std::atomic<double> collision_rate_hz_{0.0};  // monitor thread -> haptic thread
+  std::mutex state_readers_;  // serialises state() callers; the haptic threads never take it
+  std::atomic<double> collision_rate_hz_{0.0};  // monitor thread -> haptic threads
 
   // collision thread -> owner
   SpscQueue<ContactEvent> events_{kEventCapacity};
   EventCounter dropped_events_;
-  std::vector<std::uint8_t> touching_;          // per scene object; collision thread
-  std::vector<std::uint8_t> touching_now_;      // per scene object: scratch of on_collision
   std::vector<collette::ObjectId> object_ids_;  // per scene object
 
   std::ostream* trace_ = nullptr;  // written by the monitor thread while it runs, then by stop()
@@ -277,8 +290,9 @@ class HapticSession {
   std::jthread monitor_thread_;
 };
 
-/// The report as the JSON object `uh run --json` prints (nested: haptic.*, collision.*, force.*,
-/// contact.*, energy.*), without the timeline.
+/// The report as the JSON object `uh run --json` prints (nested: device.*, haptic.*, collision.*,
+/// force.*, contact.*, energy.*: the first tool's, and tools[]: each tool's tool, device.*,
+/// haptic.*, force.*, contact.*, energy.*), without the timelines.
 std::string session_report_json(const SessionReport& report);
 
 }  // namespace uh::controllers

@@ -52,7 +52,7 @@ struct SceneDevice {
   haptico::DeviceConfig config;
 };
 
-/// The tool: a shape moved by the device, with its force component.
+/// A tool: a shape moved by its own device, with its force component. A scene holds one or more.
 struct SceneTool {
   std::string name = "tool";
   SceneShape shape;
@@ -69,8 +69,10 @@ struct Scene {
   std::string name;                    ///< for messages and reports
   std::string source;                  ///< file the scene came from ("<embedded>" for the default)
   std::vector<SceneObject> objects;
-  SceneTool tool;
-  std::vector<std::string> watch;      ///< object names watched against the tool
+  /// The tools, each bound to its own device (`tool`, or `tools` for several: two hands, two
+  /// users); never empty. Each touches the objects; tools pass through each other.
+  std::vector<SceneTool> tools{1};
+  std::vector<std::string> watch;      ///< object names watched against every tool
   double haptic_hz = 1000.0;           ///< haptic thread rate [Hz]
   double collision_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running
   double seconds = 10.0;               ///< default session length [s]
@@ -83,6 +85,10 @@ struct Scene {
   /// `force.safety.max_force_rate_n_per_s`, `max_torque_rate_nm_per_s`: the largest change of the
   /// command per second (per tick: divided by the haptic rate); zero is always sent at once.
   haptico::ForceRateLimit rate_limit{};
+
+  /// The first tool (the only one in one-tool scenes).
+  SceneTool& tool() { return tools.front(); }
+  const SceneTool& tool() const { return tools.front(); }
 };
 
 /// Reads a scene file. Errors name the file, the field (as a JSON path such as
@@ -94,8 +100,8 @@ Result<Scene> load_scene(const std::filesystem::path& path);
 Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);
 
 /// Reads a device's settings from a JSON object (numbers, strings, booleans, [x, y, z]) as a
-/// scene's `tool.device.config` is read; a relative `file` resolves against `base_dir`. Errors
-/// name `source` and the key.
+/// scene's `tool.device.config` (or `tools[i].device.config`) is read; a relative `file` resolves against
+/// `base_dir`. Errors name `source` and the key.
 Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, const std::string& source,
                                                   const std::filesystem::path& base_dir);
 

@@ -23,6 +23,19 @@
 
 namespace uh::haptico {
 
+/// Devices that stop together (the managers of one session's tools): a device fault latched by
+/// one member, or its haptic thread ending by a throw, zeroes every member's force from that
+/// member's next tick on (each device has its own clock, so "at once" is within one period of
+/// each loop). It stays tripped. Any thread; real-time safe; outlives its managers.
+class FaultGroup {
+ public:
+  void trip() { tripped_.store(true, std::memory_order_release); }
+  bool tripped() const { return tripped_.load(std::memory_order_acquire); }
+
+ private:
+  std::atomic<bool> tripped_{false};
+};
+
 /// Options of a HapticManager (options aggregate).
 struct HapticManagerOptions {
   double rate_hz = 1000.0;          ///< haptic tick rate [Hz], in (0, 10000]; devices run 1-4 kHz
@@ -41,6 +54,8 @@ struct HapticManagerOptions {
   /// The tool's and the session's limits and the rate limit, applied with the device's own limits
   /// by one ForceLimiter (default: no tool or safety limit, the default rate limit).
   ForceLimitOptions limits{};
+  /// The group this device stops with (not owned; null: it stops alone). See FaultGroup.
+  FaultGroup* fault_group = nullptr;
 };
 
 /// Ticks in which each limit of the chain engaged (ForceLimiter); plain data.
@@ -73,7 +88,8 @@ struct HapticStats {
 ///   3. ForceOnHapticTick.broadcast(state, command)  (each delegate adds its force to `command`,
 ///      which starts at zero);
 ///   4. safety: a NaN/inf anywhere -> zero (counted); torque zeroed on 3-DOF devices; zero while
-///      halted or after a device error (latched until clear_fault()); otherwise the limit chain
+///      halted, after a device error (latched until clear_fault()) or once the FaultGroup
+///      tripped (another device's fault); otherwise the limit chain
 ///      (ForceLimiter): force and torque scaled down to the smallest of the device's, the tool's
 ///      and the safety limits, a linear fade-in over soft_start_s after open(), start(), resume()
 ///      and clear_fault(), and the rate limit on the change from the previous tick. Zero is sent
@@ -192,6 +208,8 @@ class HapticManager {
 
   TraceSample tick(double now_s);
   void count(std::uint32_t flags);
+  // latches a device fault here and trips the fault group (any thread)
+  void latch_fault();
   void on_loop_exit(const LoopExit& exit);
   void allow_binding();
   // commands zero, restarts the limit chain from it and traces it (with the state read after it
