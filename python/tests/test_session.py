@@ -57,7 +57,8 @@ def test_threaded_session_polls_state_and_stop_returns_the_report(scene):
     assert np.linalg.norm(after.force) == 0.0  # the device got zero at stop
     assert report["mode"] == "threaded"
     assert report["force"]["max_n"] >= max_force - 1e-9
-    assert set(report) == {"scene", "mode", "seconds", "device", "haptic", "collision", "force", "contact", "energy", "stopped_early"}
+    assert set(report) == {"scene", "mode", "seconds", "device", "haptic", "collision", "force", "contact", "energy",
+                           "stopped_early", "tools"}
 
 
 def test_report_is_the_uh_run_json_object(scene):
