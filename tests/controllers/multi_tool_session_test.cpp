@@ -161,9 +161,8 @@ struct FaultRegistry {
   explicit FaultRegistry(std::int64_t fault_after) {
     healthy.reserve(20000);
     faulty.reserve(20000);
-    const auto wrap = [this](std::vector<Vec3>* log, std::int64_t after) {
-      return [this, log,
-              after](const haptico::DeviceConfig& c) -> Result<std::unique_ptr<haptico::HapticDevice>> {
+    const auto wrap = [](std::vector<Vec3>* log, std::int64_t after) {
+      return [log, after](const haptico::DeviceConfig& c) -> Result<std::unique_ptr<haptico::HapticDevice>> {
         auto inner = haptico::DeviceRegistry::with_simulated_devices().create("sim-line", c);
         if (!inner) return inner.error();
         return std::unique_ptr<haptico::HapticDevice>(new FaultingDevice(std::move(*inner), after, log));
