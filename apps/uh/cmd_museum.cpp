@@ -1,12 +1,17 @@
 // uh museum serve [--host 127.0.0.1] [--port 7780] [--token T] [--seed N] [--minutes M] [--level easy|hard]
+// uh museum judge [--level easy|hard] [--seed N] [--kinds K,...] [--json]
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "museum_client.hpp"
+#include "progress_bar.hpp"
 #include "uh/museum/level.hpp"
+#include "uh/museum_players/blind_player.hpp"
 #include "uh/museum_service/game_server.hpp"
 
 namespace uh::cli {
@@ -48,6 +53,89 @@ int museum_serve(const MuseumServeArgs& args) {
   return 0;
 }
 
+struct MuseumJudgeArgs {
+  std::string level = "easy";
+  std::uint64_t seed = 1;
+  std::vector<std::string> kinds;
+  bool json = false;
+};
+
+museum::Difficulty difficulty_named(const std::string& level) {
+  return level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy;
+}
+
+nlohmann::json evidence_json(const museum_players::FeatureDifference& f) {
+  return {{"feature", f.feature},     {"where", f.where}, {"difference", f.difference}, {"noise", f.noise},
+          {"threshold", f.threshold}, {"unit", f.unit},   {"differs", f.differs()}};
+}
+
+int museum_judge(const MuseumJudgeArgs& args) {
+  museum_players::JudgeOptions options;
+  options.difficulty = difficulty_named(args.level);
+  options.seed = args.seed;
+  if (!args.kinds.empty()) {
+    options.kinds.clear();
+    for (const std::string& name : args.kinds) {
+      const auto kind = museum_artifacts::artifact_kind(name);
+      if (!kind)
+        return fail(fmt::format(
+            "--kinds: '{}' is no artifact kind (amphora, bowl, coin, tablet, scarab, goblet)", name));
+      options.kinds.push_back(*kind);
+    }
+  }
+  std::unique_ptr<ProgressBar> bar = std::make_unique<ProgressBar>("judging");
+  options.progress = [&bar](const std::string&, double fraction) { bar->update(fraction); };
+  auto report = museum_players::run_judge(options);
+  bar->finish();
+  bar.reset();
+  if (!report) return fail(report.error().message);
+  if (args.json) {
+    nlohmann::json pairs = nlohmann::json::array();
+    for (const auto& pair : report->pairs) {
+      nlohmann::json pieces = nlohmann::json::array();
+      for (const auto& p : pair.pieces) {
+        nlohmann::json evidence = nlohmann::json::array();
+        for (const auto& f : p.judgement.evidence) evidence.push_back(evidence_json(f));
+        pieces.push_back({{"truth", museum_artifacts::to_string(p.truth)},
+                          {"verdict", museum_players::to_string(p.judgement.verdict)},
+                          {"correct", p.correct()},
+                          {"turn_deg", p.turn_rad * 180.0 / kPi},
+                          {"simulated_s", p.simulated_s},
+                          {"evidence", evidence}});
+      }
+      pairs.push_back({{"kind", museum_artifacts::to_string(pair.kind)},
+                       {"tell", pair.tell},
+                       {"material_tell", pair.material_tell},
+                       {"pieces", pieces}});
+    }
+    const nlohmann::json out{{"level", args.level},
+                             {"seed", args.seed},
+                             {"accuracy", report->accuracy},
+                             {"simulated_s", report->simulated_s},
+                             {"pairs", pairs}};
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+  std::printf("uh museum judge: %s level, seed %llu\n", args.level.c_str(),
+              static_cast<unsigned long long>(args.seed));
+  for (const auto& pair : report->pairs) {
+    for (const auto& p : pair.pieces) {
+      std::string evidence;
+      for (const auto& f : p.judgement.evidence) {
+        if (!evidence.empty()) evidence += "; ";
+        evidence += fmt::format("{}{} {:.2f}{} (threshold {:.2f}{}){}", f.feature,
+                                f.where.empty() ? "" : " (" + f.where + ")", f.difference, f.unit,
+                                f.threshold, f.unit, f.differs() ? " DIFFERS" : "");
+      }
+      std::printf("  %-8s %-8s -> %-8s %s  %s\n", museum_artifacts::to_string(pair.kind),
+                  museum_artifacts::to_string(p.truth), museum_players::to_string(p.judgement.verdict),
+                  p.correct() ? "right" : "WRONG", evidence.c_str());
+    }
+  }
+  std::printf("accuracy %.3f (%.0f s of simulated exploration)\n", report->accuracy, report->simulated_s);
+  return 0;
+}
+
 }  // namespace
 
 void add_museum_commands(CLI::App& app, CommandRunner& runner) {
@@ -69,6 +157,20 @@ void add_museum_commands(CLI::App& app, CommandRunner& runner) {
       ->default_val("easy")
       ->check(CLI::IsMember({"easy", "hard"}));
   s->callback([&runner] { runner = [] { return museum_serve(args); }; });
+
+  static MuseumJudgeArgs judge;
+  auto* j = museum->add_subcommand(
+      "judge", "run the automated blind player over every artifact pair of a level and print its accuracy");
+  j->add_option("--level", judge.level, "easy or hard")
+      ->default_val("easy")
+      ->check(CLI::IsMember({"easy", "hard"}));
+  j->add_option("--seed", judge.seed,
+                "deals the order and the turns of the pieces and the exploration's spots")
+      ->default_val(1);
+  j->add_option("--kinds", judge.kinds, "only these artifact kinds (default: all six)")->delimiter(',');
+  j->add_flag("--json", judge.json,
+              "print one JSON object: accuracy and per pair the verdicts and the evidence");
+  j->callback([&runner] { runner = [] { return museum_judge(judge); }; });
 }
 
 }  // namespace uh::cli

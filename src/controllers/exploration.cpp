@@ -19,17 +19,29 @@ constexpr double kForceGain = 0.015;  // normal force loop: speed per newton of 
 constexpr double kNormalTauS = 0.02;  // low-pass of the normal estimate [s]
 constexpr double kHoldS = 0.3;        // rest between strokes [s]
 constexpr double kClearM = 0.002;     // lift this far past the last contact [m]
-constexpr double kMaxSeconds = 40.0;  // the script's whole budget of simulated time [s]
 // the share of the contour's ripple a grating's plane wave must explain to count as periodic
 constexpr double kPlaneWaveShare = 0.45;
 // an axis whose strokes ripple less than this share of the other's may see the texture's slow component only
 constexpr double kSlowAxisRipple = 0.6;
+constexpr double kApproachSpeed = 0.01;  // [m/s]
 
-// Where the hand starts and how the strokes are turned (planned from the geometry before the run)
+// Where the hand starts, which way it goes in and how the strokes are turned (planned from the
+// geometry before the run)
 struct ExplorePlan {
   Vec3 start{};
+  Vec3 approach{0, 0, -1};
   Vec3 axes[2]{};
+  Vec3 axis_point{};  // on the footprint's vertical centre line
 };
+
+double leg_length(const ExploreOptions& o, std::int32_t leg) {
+  return leg >= 2 ? o.second_stroke_length_m.value_or(o.stroke_length_m) : o.stroke_length_m;
+}
+
+// the level direction round the vertical line through `axis_point` at `p` (counter-clockwise seen from above)
+Vec3 around_axis(const Vec3& p, const Vec3& axis_point) {
+  return normalized(Vec3{-(p.y - axis_point.y), p.x - axis_point.x, 0.0});
+}
 
 // A hand that follows the exploration script: it reads the force it is sent and moves the handle
 // as a person exploring would (press until a force is felt, hold a normal force while stroking).
@@ -72,7 +84,10 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
     const Vec3 tangent = normalized(direction - dot(direction, normal_) * normal_);
     if (track_normal) update_normal(force, tangent, dt);
     const double pressing = dot(force, normal_);
-    return speed * tangent - kForceGain * (target - pressing) * normal_;
+    // a hand that lost the surface (it curved away) feels for it before going on, and one that ran
+    // into a rise backs off first: it never slides through the object nor off into the air
+    const bool lost = norm(force)<kTouchN, jammed = pressing> 2.5 * target;
+    return (lost || jammed ? 0.0 : speed) * tangent - kForceGain * (target - pressing) * normal_;
   }
 
   void integrate(double t, double dt, const haptico::DeviceCommand& cmd) override {
@@ -84,7 +99,7 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
     Vec3 v{};
     switch (phase_) {
       case ExplorePhase::kApproach:
-        v = {0, 0, -0.01};
+        v = kApproachSpeed * plan_.approach;
         if (touching > kTouchN) {
           touched_ = true;
           normal_ = normalized(f);
@@ -112,11 +127,14 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
       case ExplorePhase::kHold:
         v = -kForceGain * (options_.stroke_force_n - dot(f, normal_)) * normal_;
         if (in_phase >= kHoldS) {
-          if (next_leg_ < 4) {
+          if (next_leg_ < std::min(options_.stroke_legs, 4)) {
             leg_ = next_leg_++;
+            leg_normal_ = normal_;
             begin(ExplorePhase::kStroke, t);
-          } else if (!contour_done_) {
+          } else if (!contour_done_ && options_.contour != ContourPath::kNone) {
             leg_ = -1;
+            contour_turned_ = 0.0;
+            contour_from_ = position_;
             begin(ExplorePhase::kContour, t);
           } else {
             leg_ = -1;
@@ -127,19 +145,38 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
       case ExplorePhase::kStroke: {
         const Vec3 direction = (leg_ % 2 == 0 ? 1.0 : -1.0) * plan_.axes[leg_ / 2];
         v = slide(f, direction, options_.stroke_speed_m_per_s, options_.stroke_force_n, dt, true);
-        if (travelled_m_ >= options_.stroke_length_m) {
+        const bool edge = options_.stroke_stops_at_edge_rad &&
+                          dot(normal_, leg_normal_) < std::cos(*options_.stroke_stops_at_edge_rad);
+        if (travelled_m_ >= leg_length(options_, leg_) || edge) {
           leg_ = -1;
           begin(ExplorePhase::kRelease, t);  // lift off between strokes, as a finger does
         }
         break;
       }
       case ExplorePhase::kContour: {
-        const double angle = options_.stroke_speed_m_per_s * in_phase / options_.contour_radius_m;
-        const Vec3 direction = std::cos(angle) * plan_.axes[0] + std::sin(angle) * plan_.axes[1];
-        // on a circle the friction pulls across the motion too, which would tilt a normal taken
-        // from the force: the hand keeps the normal it had when it sat down, the force loop does the rest
-        v = slide(f, direction, options_.stroke_speed_m_per_s, options_.stroke_force_n, dt, false);
-        if (angle >= 2.0 * kPi) {
+        const double speed = options_.contour_speed_m_per_s.value_or(options_.stroke_speed_m_per_s);
+        bool round = false;
+        if (options_.contour == ContourPath::kAroundAxis) {
+          // level round the centre line, holding the force's level part towards the line, as a
+          // finger circles a vase (a normal taken from the force lags behind the turn and friction
+          // leans it back, which steers a hand that slides across it outwards, off the surface)
+          const Vec3 out =
+              normalized(Vec3{position_.x - plan_.axis_point.x, position_.y - plan_.axis_point.y, 0.0});
+          v = speed * around_axis(position_, plan_.axis_point) -
+              kForceGain * (options_.stroke_force_n - dot(f, out)) * out;
+          const Vec3 a = contour_from_ - plan_.axis_point, b = position_ + v * dt - plan_.axis_point;
+          contour_turned_ += std::atan2(a.x * b.y - a.y * b.x, a.x * b.x + a.y * b.y);
+          contour_from_ = position_ + v * dt;
+          round = contour_turned_ >= 2.0 * kPi;
+        } else {
+          const double angle = speed * in_phase / options_.contour_radius_m;
+          const Vec3 direction = std::cos(angle) * plan_.axes[0] + std::sin(angle) * plan_.axes[1];
+          // on a circle the friction pulls across the motion too, which would tilt a normal taken
+          // from the force: the hand keeps the normal it had when it sat down, the force loop does the rest
+          v = slide(f, direction, speed, options_.stroke_force_n, dt, false);
+          round = angle >= 2.0 * kPi;
+        }
+        if (round) {
           contour_done_ = true;
           begin(ExplorePhase::kLift, t);
         }
@@ -214,6 +251,9 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
   std::int32_t leg_ = -1;
   std::int32_t next_leg_ = 0;
   bool contour_done_ = false;
+  Vec3 leg_normal_{0, 0, 1};     // the normal where the stroke began
+  double contour_turned_ = 0.0;  // kAroundAxis: the angle gone round the centre line so far [rad]
+  Vec3 contour_from_{};
   int tap_ = 0;
   bool tap_in_ = true;
   bool touched_ = false;
@@ -228,8 +268,9 @@ double seeded_uniform(std::uint64_t& state) {
   return static_cast<double>(z >> 11) * 0x1.0p-53;
 }
 
-// The start above the object's top (near the centre of its footprint, moved by the seed) and the
-// stroke axes; from the packed shapes (geometry only, never the material)
+// The start 3 mm off the object where the site says (the seed moves it by up to 3 mm across the
+// approach), the approach direction and the stroke axes; from the packed shapes (geometry only,
+// never the material)
 Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const Pose& world_from_object,
                                      const collette::SphereTree& tool, const ExploreOptions& options) {
   const auto leaves = object.leaves();
@@ -245,25 +286,66 @@ Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const P
     hi = {std::max(hi.x, c.x + r), std::max(hi.y, c.y + r), std::max(hi.z, c.z + r)};
   }
   std::uint64_t rng = options.seed;
-  const double dx = (seeded_uniform(rng) - 0.5) * 0.006, dy = (seeded_uniform(rng) - 0.5) * 0.006;
-  const double turn = 2.0 * kPi * seeded_uniform(rng);
-  const Vec3 target{0.5 * (lo.x + hi.x) + dx, 0.5 * (lo.y + hi.y) + dy, 0.0};
-  double top = -1e300;
-  for (const auto& [c, r] : world) {
-    const double d2 = (c.x - target.x) * (c.x - target.x) + (c.y - target.y) * (c.y - target.y);
-    if (d2 < r * r) top = std::max(top, c.z + std::sqrt(r * r - d2));
-  }
-  if (top < -1e299) top = hi.z;
-  // the tool's lowest point (the handle holds it upright: device frame = world)
-  Vec3 tip{0, 0, 1e300};
-  for (const Sphere& s : tool.leaves()) {
-    const double bottom = static_cast<double>(s.z) - static_cast<double>(s.radius);
-    if (bottom < tip.z) tip = {static_cast<double>(s.x), static_cast<double>(s.y), bottom};
-  }
+  const double jitter_a = (seeded_uniform(rng) - 0.5) * 0.006, jitter_b = (seeded_uniform(rng) - 0.5) * 0.006;
+  const double turn = options.stroke_turn_rad.value_or(2.0 * kPi * seeded_uniform(rng));
+  const Vec3 middle{0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), lo.z};
   ExplorePlan plan;
-  plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + 0.003 - tip.z};
-  plan.axes[0] = {std::cos(turn), std::sin(turn), 0.0};
-  plan.axes[1] = {-std::sin(turn), std::cos(turn), 0.0};
+  plan.axis_point = middle;
+  // the tool's point that meets the object first, going in along `approach` (the handle holds
+  // the tool upright: device frame = world)
+  const auto tool_tip = [&tool](const Vec3& approach) {
+    Vec3 tip{};
+    double furthest = -1e300;
+    for (const Sphere& s : tool.leaves()) {
+      const Vec3 c{static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+      const double reach = dot(c, approach) + static_cast<double>(s.radius);
+      if (reach > furthest) {
+        furthest = reach;
+        tip = c + static_cast<double>(s.radius) * approach;
+      }
+    }
+    return tip;
+  };
+  if (options.site.from == ExploreSite::From::kTop) {
+    const Vec3 target{middle.x + options.site.offset_m[0] + jitter_a,
+                      middle.y + options.site.offset_m[1] + jitter_b, 0.0};
+    double top = -1e300;
+    for (const auto& [c, r] : world) {
+      const double d2 = (c.x - target.x) * (c.x - target.x) + (c.y - target.y) * (c.y - target.y);
+      if (d2 < r * r) top = std::max(top, c.z + std::sqrt(r * r - d2));
+    }
+    if (top < -1e299) top = hi.z;
+    plan.approach = {0, 0, -1};
+    const Vec3 tip = tool_tip(plan.approach);
+    plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + 0.003 - tip.z};
+    plan.axes[0] = {std::cos(turn), std::sin(turn), 0.0};
+    plan.axes[1] = {-std::sin(turn), std::cos(turn), 0.0};
+    return plan;
+  }
+  // side: level towards the centre line from `azimuth`, at the height (both moved by the seed)
+  const double azimuth = options.site.azimuth_rad + jitter_a / 0.05;  // up to 3 mm along a 5 cm radius
+  const Vec3 out{std::cos(azimuth), std::sin(azimuth), 0.0};
+  // (up or down by a third of the seed's move: a band round a coin's edge is a few millimetres high)
+  const double z = lo.z + std::clamp(options.site.height_fraction, 0.0, 1.0) * (hi.z - lo.z) + jitter_b / 3.0;
+  // the outermost surface point on the level ray from the centre line: per sphere, the circle it
+  // cuts at height z, crossed by the ray
+  double outer = -1e300;
+  for (const auto& [c, r] : world) {
+    const double dz = c.z - z;
+    if (std::fabs(dz) >= r) continue;
+    const double rho2 = r * r - dz * dz;
+    const Vec3 rel{c.x - middle.x, c.y - middle.y, 0.0};
+    const double along = dot(rel, out);
+    const double across2 = dot(rel, rel) - along * along;
+    if (across2 < rho2) outer = std::max(outer, along + std::sqrt(rho2 - across2));
+  }
+  if (outer < -1e299) return Error{fmt::format("nothing of the object is at height {:.4f} m", z)};
+  plan.approach = -out;
+  const Vec3 tip = tool_tip(plan.approach);
+  const Vec3 surface{middle.x + outer * out.x, middle.y + outer * out.y, z};
+  plan.start = surface + 0.003 * out - tip;
+  plan.axes[0] = {0, 0, 1};
+  plan.axes[1] = {-out.y, out.x, 0.0};
   return plan;
 }
 
@@ -650,9 +732,9 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     double peak = -1e300;
     std::vector<double> slid;
     for (std::size_t j = 0; j < s.travel.size(); ++j) {
-      if (s.travel[j] < o.stroke_length_m / 3.0) peak = std::max(peak, s.friction_ratio[j]);
-      if (s.travel[j] > 0.5 * o.stroke_length_m && s.travel[j] < 0.95 * o.stroke_length_m)
-        slid.push_back(s.friction_ratio[j]);
+      const double length = leg_length(o, leg);
+      if (s.travel[j] < length / 3.0) peak = std::max(peak, s.friction_ratio[j]);
+      if (s.travel[j] > 0.5 * length && s.travel[j] < 0.95 * length) slid.push_back(s.friction_ratio[j]);
     }
     if (peak > -1e300) breakaway.push_back(peak);
     if (!slid.empty()) sliding.push_back(median(slid));
@@ -679,12 +761,12 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
   // texture: the spectrum of the normal force ripple along each stroke axis (both strokes of the
   // axis), after the breakaway (past 15 % of the stroke); the dominant spatial frequencies of the two axes
   // are the components of the texture's wave vector in the stroke plane, so period = 1 / |(f_1, f_2)|
-  const double from = 0.15 * o.stroke_length_m, to = 0.97 * o.stroke_length_m;
   const double ds = 2.5e-5;  // resampling step [m]: 40 samples per millimetre
   double sum_sq = 0.0;
   std::size_t count = 0;
   double axis_frequency[2] = {0.0, 0.0};  // [1/m], 0 = no peak along that axis
   for (int axis = 0; axis < 2; ++axis) {
+    const double from = 0.15 * leg_length(o, 2 * axis), to = 0.97 * leg_length(o, 2 * axis);
     Spectrum spectrum;
     const double span = to - from;
     for (double f = 2.0 / span; f <= 1.0 / (8.0 * ds); f += 1.0 / (16.0 * span))
@@ -777,7 +859,7 @@ Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const s
     alone.objects[0].shape.tree = object_tree->tree;
     alone.objects[0].shape.coverage = object_tree->coverage;
 
-    const auto capacity = static_cast<std::size_t>(kMaxSeconds * haptic_hz) + 16;
+    const auto capacity = static_cast<std::size_t>(options.max_seconds * haptic_hz) + 16;
     auto device = std::make_unique<ExplorerDevice>(
         haptico::SimDeviceOptions{.rate_hz = haptic_hz,
                                   .max_force_n = 20.0,
@@ -802,17 +884,18 @@ Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const s
     auto session = HapticSession::create(alone, so, registry);
     if (!session) return session.error();
     explorer->set_session(session->get());
-    if (auto ran = (*session)->run_stepped(kMaxSeconds, options.ticks_per_collision_step); !ran)
+    if (auto ran = (*session)->run_stepped(options.max_seconds, options.ticks_per_collision_step); !ran)
       return ran.error();
     if (!explorer->touched())
-      return Error{fmt::format("{}: object '{}': the tool never touched it going down from above its top",
-                               scene.source, object.name)};
+      return Error{
+          fmt::format("{}: object '{}': the tool never touched it on its way in", scene.source, object.name)};
     ObjectExploration result;
     result.object = object.name;
     result.trace.samples = std::move(explorer->trace());
     result.trace.options = options;
     result.trace.stroke_axes[0] = plan->axes[0];
     result.trace.stroke_axes[1] = plan->axes[1];
+    result.trace.axis_point = plan->axis_point;
     result.work_on_hand_j = (*session)->report().work_on_hand_j;
     result.simulated_s = (*session)->report().seconds;
     result.haptic_ticks = (*session)->report().haptic_ticks;

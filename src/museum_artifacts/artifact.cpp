@@ -199,6 +199,75 @@ Tell tell(ArtifactKind kind, Difficulty difficulty) {
   return {};
 }
 
+MaterialTell material_tell(ArtifactKind kind, Difficulty difficulty) {
+  const bool e = easy(difficulty);
+  switch (kind) {
+    case ArtifactKind::bowl: {
+      const double ratio = e ? 0.55 : 0.8;
+      return {"stiffness", ratio,
+              fmt::format("the forgery is resin, {:.0f} % softer than the glazed genuine bowl",
+                          100.0 * (1.0 - ratio))};
+    }
+    case ArtifactKind::tablet: {
+      const double ratio = e ? 1.6 : 1.25;
+      return {
+          "friction", ratio,
+          fmt::format("the forgery is plaster, {:.0f} % grippier than the fired clay of the genuine tablet",
+                      100.0 * (ratio - 1.0))};
+    }
+    case ArtifactKind::goblet: {
+      const double ratio = e ? 0.6 : 0.8;
+      return {"friction", ratio,
+              fmt::format("the forgery is plated, {:.0f} % more slippery than the genuine silver goblet",
+                          100.0 * (1.0 - ratio))};
+    }
+    case ArtifactKind::amphora:
+    case ArtifactKind::coin:
+    case ArtifactKind::scarab:
+      return {};
+  }
+  return {};
+}
+
+forcecomp::Material artifact_material(ArtifactKind kind, Difficulty difficulty, Piece piece) {
+  // the genuine pieces' materials: stiffness k [N/m^2] of the gradient law, Coulomb coefficients
+  struct Genuine {
+    double stiffness, friction_static, friction_dynamic;
+  };
+  const Genuine g = [kind]() -> Genuine {
+    switch (kind) {
+      case ArtifactKind::amphora:
+        return {1.5e5, 0.45, 0.35};  // fired clay
+      case ArtifactKind::bowl:
+        return {2e5, 0.3, 0.22};  // glazed ceramic
+      case ArtifactKind::coin:
+        return {2.5e5, 0.35, 0.25};  // bronze
+      case ArtifactKind::tablet:
+        return {1.5e5, 0.4, 0.3};  // fired clay
+      case ArtifactKind::scarab:
+        return {2.5e5, 0.4, 0.3};  // stone
+      case ArtifactKind::goblet:
+        return {2.5e5, 0.3, 0.22};  // silver
+    }
+    return {1.5e5, 0.4, 0.3};
+  }();
+  forcecomp::Material m;
+  m.has_stiffness = true;
+  m.stiffness = g.stiffness;
+  m.has_friction = true;
+  m.friction_static = g.friction_static;
+  m.friction_dynamic = g.friction_dynamic;
+  if (piece == Piece::forgery) {
+    const MaterialTell t = material_tell(kind, difficulty);
+    if (t.property == "stiffness") m.stiffness *= t.ratio;
+    if (t.property == "friction") {
+      m.friction_static *= t.ratio;
+      m.friction_dynamic *= t.ratio;
+    }
+  }
+  return m;
+}
+
 collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, Piece piece) {
   const Tell t = tell(kind, difficulty);
   const bool genuine = piece == Piece::genuine;
@@ -290,6 +359,16 @@ Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, Difficulty dif
     if (auto written = write_file_atomically(path, obj); !written) return written.error();
   }
   return controllers::SceneShape{.mesh = path, .spheres = spheres, .meters_per_unit = 1.0};
+}
+
+Result<controllers::SceneObject> artifact_object(ArtifactKind kind, Difficulty difficulty, Piece piece,
+                                                 const std::filesystem::path& cache_dir,
+                                                 const std::string& name, const Pose& pose,
+                                                 std::int64_t spheres) {
+  auto shape = artifact_shape(kind, difficulty, piece, cache_dir, spheres);
+  if (!shape) return shape.error();
+  return controllers::SceneObject{
+      .name = name, .shape = *shape, .pose = pose, .material = artifact_material(kind, difficulty, piece)};
 }
 
 }  // namespace uh::museum_artifacts

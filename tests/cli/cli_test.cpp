@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -833,6 +834,41 @@ TEST_F(CliTest, ExploreRecoversFrictionAndTextureOnAFlatPackedSlab) {
                   0.1 * m[coefficient].get<double>())
           << object << " " << coefficient;
   }
+}
+
+TEST_F(CliTest, MuseumJudgeReportsItsVerdictsAndTheirEvidence) {
+  // the artifacts' packings are kept in the build tree (built once, like the test command's other caches)
+  const std::string cache = fmt::format("UH_CACHE_DIR='{}' ", UH_TEST_CACHE_DIR);
+  const CommandRun r = uh("museum judge --kinds coin --seed 1 --json", cache);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json out = json_of(r);
+  EXPECT_EQ(out["level"], "easy");
+  ASSERT_EQ(out["pairs"].size(), 1u);
+  const nlohmann::json& pair = out["pairs"][0];
+  EXPECT_EQ(pair["kind"], "coin");
+  ASSERT_EQ(pair["pieces"].size(), 2u);
+  int correct = 0;
+  std::set<std::string> truths;
+  for (const auto& piece : pair["pieces"]) {
+    truths.insert(piece["truth"].get<std::string>());
+    EXPECT_EQ(piece["correct"].get<bool>(), piece["truth"] == piece["verdict"]);
+    correct += piece["correct"].get<bool>() ? 1 : 0;
+    ASSERT_FALSE(piece["evidence"].empty());
+    bool any_differs = false;
+    for (const auto& f : piece["evidence"]) {
+      EXPECT_TRUE(f["unit"] == "mm" || f["unit"] == "%") << f.dump();
+      EXPECT_EQ(f["differs"].get<bool>(), f["difference"].get<double>() > f["threshold"].get<double>());
+      any_differs = any_differs || f["differs"].get<bool>();
+    }
+    // a forgery verdict rests on a feature that differs, a genuine one on none
+    EXPECT_EQ(any_differs, piece["verdict"] == "forgery");
+  }
+  EXPECT_EQ(truths, (std::set<std::string>{"genuine", "forgery"}));
+  EXPECT_DOUBLE_EQ(out["accuracy"].get<double>(), correct / 2.0);
+
+  const CommandRun bad = uh("museum judge --kinds coin,teapot", cache);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("'teapot' is no artifact kind"), std::string::npos) << bad.err;
 }
 
 TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {

@@ -21,20 +21,53 @@
 
 namespace uh::controllers {
 
+/// Where on the object the hand goes in (planned from the packed shape's bounds, never its material).
+struct ExploreSite {
+  enum class From : std::uint8_t {
+    kTop,   ///< down onto the top, near the middle of the footprint moved by `offset_m` (and the seed)
+    kSide,  ///< horizontally towards the footprint's vertical centre line, at a height and an azimuth
+  };
+  From from = From::kTop;
+  double offset_m[2] = {0.0, 0.0};  ///< top: where, from the footprint's middle along x and y [m]
+  double height_fraction = 0.5;     ///< side: at this fraction of the object's height (0 base, 1 top)
+  double azimuth_rad = 0.0;         ///< side: coming from this direction about the vertical (0 = from +x)
+};
+
+/// The path the contour follow takes after the strokes.
+enum class ContourPath : std::uint8_t {
+  kCircle,      ///< one circle of `contour_radius_m` in the tangent plane
+  kAroundAxis,  ///< once around the footprint's vertical centre line, level, along the surface (a side site)
+  kNone,
+};
+
 /// Settings of the exploration script (options aggregate).
 struct ExploreOptions {
+  ExploreSite site{};
   double press_force_n = 3.0;          ///< press to this normal force, then release [N]
   double press_speed_m_per_s = 0.004;  ///< speed of the press and release [m/s]
   double stroke_force_n = 2.0;         ///< normal force held while stroking [N]
   double stroke_speed_m_per_s = 0.02;  ///< stroke speed [m/s]
   double stroke_length_m = 0.024;      ///< length of each stroke [m]
-  double contour_radius_m = 0.005;     ///< the contour follow: one circle of this radius [m]
+  /// Length of the strokes along the second axis [m]; as `stroke_length_m` when empty.
+  std::optional<double> second_stroke_length_m;
+  /// A stroke ends early where the surface's normal has turned this far from where it began (an
+  /// edge, as a finger stops at a rim) [rad]; strokes go their whole length when empty.
+  std::optional<double> stroke_stops_at_edge_rad;
+  int stroke_legs = 4;  ///< how many of the four strokes (+e1, -e1, +e2, -e2) to make, in that order
+  /// The stroke axes: top sites turn e1 = +x by this about the vertical (the seed's turn when
+  /// empty); side sites stroke along e1 = up and e2 = the level tangent.
+  std::optional<double> stroke_turn_rad;
+  ContourPath contour = ContourPath::kCircle;
+  double contour_radius_m = 0.005;              ///< the circle's radius [m]
+  std::optional<double> contour_speed_m_per_s;  ///< the contour's speed [m/s]; the stroke speed when empty
   int taps = 3;                        ///< taps at the end
   double tap_speed_m_per_s = 0.03;     ///< [m/s]
   std::optional<double> haptic_hz;     ///< override of the scene's haptic rate [Hz]
   int ticks_per_collision_step = 1;    ///< haptic ticks per collision step (simulated time)
-  /// Chooses where on the object the exploration happens (up to 3 mm off its top) and turns the
-  /// pair of stroke directions about the vertical; the same seed gives the same run.
+  double max_seconds = 40.0;           ///< the script's whole budget of simulated time [s]
+  /// Moves where on the object the exploration happens (by up to 3 mm; a side site's height by up
+  /// to 1 mm) and turns the pair of
+  /// stroke directions about the vertical (unless `stroke_turn_rad`); the same seed gives the same run.
   std::uint64_t seed = 1;
 };
 
@@ -66,7 +99,8 @@ struct ExploreSample {
 struct ExploreTrace {
   std::vector<ExploreSample> samples;
   ExploreOptions options{};
-  Vec3 stroke_axes[2]{};  ///< e1, e2: the stroke directions (horizontal)
+  Vec3 stroke_axes[2]{};  ///< e1, e2: the stroke directions
+  Vec3 axis_point{};      ///< a point of the footprint's vertical centre line (kAroundAxis goes round it)
 };
 
 /// What the estimators found on one object. Optional fields are empty when the trace holds no

@@ -18,6 +18,7 @@
 #include "uh/collette/triangle_mesh.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/result.hpp"
+#include "uh/forcecomp/material.hpp"
 #include "uh/museum/level.hpp"
 
 namespace uh::museum_artifacts {
@@ -49,6 +50,21 @@ Tell tell(ArtifactKind kind, museum::Difficulty difficulty);
 /// forgery share their vertex grid: vertex i of one is vertex i of the other, moved by the tell.
 collette::TriangleMesh artifact_mesh(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
 
+/// How a kind's forgery differs in material (besides its shape) at a difficulty: `property` is
+/// "stiffness" or "friction" (both coefficients scale alike), and the forgery's value is `ratio`
+/// times the genuine's; an empty property: the same material. Easy ratios are well above what a
+/// hand tells apart (stiffness 15-45 %, friction about 20 %), hard ones near it.
+struct MaterialTell {
+  std::string property{};
+  double ratio = 1.0;
+  std::string description{};
+};
+MaterialTell material_tell(ArtifactKind kind, museum::Difficulty difficulty);
+
+/// What the piece's surface feels like: the kind's material (fired clay, bronze, stone, silver...),
+/// changed by material_tell() on a forgery.
+forcecomp::Material artifact_material(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
+
 /// Writes the piece's mesh as an OBJ file into `cache_dir`/museum-artifacts (named by kind,
 /// difficulty, piece and a hash of its content; an existing file is kept) and returns the scene
 /// shape that packs it with `spheres`: controllers::load_shape_tree() then builds and caches its
@@ -56,5 +72,11 @@ collette::TriangleMesh artifact_mesh(ArtifactKind kind, museum::Difficulty diffi
 Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, museum::Difficulty difficulty, Piece piece,
                                                const std::filesystem::path& cache_dir,
                                                std::int64_t spheres = 10000);
+
+/// The piece as a scene object named `name` standing at `pose`: artifact_shape() and artifact_material().
+Result<controllers::SceneObject> artifact_object(ArtifactKind kind, museum::Difficulty difficulty,
+                                                 Piece piece, const std::filesystem::path& cache_dir,
+                                                 const std::string& name, const Pose& pose = {},
+                                                 std::int64_t spheres = 10000);
 
 }  // namespace uh::museum_artifacts

@@ -1,0 +1,550 @@
+#include "uh/museum_players/blind_player.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "uh/collette/sphere_tree_builder.hpp"
+
+namespace uh::museum_players {
+
+using controllers::ContourPath;
+using controllers::ExploreOptions;
+using controllers::ExplorePhase;
+using controllers::ExploreSite;
+using controllers::ExploreTrace;
+
+const char* to_string(Verdict verdict) { return verdict == Verdict::genuine ? "genuine" : "forgery"; }
+
+namespace {
+
+constexpr double kStrokeStepM = 0.00025;  // surface tracks along strokes: a sample every 0.25 mm
+constexpr int kAroundSamples = 720;       // around the piece: every half degree
+constexpr double kSlideForceN = 1.5;      // normal force held on the survey's long strokes and contours
+constexpr double kEdgeClearM = 0.006;     // side contours stay this far from the base and the top
+constexpr double kShelfZ = 0.7;  // a contour whose force points up or down more than this is on a shelf
+
+struct Bounds {
+  Vec3 lo{1e300, 1e300, 1e300};
+  Vec3 hi{-1e300, -1e300, -1e300};
+};
+
+Bounds world_bounds(const collette::SphereTree& tree, const Pose& pose) {
+  Bounds b;
+  for (const Sphere& s : tree.leaves()) {
+    const Vec3 c = transform_point(
+        pose, Vec3{static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)});
+    const double r = static_cast<double>(s.radius);
+    b.lo = {std::min(b.lo.x, c.x - r), std::min(b.lo.y, c.y - r), std::min(b.lo.z, c.z - r)};
+    b.hi = {std::max(b.hi.x, c.x + r), std::max(b.hi.y, c.y + r), std::max(b.hi.z, c.z + r)};
+  }
+  return b;
+}
+
+// The press's secant stiffness [N/mm]: the force it gained over the depth it went in between a
+// tenth and nine tenths of the press force (along the press's mean force direction). Unlike the
+// slope at first touch (estimate_material), which extrapolates, it reads only what was pressed.
+std::optional<double> secant_stiffness(const ExploreTrace& trace) {
+  const double f_lo = 0.1 * trace.options.press_force_n, f_hi = 0.9 * trace.options.press_force_n;
+  Vec3 sum{};
+  for (const auto& s : trace.samples)
+    if (s.phase == ExplorePhase::kPress) sum += s.force;
+  if (norm(sum) == 0.0) return std::nullopt;
+  const Vec3 n = normalized(sum);
+  std::optional<double> at_lo, at_hi;  // depth where the force first passed each level
+  for (const auto& s : trace.samples) {
+    if (s.phase != ExplorePhase::kPress) continue;
+    const double f = dot(s.force, n), depth = -dot(s.position, n);
+    if (!at_lo && f >= f_lo) at_lo = depth;
+    if (!at_hi && f >= f_hi) at_hi = depth;
+  }
+  if (!at_lo || !at_hi || !(*at_hi > *at_lo)) return std::nullopt;
+  return (f_hi - f_lo) / ((*at_hi - *at_lo) * 1e3);
+}
+
+// One site of the survey: where and how the hand goes in, and what its tracks are called.
+struct SurveySite {
+  std::string name;
+  ExploreOptions options;
+  bool pad = false;  // pressed with the finger's pad (a larger ball) rather than the stylus's tip
+};
+
+// fills the gaps of a resampled track (bins no sample fell in) by linear interpolation; false when empty
+bool fill_gaps(std::vector<double>& v, std::vector<int>& count, bool around) {
+  const std::size_t n = v.size();
+  std::vector<std::size_t> known;
+  for (std::size_t i = 0; i < n; ++i)
+    if (count[i] > 0) known.push_back(i);
+  if (known.size() < 2) return false;
+  for (std::size_t k = 0; k < known.size(); ++k) {
+    const std::size_t a = known[k];
+    const bool last = k + 1 == known.size();
+    if (last && !around) break;
+    const std::size_t b = last ? known[0] + n : known[k + 1];
+    for (std::size_t i = a + 1; i < b; ++i) {
+      const double u = static_cast<double>(i - a) / static_cast<double>(b - a);
+      v[i % n] = v[a] + u * (v[b % n] - v[a]);
+    }
+  }
+  if (!around) {  // before the first and after the last sample: nothing was felt there
+    v.erase(v.begin() + static_cast<std::ptrdiff_t>(known.back()) + 1, v.end());
+    v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(known.front()));
+  }
+  return true;
+}
+
+// The surface the hand traced over one site's sliding stretches (the strokes and a contour around)
+void add_tracks(const SurveySite& site, const ExploreTrace& trace, std::vector<SurfaceTrack>& tracks) {
+  const bool side = site.options.site.from == ExploreSite::From::kSide;
+  const Vec3 axis = trace.axis_point;
+  const auto radial = [&axis](const Vec3& p) { return std::hypot(p.x - axis.x, p.y - axis.y); };
+  const auto height = [&](const Vec3& p) { return side ? radial(p) : p.z; };
+  static constexpr const char* kLegNames[2][4] = {
+      {"stroke +x", "stroke -x", "stroke +y", "stroke -y"},
+      {"stroke up", "stroke down", "stroke across", "stroke back"}};
+  const auto& x = trace.samples;
+  for (std::int32_t leg = 0; leg < 4; ++leg) {
+    // along the leg's axis, binned every kStrokeStepM
+    const Vec3 along = trace.stroke_axes[leg / 2];
+    double lo = 1e300, hi = -1e300;
+    for (const auto& s : x)
+      if (s.phase == ExplorePhase::kStroke && s.leg == leg && norm(s.force) > 0.05) {
+        lo = std::min(lo, dot(s.position, along));
+        hi = std::max(hi, dot(s.position, along));
+      }
+    if (!(hi - lo > 20.0 * kStrokeStepM)) continue;
+    SurfaceTrack t{.name = fmt::format("{} {}", site.name, kLegNames[side ? 1 : 0][leg]),
+                   .around = false,
+                   .step = kStrokeStepM,
+                   .start = 0.0,
+                   .height = {}};
+    const auto bins = static_cast<std::size_t>((hi - lo) / kStrokeStepM) + 1;
+    std::vector<double> sum(bins, 0.0);
+    std::vector<int> count(bins, 0);
+    for (const auto& s : x) {
+      if (s.phase != ExplorePhase::kStroke || s.leg != leg || norm(s.force) <= 0.05) continue;
+      const auto i =
+          std::min(bins - 1, static_cast<std::size_t>((dot(s.position, along) - lo) / kStrokeStepM));
+      sum[i] += height(s.position);
+      ++count[i];
+    }
+    for (std::size_t i = 0; i < bins; ++i)
+      if (count[i] > 0) sum[i] /= count[i];
+    std::size_t first = 0;
+    while (first < bins && count[first] == 0) ++first;
+    if (!fill_gaps(sum, count, false)) continue;
+    t.start = lo + static_cast<double>(first) * kStrokeStepM;
+    t.height = std::move(sum);
+    tracks.push_back(std::move(t));
+  }
+  if (site.options.contour != ContourPath::kAroundAxis) return;
+  // where the surface faces up or down more than sideways (a shelf: the top of a foot where it
+  // meets the stem), the ball circles against two surfaces at once and wanders: no track there
+  Vec3 pushed{};
+  for (const auto& s : x)
+    if (s.phase == ExplorePhase::kContour) pushed += s.force;
+  if (norm(pushed) == 0.0 || std::fabs(normalized(pushed).z) > kShelfZ) return;
+  std::vector<double> sum(kAroundSamples, 0.0);
+  std::vector<int> count(kAroundSamples, 0);
+  const double step = 2.0 * kPi / kAroundSamples;
+  for (const auto& s : x) {
+    if (s.phase != ExplorePhase::kContour || norm(s.force) <= 0.05) continue;
+    double a = std::atan2(s.position.y - axis.y, s.position.x - axis.x);
+    if (a < 0.0) a += 2.0 * kPi;
+    const auto i = std::min<std::size_t>(kAroundSamples - 1, static_cast<std::size_t>(a / step));
+    sum[i] += radial(s.position);
+    ++count[i];
+  }
+  for (int i = 0; i < kAroundSamples; ++i)
+    if (count[i] > 0) sum[i] /= count[i];
+  // most of the way round, or it did not go round
+  if (std::count_if(count.begin(), count.end(), [](int c) { return c > 0; }) < kAroundSamples * 3 / 4) return;
+  if (!fill_gaps(sum, count, true)) return;
+  tracks.push_back({.name = fmt::format("{} around", site.name),
+                    .around = true,
+                    .step = step,
+                    .start = 0.0,
+                    .height = std::move(sum)});
+}
+
+std::vector<SurveySite> plan_survey(const Bounds& b, const SurveyOptions& o) {
+  std::vector<SurveySite> sites;
+  const double w = b.hi.x - b.lo.x, d = b.hi.y - b.lo.y, h = b.hi.z - b.lo.z;
+  ExploreOptions base;
+  base.seed = o.seed;
+  base.haptic_hz = o.haptic_hz;
+  base.stroke_turn_rad = 0.0;
+  base.stroke_stops_at_edge_rad = 0.6;  // about 35 degrees: the rim of a top
+  // the top, as `uh explore` does it: the material
+  sites.push_back({"top", base});
+  // presses around the middle of the top (a press reads the packing's grain under the tip as well
+  // as the material: the median of several)
+  for (int k = 0; k < 4; ++k) {
+    ExploreOptions press = base;
+    press.site.offset_m[0] = (k % 2 == 0 ? -1.0 : 1.0) * 0.004;
+    press.site.offset_m[1] = (k / 2 == 0 ? -1.0 : 1.0) * 0.004;
+    press.stroke_legs = 0;
+    press.contour = ContourPath::kNone;
+    press.taps = 0;
+    sites.push_back({fmt::format("top press {}", k + 1), press, true});
+  }
+  const bool flat = h < 0.5 * std::min(w, d);
+  const bool round = std::fabs(w - d) < 0.1 * std::max(w, d);
+  ExploreOptions slide = base;
+  slide.stroke_force_n = kSlideForceN;
+  slide.taps = 0;
+  slide.contour = ContourPath::kNone;
+  if (flat) {  // long strokes over the top, from near one corner along x and along y
+    ExploreOptions raster = slide;
+    raster.site.offset_m[0] = -0.3 * w;
+    raster.site.offset_m[1] = -0.3 * d;
+    raster.stroke_length_m = 0.6 * w;
+    raster.second_stroke_length_m = 0.6 * d;
+    sites.push_back({"top raster", raster});
+  }
+  if (round) {  // level contours round the side at heights every ring_spacing_m, strokes up and down it
+    const double span = h - 2.0 * kEdgeClearM;
+    const int rings = span > 0.0 ? static_cast<int>(span / o.ring_spacing_m) + 1 : 1;
+    for (int k = 0; k < rings; ++k) {
+      const double z = rings == 1 ? 0.5 * h : 0.5 * h + (k - 0.5 * (rings - 1)) * o.ring_spacing_m;
+      ExploreOptions ring = slide;
+      ring.site.from = ExploreSite::From::kSide;
+      ring.site.height_fraction = z / h;
+      ring.contour = ContourPath::kAroundAxis;
+      ring.contour_speed_m_per_s = 0.04;
+      ring.stroke_legs = 0;
+      ring.stroke_stops_at_edge_rad.reset();  // up a side that bulges and narrows
+      const double up = (h - kEdgeClearM) - z;
+      if (k == 0 && up > 0.01) {
+        ring.stroke_legs = 2;
+        ring.stroke_length_m = up;
+      }
+      sites.push_back({fmt::format("side {:.0f} mm", z * 1e3), ring});
+    }
+  }
+  return sites;
+}
+
+}  // namespace
+
+Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const SurveyOptions& options,
+                                 const std::filesystem::path& cache_dir) {
+  // the stylus: one ball
+  const Sphere ball{0.f, 0.f, 0.f, static_cast<float>(options.tool_radius_m)};
+  auto tool_tree = collette::build_sphere_tree(std::span<const Sphere>(&ball, 1));
+  if (!tool_tree) return tool_tree.error();
+  const Sphere pad_ball{0.f, 0.f, 0.f, static_cast<float>(options.pad_radius_m)};
+  auto pad_tree = collette::build_sphere_tree(std::span<const Sphere>(&pad_ball, 1));
+  if (!pad_tree) return pad_tree.error();
+  const auto tip = std::make_shared<const collette::SphereTree>(std::move(*tool_tree));
+  const auto pad = std::make_shared<const collette::SphereTree>(std::move(*pad_tree));
+  auto piece_tree = controllers::load_shape_tree(piece.shape, cache_dir);
+  if (!piece_tree) return Error{fmt::format("{}: {}", piece.name, piece_tree.error().message)};
+
+  controllers::Scene scene;
+  scene.name = "museum table";
+  scene.source = "the museum's table";
+  scene.objects = {piece};
+  scene.objects[0].shape.tree = piece_tree->tree;
+  scene.objects[0].shape.coverage = piece_tree->coverage;
+  scene.tool.name = "stylus";
+  scene.tool.shape.tree = tip;
+  scene.tool.shape.coverage = 1.0;
+  scene.watch = {piece.name};
+  scene.haptic_hz = options.haptic_hz;
+  scene.collision_hz = options.haptic_hz;
+
+  controllers::SessionOptions session;
+  session.cache_dir = cache_dir;
+  PieceSurvey survey;
+  for (SurveySite& site : plan_survey(world_bounds(*piece_tree->tree, piece.pose), options)) {
+    site.options.max_seconds = std::max(1.0, options.max_piece_seconds - survey.simulated_s);
+    scene.tool.shape.tree = site.pad ? pad : tip;
+    auto explored = controllers::explore_scene(scene, piece.name, site.options, session);
+    if (!explored) return Error{fmt::format("{} ({}): {}", piece.name, site.name, explored.error().message)};
+    const controllers::ObjectExploration& e = explored->front();
+    if (site.name == "top") survey.material = e.estimate;
+    if (const auto k = secant_stiffness(e.trace)) survey.site_stiffness.emplace_back(site.name, *k);
+    add_tracks(site, e.trace, survey.tracks);
+    survey.simulated_s += e.simulated_s;
+    survey.haptic_ticks += e.haptic_ticks;
+    if (survey.simulated_s >= options.max_piece_seconds) break;
+  }
+  return survey;
+}
+
+namespace {
+
+constexpr double kSurfaceFloorM = 0.0003;    // a surface difference under 0.3 mm is not told apart
+constexpr double kStiffnessFloor = 0.15;     // nor stiffness under 15 % (the least a hand tells apart)
+constexpr double kFrictionFloor = 0.10;      // nor friction under 10 % (half of what a hand tells apart)
+constexpr double kNoiseMargin = 2.0;         // a difference must exceed twice the reference's own spread
+constexpr double kShiftSearchM = 0.003;      // strokes: the piece may sit up to 3 mm off the reference
+constexpr std::size_t kStrokeSmoothing = 4;  // samples (1 mm) averaged before the largest difference
+constexpr std::size_t kAroundSmoothing = 3;  // samples (1.5 degrees) around
+
+// a - b across b's slope (where the surface is steep, a little shift along the way is a large
+// difference of height but a small one across), minus its least-squares line (a piece standing a
+// little off, or tilted, moves whole tracks)
+std::vector<double> detrended_difference(const double* a, const double* b, std::size_t n, double step) {
+  std::vector<double> d(n);
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double slope = n < 3 ? 0.0 : (b[std::min(i + 1, n - 1)] - b[i > 0 ? i - 1 : 0]) / (2.0 * step);
+    d[i] = (a[i] - b[i]) / std::sqrt(1.0 + slope * slope);
+    mx += static_cast<double>(i);
+    my += d[i];
+  }
+  mx /= static_cast<double>(n);
+  my /= static_cast<double>(n);
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sxy += (static_cast<double>(i) - mx) * (d[i] - my);
+    sxx += (static_cast<double>(i) - mx) * (static_cast<double>(i) - mx);
+  }
+  const double slope = sxx > 0.0 ? sxy / sxx : 0.0;
+  for (std::size_t i = 0; i < n; ++i) d[i] -= my + slope * (static_cast<double>(i) - mx);
+  return d;
+}
+
+// the largest |v| averaged over `width` neighbouring samples (a ridge or a dent spans millimetres;
+// a single sample's jolt, where the hand lost the surface for a moment, does not count)
+double largest_abs(const std::vector<double>& v, std::size_t width, bool around) {
+  double m = 0.0;
+  const std::size_t n = v.size();
+  if (n < width) return 0.0;
+  for (std::size_t i = 0; i + (around ? 0 : width) <= (around ? n - 1 : n); ++i) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < width; ++k) sum += v[(i + k) % n];
+    m = std::max(m, std::fabs(sum / static_cast<double>(width)));
+  }
+  return m;
+}
+
+double mean_square(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x * x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+// The largest difference between two tracks of the same stretch after the best alignment: strokes
+// shifted along their axis by up to kShiftSearchM, contours around turned by any angle (the piece
+// may stand turned), each minus what a piece standing off-centre adds (a line; around: the mean
+// and the first harmonic). Negative when they do not overlap enough to compare.
+double surface_difference(const SurfaceTrack& a, const SurfaceTrack& b) {
+  if (a.around != b.around || a.height.empty() || b.height.empty()) return -1.0;
+  if (a.around) {
+    const std::size_t n = a.height.size();
+    if (b.height.size() != n) return -1.0;
+    double best = 1e300, best_largest = -1.0;
+    std::vector<double> d(n);
+    for (std::size_t shift = 0; shift < n; ++shift) {
+      double c0 = 0.0, c1 = 0.0, s1 = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        d[i] = a.height[i] - b.height[(i + shift) % n];
+        const double angle = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(n);
+        c0 += d[i];
+        c1 += d[i] * std::cos(angle);
+        s1 += d[i] * std::sin(angle);
+      }
+      c0 /= static_cast<double>(n);
+      c1 *= 2.0 / static_cast<double>(n);
+      s1 *= 2.0 / static_cast<double>(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const double angle = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(n);
+        d[i] -= c0 + c1 * std::cos(angle) + s1 * std::sin(angle);
+      }
+      const double ms = mean_square(d);
+      if (ms < best) {
+        best = ms;
+        best_largest = largest_abs(d, kAroundSmoothing, true);
+      }
+    }
+    return best_largest;
+  }
+  // strokes: sample i of a is at a.start + i step; trim a millimetre at each end (the start from rest)
+  const auto trim = static_cast<std::ptrdiff_t>(0.001 / a.step);
+  const auto shifts = static_cast<std::ptrdiff_t>(kShiftSearchM / a.step);
+  const auto offset = static_cast<std::ptrdiff_t>(std::lround((a.start - b.start) / a.step));
+  const auto na = static_cast<std::ptrdiff_t>(a.height.size()),
+             nb = static_cast<std::ptrdiff_t>(b.height.size());
+  const std::ptrdiff_t need = std::max<std::ptrdiff_t>(40, std::min(na, nb) / 2);
+  double best = 1e300, best_largest = -1.0;
+  for (std::ptrdiff_t s = -shifts; s <= shifts; ++s) {
+    // a[i] against b[i + offset + s]
+    const std::ptrdiff_t k = offset + s;
+    const std::ptrdiff_t from = std::max(trim, trim - k), to = std::min(na - trim, nb - trim - k);
+    if (to - from < need) continue;
+    const auto n = static_cast<std::size_t>(to - from);
+    const std::vector<double> d =
+        detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step);
+    const double ms = mean_square(d);
+    if (ms < best) {
+      best = ms;
+      best_largest = largest_abs(d, kStrokeSmoothing, false);
+    }
+  }
+  return best_largest;
+}
+
+const SurfaceTrack* find_track(const PieceSurvey& survey, const std::string& name) {
+  for (const SurfaceTrack& t : survey.tracks)
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+// |a / b - 1|, or nothing when either is missing or b is not positive
+std::optional<double> relative_difference(const std::optional<double>& a, const std::optional<double>& b) {
+  if (!a || !b || !(*b > 0.0)) return std::nullopt;
+  return std::fabs(*a / *b - 1.0);
+}
+
+}  // namespace
+
+Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
+                      const PieceSurvey& reference_again) {
+  Judgement j;
+  // the surface: per track, against the reference's same track
+  std::vector<FeatureDifference> surface;
+  for (const SurfaceTrack& r : reference.tracks) {
+    const SurfaceTrack* p = find_track(piece, r.name);
+    const SurfaceTrack* again = find_track(reference_again, r.name);
+    if (p == nullptr || again == nullptr) continue;
+    // the piece differs only as much as it differs from the closer of the two explorations of the
+    // reference (which differ from each other by the noise)
+    const double to_first = surface_difference(*p, r), to_second = surface_difference(*p, *again);
+    const double noise = surface_difference(*again, r);
+    if (to_first < 0.0 || to_second < 0.0 || noise < 0.0) continue;
+    const double difference = std::min(to_first, to_second);
+    surface.push_back({.feature = "surface",
+                       .where = r.name,
+                       .difference = difference * 1e3,
+                       .noise = noise * 1e3,
+                       .threshold = std::max(kSurfaceFloorM, kNoiseMargin * noise) * 1e3,
+                       .unit = "mm"});
+  }
+  // the most telling track first
+  std::sort(surface.begin(), surface.end(), [](const FeatureDifference& a, const FeatureDifference& b) {
+    return a.difference / a.threshold > b.difference / b.threshold;
+  });
+  if (!surface.empty()) j.evidence.push_back(surface.front());
+  const auto material = [&](const char* name, const std::optional<double>& p, const std::optional<double>& r,
+                            const std::optional<double>& again, double floor) {
+    const auto to_first = relative_difference(p, r), to_second = relative_difference(p, again);
+    const auto noise = relative_difference(again, r);
+    if (!to_first || !to_second || !noise) return;
+    const auto difference = std::min(*to_first, *to_second);
+    j.evidence.push_back({.feature = name,
+                          .where = "top",
+                          .difference = difference * 100.0,
+                          .noise = *noise * 100.0,
+                          .threshold = std::max(floor, kNoiseMargin * *noise) * 100.0,
+                          .unit = "%"});
+  };
+  // stiffness: the median of the presses on the top (a press reads the packing's grain under the
+  // tip as well as the material; on the top they all meet the same curvature)
+  const auto top_stiffness = [](const PieceSurvey& survey) -> std::optional<double> {
+    std::vector<double> k;
+    for (const auto& [site, value] : survey.site_stiffness)
+      if (site.rfind("top press", 0) == 0) k.push_back(value);
+    if (k.empty()) return std::nullopt;
+    std::nth_element(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(k.size() / 2), k.end());
+    return k[k.size() / 2];
+  };
+  material("stiffness", top_stiffness(piece), top_stiffness(reference), top_stiffness(reference_again),
+           kStiffnessFloor);
+  material("dynamic friction", piece.material.friction_dynamic, reference.material.friction_dynamic,
+           reference_again.material.friction_dynamic, kFrictionFloor);
+  const bool differs = std::any_of(j.evidence.begin(), j.evidence.end(),
+                                   [](const FeatureDifference& f) { return f.differs(); });
+  j.verdict = differs ? Verdict::forgery : Verdict::genuine;
+  return j;
+}
+
+namespace {
+
+// splitmix64: the judge's deal, the same on every platform
+std::uint64_t next_random(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+double uniform(std::uint64_t& state) { return static_cast<double>(next_random(state) >> 11) * 0x1.0p-53; }
+
+// pieces made on the lathe may stand turned any way about their axis; slabs lie as they were made
+bool turned_on_the_table(museum_artifacts::ArtifactKind kind) {
+  using museum_artifacts::ArtifactKind;
+  return kind != ArtifactKind::tablet && kind != ArtifactKind::scarab;
+}
+
+}  // namespace
+
+Result<JudgeReport> run_judge(const JudgeOptions& options) {
+  using museum_artifacts::Piece;
+  JudgeReport report;
+  report.difficulty = options.difficulty;
+  report.seed = options.seed;
+  std::uint64_t deal = options.seed * 0x2545F4914F6CDD1Dull + 7;
+  const std::filesystem::path cache =
+      options.cache_dir.empty() ? controllers::default_cache_dir() : options.cache_dir;
+  const std::size_t total = options.kinds.size() * 4;
+  std::size_t done = 0;
+  std::size_t correct = 0, judged = 0;
+  for (const museum_artifacts::ArtifactKind kind : options.kinds) {
+    const std::string kind_name = museum_artifacts::to_string(kind);
+    const auto explore = [&](Piece piece, double turn, double offset_x, double offset_y,
+                             std::uint64_t seed) -> Result<PieceSurvey> {
+      if (options.progress)
+        options.progress(fmt::format("{} {}", kind_name, done < 2 ? "reference" : "piece"),
+                         static_cast<double>(done) / static_cast<double>(total));
+      const Pose pose{quat_from_axis_angle({0, 0, 1}, turn), {offset_x, offset_y, 0.0}};
+      auto object =
+          museum_artifacts::artifact_object(kind, options.difficulty, piece, cache, kind_name, pose);
+      if (!object) return object.error();
+      SurveyOptions survey = options.survey;
+      survey.seed = seed;
+      auto result = survey_piece(*object, survey, cache);
+      ++done;
+      return result;
+    };
+    const auto turn = [&] { return turned_on_the_table(kind) ? 2.0 * kPi * uniform(deal) : 0.0; };
+    const auto off = [&] { return (uniform(deal) - 0.5) * 0.004; };
+    done = static_cast<std::size_t>(&kind - options.kinds.data()) * 4;
+    // the genuine reference, explored twice (two turns, two seeds): how much it differs from itself
+    auto reference = explore(Piece::genuine, 0.0, 0.0, 0.0, next_random(deal));
+    if (!reference) return reference.error();
+    auto again = explore(Piece::genuine, turn(), off(), off(), next_random(deal));
+    if (!again) return again.error();
+    PairResult pair;
+    pair.kind = kind;
+    pair.tell = museum_artifacts::tell(kind, options.difficulty).description;
+    pair.material_tell = museum_artifacts::material_tell(kind, options.difficulty).description;
+    const bool genuine_first = (next_random(deal) & 1u) == 0u;
+    for (const Piece truth :
+         {genuine_first ? Piece::genuine : Piece::forgery, genuine_first ? Piece::forgery : Piece::genuine}) {
+      PieceResult r;
+      r.truth = truth;
+      r.turn_rad = turn();
+      const double x = off(), y = off();
+      auto survey = explore(truth, r.turn_rad, x, y, next_random(deal));
+      if (!survey) return survey.error();
+      r.judgement = judge_piece(*survey, *reference, *again);
+      r.simulated_s = survey->simulated_s;
+      report.simulated_s += survey->simulated_s;
+      correct += r.correct() ? 1 : 0;
+      ++judged;
+      pair.pieces.push_back(std::move(r));
+    }
+    report.simulated_s += reference->simulated_s + again->simulated_s;
+    report.pairs.push_back(std::move(pair));
+  }
+  if (options.progress) options.progress("done", 1.0);
+  report.accuracy = judged > 0 ? static_cast<double>(correct) / static_cast<double>(judged) : 0.0;
+  return report;
+}
+
+}  // namespace uh::museum_players
