@@ -815,7 +815,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     // a grating is one plane wave over the whole surface: the wave vector the strokes found must
     // also explain the ripple along the contour, a third path; a random texture (or a packing's
     // grain) has its strongest component differ from path to path, and then has no period
-    const PlaneWaveFit fit = fit_plane_wave(contour, trace.stroke_axes, axis_frequency, 2.5 / (to - from),
+    const PlaneWaveFit fit = fit_plane_wave(contour, trace.stroke_axes, axis_frequency, 2.5 / (0.82 * std::min(leg_length(o, 0), leg_length(o, 2))),
                                             e.stiffness_n_per_mm.value_or(0.0) * 1e3, e.ripple_axis_n);
     e.texture_wave_share = fit.share;
     if (fit.share >= kPlaneWaveShare) e.texture_period_m = 1.0 / std::hypot(fit.f1, fit.f2);

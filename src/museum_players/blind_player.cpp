@@ -25,7 +25,6 @@ constexpr double kStrokeStepM = 0.00025;  // surface tracks along strokes: a sam
 constexpr int kAroundSamples = 720;       // around the piece: every half degree
 constexpr double kSlideForceN = 1.5;      // normal force held on the survey's long strokes and contours
 constexpr double kEdgeClearM = 0.006;     // side contours stay this far from the base and the top
-constexpr double kShelfZ = 0.7;  // a contour whose force points up or down more than this is on a shelf
 
 struct Bounds {
   Vec3 lo{1e300, 1e300, 1e300};
@@ -141,12 +140,6 @@ void add_tracks(const SurveySite& site, const ExploreTrace& trace, std::vector<S
     tracks.push_back(std::move(t));
   }
   if (site.options.contour != ContourPath::kAroundAxis) return;
-  // where the surface faces up or down more than sideways (a shelf: the top of a foot where it
-  // meets the stem), the ball circles against two surfaces at once and wanders: no track there
-  Vec3 pushed{};
-  for (const auto& s : x)
-    if (s.phase == ExplorePhase::kContour) pushed += s.force;
-  if (norm(pushed) == 0.0 || std::fabs(normalized(pushed).z) > kShelfZ) return;
   std::vector<double> sum(kAroundSamples, 0.0);
   std::vector<int> count(kAroundSamples, 0);
   const double step = 2.0 * kPi / kAroundSamples;
