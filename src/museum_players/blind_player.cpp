@@ -243,9 +243,9 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   scene.objects = {piece};
   scene.objects[0].shape.tree = piece_tree->tree;
   scene.objects[0].shape.coverage = piece_tree->coverage;
-  scene.tool.name = "stylus";
-  scene.tool.shape.tree = tip;
-  scene.tool.shape.coverage = 1.0;
+  scene.tool().name = "stylus";
+  scene.tool().shape.tree = tip;
+  scene.tool().shape.coverage = 1.0;
   scene.watch = {piece.name};
   scene.haptic_hz = options.haptic_hz;
   scene.collision_hz = options.haptic_hz;
@@ -255,7 +255,7 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   PieceSurvey survey;
   for (SurveySite& site : plan_survey(world_bounds(*piece_tree->tree, piece.pose), options)) {
     site.options.max_seconds = std::max(1.0, options.max_piece_seconds - survey.simulated_s);
-    scene.tool.shape.tree = site.pad ? pad : tip;
+    scene.tool().shape.tree = site.pad ? pad : tip;
     auto explored = controllers::explore_scene(scene, piece.name, site.options, session);
     if (!explored) return Error{fmt::format("{} ({}): {}", piece.name, site.name, explored.error().message)};
     const controllers::ObjectExploration& e = explored->front();
