@@ -263,6 +263,14 @@ json event_json(const museum::Event& e) {
   return j;
 }
 
+json in_hands_json(const museum::Level& level, const museum::GameState& state, int item) {
+  const museum::ItemState& it = state.items[static_cast<std::size_t>(item)];
+  return {{"type", "in_hands"},
+          {"item", item},
+          {"kind", level.artifact_kinds[static_cast<std::size_t>(it.kind)]},
+          {"piece", it.genuine ? "genuine" : "forgery"}};
+}
+
 json summary_json(const museum::Level& level, const museum::RoundSummary& s) {
   json targets = json::array();
   for (int t = 0; t < s.target_count; ++t) {

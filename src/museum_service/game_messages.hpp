@@ -57,6 +57,10 @@ json level_json(const museum::Level& level);
 json snapshot_json(const museum::Level& level, const museum::GameState& state, std::string_view phase,
                    bool vive_connected, bool phantom_connected);
 json event_json(const museum::Event& event);
+/// To Phantom only: the artifact in its hands (`item`, the first on the table), its `kind` and which
+/// `piece` it is (genuine or forgery), for the station to load the right object under the device.
+/// The player is never told; only what the device renders of it tells.
+json in_hands_json(const museum::Level& level, const museum::GameState& state, int item);
 json summary_json(const museum::Level& level, const museum::RoundSummary& summary);
 
 }  // namespace uh::museum_service

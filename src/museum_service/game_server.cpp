@@ -31,11 +31,12 @@ constexpr int kMaxCatchUpTicks = 5;
 class GameHub final : public service::Endpoint {
  public:
   GameHub(asio::io_context& io, const museum::Level& level, std::uint64_t seed, std::string token,
-          int snapshot_every)
+          int snapshot_every, double speed)
       : level_(level),
         state_(museum::new_game(level, seed)),
         token_(std::move(token)),
         snapshot_every_(snapshot_every),
+        tick_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(level.rules.tick_s / speed))),
         timer_(io) {
     state_.paused = true;
     next_tick_ = Clock::now();
@@ -150,6 +151,7 @@ class GameHub final : public service::Endpoint {
       update_pause();
     }
     c.peer->send(snapshot().dump());
+    if (h.role == Role::phantom) send_in_hands(c);
     if (summary_sent_) c.peer->send(summary_json(level_, museum::summarize(level_, state_)).dump());
   }
 
@@ -211,16 +213,14 @@ class GameHub final : public service::Endpoint {
     timer_.expires_at(next_tick_);
     timer_.async_wait([this](const boost::system::error_code& ec) {
       if (ec || shut_down_) return;
-      const auto tick =
-          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(level_.rules.tick_s));
       const auto now = Clock::now();
       int ticks = 0;
       while (next_tick_ <= now && ticks < kMaxCatchUpTicks) {
         play_tick();
-        next_tick_ += tick;
+        next_tick_ += tick_;
         ++ticks;
       }
-      if (next_tick_ <= now) next_tick_ = now + tick;
+      if (next_tick_ <= now) next_tick_ = now + tick_;
       schedule();
     });
   }
@@ -251,12 +251,26 @@ class GameHub final : public service::Endpoint {
       broadcast(summary_json(level_, summary).dump());
     }
     if (++server_ticks_ % snapshot_every_ == 0) broadcast_snapshot();
+    const int front = state_.table_count > 0 ? state_.table[0] : -1;
+    if (front != in_hands_) {
+      in_hands_ = front;
+      for (auto& [id, c] : clients_)
+        if (c.role == Role::phantom) send_in_hands(c);
+    }
+  }
+
+  // the artifact now in Phantom's hands, to Phantom only (nothing when the table is empty)
+  void send_in_hands(Client& c) {
+    if (state_.table_count == 0 || state_.phase == museum::Phase::ended) return;
+    c.peer->send(in_hands_json(level_, state_, state_.table[0]).dump());
   }
 
   museum::Level level_;
   museum::GameState state_;
   std::string token_;
   int snapshot_every_;
+  Clock::duration tick_;  // of the wall clock: the rules' tick over the round's speed
+  int in_hands_ = -1;     // the item Phantom was last told it holds
   asio::steady_timer timer_;
   Clock::time_point next_tick_;
   std::int64_t server_ticks_ = 0;
@@ -288,6 +302,8 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
     return Error{"level: " + valid.error().message};
   if (!(options.snapshot_hz >= 20.0 && options.snapshot_hz <= 30.0))
     return Error{fmt::format("snapshot rate {} Hz is not within 20..30 Hz", options.snapshot_hz)};
+  if (!(options.speed >= 0.1 && options.speed <= 20.0))
+    return Error{fmt::format("speed {} is not within 0.1..20 (game seconds per second)", options.speed)};
   // snapshots every n rule ticks: the rate within 20..30 Hz nearest the one asked for
   const double tick_hz = 1.0 / options.level.rules.tick_s;
   const int every = std::max(1, static_cast<int>(std::lround(tick_hz / options.snapshot_hz)));
@@ -302,7 +318,8 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
        .no_page = "this build of uh has no browser client for the museum\n",
        .program = "uh museum serve"},
       [&](asio::io_context& io) {
-        auto made = std::make_unique<GameHub>(io, options.level, options.seed, options.token, every);
+        auto made = std::make_unique<GameHub>(io, options.level, options.seed, options.token, every,
+                                              options.speed);
         hub = made.get();
         return made;
       });

@@ -164,6 +164,11 @@ TEST(MuseumServer, SnapshotsComeAtTwentyToThirtyHertzOfGameTime) {
   refused = GameServer::start(broken);
   ASSERT_FALSE(refused.has_value());
   EXPECT_NE(refused.error().message.find("level: "), std::string::npos);
+  GameServerOptions too_fast = open_hall_round();
+  too_fast.speed = 50.0;
+  refused = GameServer::start(too_fast);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("speed 50 is not within 0.1..20"), std::string::npos);
 }
 
 TEST(MuseumServer, ADroppedPlayerPausesTheRoundAndAReconnectResumesIt) {
@@ -287,6 +292,7 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
   auto server = start(options);
   ASSERT_TRUE(server);
   json summary;                             // written by Phantom's thread, read after the join
+  std::vector<json> in_hands;               // the same
   std::atomic<bool> summary_arrived{false};  // what Vive's loop may look at meanwhile
   std::thread phantom_thread([&] {
     Client phantom(server->port());
@@ -303,6 +309,7 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
         summary_arrived.store(true, std::memory_order_release);
         return;
       }
+      if ((*m)["type"] == "in_hands") in_hands.push_back(*m);
       if ((*m)["type"] != "snapshot" || (*m)["table"].empty()) continue;
       const int item = (*m)["table"][0]["item"];
       if (std::find(seen.begin(), seen.end(), item) == seen.end()) seen.push_back(item);
@@ -327,8 +334,11 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
     if (!run_to(vive, link, level.table + museum::Vec2{0.5, 0.0})) return false;
     // the round may end (both verdicts given) before the last snapshot shows empty hands
     act_until(vive, link, "deliver", [](const json& s) { return s["vive"]["carried"].empty(); });
-    // stays connected until the round ends (a drop would pause it)
-    while (next_snapshot(vive).has_value() && !summary_arrived.load(std::memory_order_acquire)) {
+    // stays connected until the round ends (a drop would pause it); never told what Phantom holds
+    while (!summary_arrived.load(std::memory_order_acquire)) {
+      const auto m = vive.read();
+      if (!m) break;
+      if ((*m)["type"] == "in_hands") ADD_FAILURE() << "only Phantom is told which piece it holds";
     }
     return true;
   }();
@@ -349,6 +359,14 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
   const museum::GameState end = server->state();
   EXPECT_EQ(end.phase, museum::Phase::ended);
   EXPECT_EQ(end.score.points, score["points"].get<int>());
+  // Phantom was told each piece as it came into its hands: the two delivered, each as it is
+  ASSERT_EQ(in_hands.size(), 2u);
+  EXPECT_NE(in_hands[0]["item"], in_hands[1]["item"]);
+  for (const json& h : in_hands) {
+    const museum::ItemState& item = end.items[h["item"].get<std::size_t>()];
+    EXPECT_EQ(h["piece"], item.genuine ? "genuine" : "forgery");
+    EXPECT_EQ(h["kind"], level.artifact_kinds[static_cast<std::size_t>(item.kind)]);
+  }
 }
 
 }  // namespace

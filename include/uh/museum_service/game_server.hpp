@@ -7,7 +7,8 @@
 /// over `ws://HOST:PORT/ws` and sends every client snapshots (20-30 Hz), events and the end
 /// summary, in the versioned JSON messages of docs/museum.md. The round plays while a Vive and a
 /// Phantom are connected; when either drops out it pauses (the station zeroes Phantom's force on
-/// the paused snapshot) and a reconnect in that role resumes it. A bad message gets an error
+/// the paused snapshot) and a reconnect in that role resumes it. Phantom alone is told which
+/// piece it holds (`in_hands`): its station puts that piece under the device. A bad message gets an error
 /// naming what is wrong and is logged; the connection stays usable.
 
 #include <cstdint>
@@ -34,6 +35,9 @@ struct GameServerOptions {
   museum::Level level = museum::make_level(museum::Difficulty::easy);  ///< must validate
   std::uint64_t seed = 1;
   double snapshot_hz = 20.0;                 ///< snapshots per second of game time, 20..30
+  /// Game seconds per second of the wall clock, 0.1..20: 1 for people; a round of bots only may
+  /// run faster (`uh museum play --bots --speed`).
+  double speed = 1.0;
   std::vector<service::StaticFile> files{};  ///< the browser client's files, if any
 };
 
