@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
+#include <limits>
 #include <memory>
 #include <random>
 #include <set>
@@ -12,6 +14,7 @@
 #include "tree_test_support.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/collette/volume_query.hpp"
+#include "uh/core/sphere_overlap.hpp"
 
 namespace uh::collette {
 namespace {
@@ -199,19 +202,117 @@ TEST(VolumeQuery, TruncatesAtCapacityButKeepsTotals) {
 }
 
 TEST(VolumeQuery, DeepPosesMatchBruteForce) {
-  // a quarter of the volume overlapping: thousands of pairs, every visit type of the traversal
+  // a quarter of the volume overlapping: thousands of pairs, every visit type of the traversal;
+  // with the AVX2 kernels where the CPU has them, and with the baseline kernels
   const auto la = make_packing(0.13, Shape::kBall, 71);
   const auto lb = make_packing(0.11, Shape::kBox, 72);
   for (const auto& [arity_a, arity_b] : {std::pair{8, 8}, std::pair{4, 8}, std::pair{8, 3}}) {
     const auto ta = build_sphere_tree(la, {.arity = arity_a});
     const auto tb = build_sphere_tree(lb, {.arity = arity_b});
     ASSERT_TRUE(ta && tb);
-    VolumeQuery query;
     const std::vector<Pose> poses =
         deep_poses(*ta, *tb, 3, 300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      expect_pose_matches_brute_force(query, *ta, *tb, la, lb, poses[k], static_cast<int>(k));
-      EXPECT_GT(query.result().stats.overlapping_pairs, 300) << "not deep: the test would prove little";
+    for (const bool avx2 : {true, false}) {
+      VolumeQuery query({.use_avx2 = avx2});
+      for (std::size_t k = 0; k < poses.size(); ++k) {
+        expect_pose_matches_brute_force(query, *ta, *tb, la, lb, poses[k], static_cast<int>(k));
+        EXPECT_GT(query.result().stats.overlapping_pairs, 300) << "not deep: the test would prove little";
+      }
+    }
+  }
+}
+
+// The kernels the fast path may take on this machine: AVX2 where the CPU has it (not on Windows
+// builds), and always the baseline (SSE2).
+TEST(VolumeQuery, TakesTheAvx2KernelsWhereTheCpuHasThem) {
+#if defined(__x86_64__) && !defined(_WIN32)
+  __builtin_cpu_init();
+  const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
+#else
+  const bool cpu_has_avx2 = false;
+#endif
+  EXPECT_EQ(VolumeQuery().uses_avx2(), cpu_has_avx2);
+  EXPECT_FALSE(VolumeQuery({.use_avx2 = false}).uses_avx2());
+  EXPECT_FALSE(VolumeQuery({.reference_kernel = true, .use_avx2 = false}).uses_avx2());
+}
+
+// Leaf pairs at the lens kernel's branch points (coincident centres, containment and its boundary,
+// lenses of equal and unequal radii, touching to the last bit, a hair apart), evaluated by the
+// fast path with each kernel width: every stored pair must be sphere_overlap<float> of its two
+// spheres bit for bit, and no overlapping pair may be missing.
+TEST(VolumeQuery, FastKernelsEqualTheScalarLensAtItsBranchPoints) {
+  std::vector<Sphere> la, lb;
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int i = 0; i < 40; ++i) {
+    // A's spheres on a line, 10 apart; B's spheres around each
+    const float x = 10.f * static_cast<float>(i), r = 0.5f + unit(rng);
+    la.push_back({x, 0.f, 0.f, r});
+    const float r2 = 0.2f + unit(rng);
+    const float sum = r + r2, delta = std::abs(r - r2);
+    const float ds[] = {0.f,
+                        0.5f * delta,
+                        delta,
+                        std::nextafter(delta, 0.f),
+                        std::nextafter(delta, sum),
+                        0.5f * (delta + sum),
+                        std::nextafter(sum, 0.f),
+                        sum,
+                        std::nextafter(sum, 2.f * sum),
+                        std::numeric_limits<float>::min()};
+    // each B sphere of a group along its own direction, offset so that they do not meet A's neighbours
+    for (int k = 0; k < static_cast<int>(std::size(ds)); ++k) {
+      const float dir = k % 2 == 0 ? 1.f : -1.f;
+      if (k % 3 == 0)
+        lb.push_back({x + dir * ds[k], 0.f, 0.f, r2});
+      else
+        lb.push_back({x, dir * ds[k], 0.f, k % 3 == 1 ? r2 : r});
+    }
+  }
+  for (const int arity : {8, 4}) {
+    const auto ta = build_sphere_tree(la, {.arity = arity});
+    const auto tb = build_sphere_tree(lb, {.arity = arity});
+    ASSERT_TRUE(ta && tb);
+    for (const bool avx2 : {true, false}) {
+      VolumeQuery q({.use_avx2 = avx2});
+      q.run(*ta, *tb, Pose{});
+      std::set<std::pair<int, int>> got;
+      for (const PairOverlap& p : q.pairs()) {
+        got.emplace(p.leaf_a, p.leaf_b);
+        const Sphere& a = la[static_cast<std::size_t>(p.leaf_a)];
+        const Sphere& b = lb[static_cast<std::size_t>(p.leaf_b)];
+        const float dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+        const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const SphereOverlap<float> o = sphere_overlap(d, a.radius, b.radius);
+        const float inv = d > 0.f ? 1.f / d : 0.f;
+        const float expected[8] = {o.volume,
+                                   o.area,
+                                   dx * inv,
+                                   dy * inv,
+                                   dz * inv,
+                                   a.x + dx * inv * o.centroid_offset,
+                                   a.y + dy * inv * o.centroid_offset,
+                                   a.z + dz * inv * o.centroid_offset};
+        const float actual[8] = {p.volume,    p.area,        p.normal[0],   p.normal[1],
+                                 p.normal[2], p.centroid[0], p.centroid[1], p.centroid[2]};
+        EXPECT_EQ(std::memcmp(expected, actual, sizeof expected), 0)
+            << "pair (" << p.leaf_a << ", " << p.leaf_b << ") at d " << d << ": volume " << p.volume
+            << " against " << o.volume << (avx2 ? " (AVX2 kernels)" : " (baseline kernels)");
+      }
+      // every overlapping pair found (the scalar kernel decides, pair by pair)
+      int overlapping = 0;
+      for (std::size_t i = 0; i < la.size(); ++i)
+        for (std::size_t j = 0; j < lb.size(); ++j) {
+          const float dx = lb[j].x - la[i].x, dy = lb[j].y - la[i].y, dz = lb[j].z - la[i].z;
+          if (sphere_overlap(std::sqrt(dx * dx + dy * dy + dz * dz), la[i].radius, lb[j].radius).volume >
+              0.f) {
+            ++overlapping;
+            EXPECT_TRUE(got.count({static_cast<int>(i), static_cast<int>(j)}))
+                << "pair " << i << ", " << j << " missing";
+          }
+        }
+      EXPECT_EQ(static_cast<int>(got.size()), overlapping);
+      EXPECT_GT(overlapping, 300) << "the cases hardly overlap: the test would prove little";
     }
   }
 }
@@ -226,30 +327,40 @@ void expect_fast_equals_reference(float margin) {
     const auto ta = build_sphere_tree(la, {.arity = arity_a});
     const auto tb = build_sphere_tree(lb, {.arity = arity_b});
     ASSERT_TRUE(ta && tb);
-    VolumeQuery fast({.contact_margin = margin});
-    VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
-    for (const Pose& pose :
-         deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {
-      const VolumeQueryResult f = fast.run(*ta, *tb, pose);
-      const VolumeQueryResult& r = reference.run(*ta, *tb, pose);
-      ASSERT_GT(r.pair_count, 150);
-      ASSERT_EQ(f.pair_count, r.pair_count);
-      ASSERT_EQ(f.stats.overlapping_pairs, r.stats.overlapping_pairs);
-      ASSERT_EQ(f.near_pairs, r.near_pairs);
-      if (margin > 0.f) {
-        EXPECT_GT(r.near_pairs, 0) << "the margin found no near pairs: the test would prove little";
+    // the fast path with the AVX2 kernels (where the CPU has them) and with the baseline kernels
+    for (const bool avx2 : {true, false}) {
+      VolumeQuery fast({.contact_margin = margin, .use_avx2 = avx2});
+      VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
+      for (const Pose& pose :
+           deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {
+        const VolumeQueryResult f = fast.run(*ta, *tb, pose);
+        const VolumeQueryResult& r = reference.run(*ta, *tb, pose);
+        ASSERT_GT(r.pair_count, 150);
+        ASSERT_EQ(f.pair_count, r.pair_count);
+        ASSERT_EQ(f.stats.overlapping_pairs, r.stats.overlapping_pairs);
+        ASSERT_EQ(f.near_pairs, r.near_pairs);
+        if (margin > 0.f) {
+          EXPECT_GT(r.near_pairs, 0) << "the margin found no near pairs: the test would prove little";
+        }
+        for (int i = 0; i < r.pair_count; ++i) {
+          const PairOverlap& pf = fast.pairs()[static_cast<std::size_t>(i)];
+          const PairOverlap& pr = reference.pairs()[static_cast<std::size_t>(i)];
+          ASSERT_EQ(std::memcmp(&pf, &pr, sizeof(PairOverlap)), 0)
+              << "pair " << i << ": (" << pf.leaf_a << ", " << pf.leaf_b << ") volume " << pf.volume
+              << " against (" << pr.leaf_a << ", " << pr.leaf_b << ") volume " << pr.volume;
+        }
+        // summed in the same order: equal, not merely close
+        EXPECT_EQ(f.total_volume, r.total_volume);
+        EXPECT_EQ(f.weighted_normal_sum.x, r.weighted_normal_sum.x);
+        EXPECT_EQ(f.weighted_normal_sum.y, r.weighted_normal_sum.y);
+        EXPECT_EQ(f.weighted_normal_sum.z, r.weighted_normal_sum.z);
+        EXPECT_EQ(f.volume_gradient.x, r.volume_gradient.x);
+        EXPECT_EQ(f.volume_gradient.y, r.volume_gradient.y);
+        EXPECT_EQ(f.volume_gradient.z, r.volume_gradient.z);
+        EXPECT_EQ(f.volume_centroid.x, r.volume_centroid.x);
+        EXPECT_EQ(f.volume_centroid.y, r.volume_centroid.y);
+        EXPECT_EQ(f.volume_centroid.z, r.volume_centroid.z);
       }
-      for (int i = 0; i < r.pair_count; ++i) {
-        const PairOverlap& pf = fast.pairs()[static_cast<std::size_t>(i)];
-        const PairOverlap& pr = reference.pairs()[static_cast<std::size_t>(i)];
-        ASSERT_EQ(std::memcmp(&pf, &pr, sizeof(PairOverlap)), 0)
-            << "pair " << i << ": (" << pf.leaf_a << ", " << pf.leaf_b << ") volume " << pf.volume
-            << " against (" << pr.leaf_a << ", " << pr.leaf_b << ") volume " << pr.volume;
-      }
-      EXPECT_NEAR(f.total_volume, r.total_volume, 1e-12 * r.total_volume);
-      EXPECT_LT(norm(f.weighted_normal_sum - r.weighted_normal_sum), 1e-12 * r.total_volume);
-      EXPECT_LT(norm(f.volume_gradient - r.volume_gradient), 1e-12 * norm(r.volume_gradient));
-      EXPECT_LT(norm(f.volume_centroid - r.volume_centroid), 1e-12);
     }
   }
 }

@@ -73,6 +73,11 @@ struct VolumeQueryOptions {
   /// the reference that tests and benchmarks compare the fast path with. Same results (the same
   /// pairs, bit for bit, and the same totals), slower.
   bool reference_kernel = false;
+  /// Run the fast path's node tests and lens kernel eight lanes wide (AVX2) when the CPU has AVX2,
+  /// checked once at construction (VolumeQuery::uses_avx2()); false keeps the baseline kernels
+  /// (SSE2, four lanes), which every x86-64 runs. Both give the same results, bit for bit. Builds
+  /// for Windows have the baseline kernels only.
+  bool use_avx2 = true;
 };
 
 /// Totals of one VolumeQuery::run, in A's mesh frame. Trivially copyable.
@@ -137,6 +142,8 @@ class VolumeQuery {
   /// The overlapping pairs stored by the last run (empty unless collect_pairs), A frame.
   std::span<const PairOverlap> pairs() const { return {pairs_.data(), static_cast<std::size_t>(result_.pair_count)}; }
   const VolumeQueryOptions& options() const { return options_; }
+  /// True when runs take the AVX2 kernels (options().use_avx2 and the CPU has AVX2).
+  bool uses_avx2() const { return uses_avx2_; }
 
   /// One entry of the traversal stack: a node pair known to overlap, as traversal ids
   /// (SphereTree::Blocks), with both node spheres, B's already in A's frame (so each B node is
@@ -164,6 +171,7 @@ class VolumeQuery {
   std::vector<StackEntry> stack_;
   std::vector<PairOverlap> pairs_;
   VolumeQueryResult result_;
+  bool uses_avx2_ = false;
   // coherence: the kept pairs, B's leaves among them (by index) and where they are this run, and
   // the trees and pose of the traversal that kept them
   std::vector<Candidate> candidates_;
