@@ -1,5 +1,6 @@
 // uh museum serve [--host 127.0.0.1] [--port 7780] [--token T] [--seed N] [--minutes M] [--level easy|hard]
 // uh museum judge [--level easy|hard] [--seed N] [--kinds K,...] [--json]
+// uh museum play: cmd_museum_play.cpp
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -138,6 +139,8 @@ int museum_judge(const MuseumJudgeArgs& args) {
 
 }  // namespace
 
+void add_museum_play_command(CLI::App& museum, CommandRunner& runner);  // cmd_museum_play.cpp
+
 void add_museum_commands(CLI::App& app, CommandRunner& runner) {
   auto* museum = app.add_subcommand("museum", "the museum heist game (docs/museum.md)");
   museum->require_subcommand(1);
@@ -171,6 +174,8 @@ void add_museum_commands(CLI::App& app, CommandRunner& runner) {
   j->add_flag("--json", judge.json,
               "print one JSON object: accuracy and per pair the verdicts and the evidence");
   j->callback([&runner] { runner = [] { return museum_judge(judge); }; });
+
+  add_museum_play_command(*museum, runner);
 }
 
 }  // namespace uh::cli

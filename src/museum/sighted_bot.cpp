@@ -117,14 +117,14 @@ ViveInput SightedBot::decide(const GameState& state) {
       for (int g = 0; g < state.guard_count; ++g)
         heard = heard || distance(state.guards[static_cast<std::size_t>(g)].pos, goal) <=
                              level_.rules.glass_hear_radius;
-      if (!heard || waited_ticks_ >= kMaxWaitTicks) {
-        waited_ticks_ = 0;
+      if (waiting_since_tick_ < 0) waiting_since_tick_ = state.tick;
+      if (!heard || state.tick - waiting_since_tick_ >= kMaxWaitTicks) {
+        waiting_since_tick_ = -1;
         return {.break_case = true};
       }
-      ++waited_ticks_;
       // waiting here, unless a guard would catch her: then the look-ahead below moves her away
       if (safe(state, Plan::stand, goal)) return {};
-      replan_in_ticks_ = 0;
+      replan_at_tick_ = state.tick;
     }
   } else if (distance(vive.pos, level_.table) <= kArrive) {
     return {};  // nothing left to fetch: wait by the table
@@ -132,8 +132,9 @@ ViveInput SightedBot::decide(const GameState& state) {
   // every few ticks, look ahead: play the next seconds on a copy of what she sees (the rules
   // are deterministic) going on, standing still, or going back towards the entrance, and take
   // the first way on which no guard catches her
-  if (replan_in_ticks_-- <= 0) {
-    replan_in_ticks_ = kReplanTicks;
+  // (by the state's tick: a client sees a snapshot every few ticks)
+  if (state.tick >= replan_at_tick_) {
+    replan_at_tick_ = state.tick + kReplanTicks;
     plan_ = Plan::go_on;
     for (const Plan p : {Plan::go_on, Plan::stand, Plan::back_off, Plan::run_on, Plan::run_off}) {
       if (safe(state, p, goal)) {

@@ -468,13 +468,12 @@ std::uint64_t next_random(std::uint64_t& state) {
 }
 double uniform(std::uint64_t& state) { return static_cast<double>(next_random(state) >> 11) * 0x1.0p-53; }
 
-// pieces made on the lathe may stand turned any way about their axis; slabs lie as they were made
+}  // namespace
+
 bool turned_on_the_table(museum_artifacts::ArtifactKind kind) {
   using museum_artifacts::ArtifactKind;
   return kind != ArtifactKind::tablet && kind != ArtifactKind::scarab;
 }
-
-}  // namespace
 
 Result<JudgeReport> run_judge(const JudgeOptions& options) {
   using museum_artifacts::Piece;

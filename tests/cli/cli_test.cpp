@@ -871,6 +871,54 @@ TEST_F(CliTest, MuseumJudgeReportsItsVerdictsAndTheirEvidence) {
   EXPECT_NE(bad.err.find("'teapot' is no artifact kind"), std::string::npos) << bad.err;
 }
 
+TEST_F(CliTest, MuseumPlayBotsPlaysARoundToItsSummary) {
+  // a three-minute round at 10 times the clock (at most 18 s): the server, the sighted bot and the
+  // blind bot as clients over loopback sockets
+  const std::string cache = fmt::format("UH_CACHE_DIR='{}' ", UH_TEST_CACHE_DIR);
+  const CommandRun r = uh("museum play --bots --seed 1 --minutes 3 --speed 10 --json", cache);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json out = json_of(r);
+  const nlohmann::json& summary = out["summary"];
+  ASSERT_EQ(summary["type"], "summary");
+  EXPECT_GT(summary["seconds_played"].get<double>(), 0.0);
+  ASSERT_EQ(summary["targets"].size(), 3u) << "the easy level names three targets";
+  // the points are what the pieces' places say
+  const nlohmann::json& score = summary["score"];
+  EXPECT_EQ(score["points"].get<int>(),
+            100 * score["genuine_kept"].get<int>() - 60 * score["forgeries_kept"].get<int>() +
+                score["time_bonus"].get<int>());
+  // every piece kept or put aside is one the blind bot judged so, from evidence that says so
+  int settled = 0;
+  for (const auto& t : summary["targets"]) {
+    for (const char* piece : {"genuine", "forgery"}) {
+      const std::string place = t[piece];
+      if (place != "kept" && place != "rejected") continue;
+      ++settled;
+      bool found = false;
+      for (const auto& v : out["verdicts"])
+        found = found || (v["kind"] == t["kind"] && (v["verdict"] == "genuine") == (place == "kept"));
+      EXPECT_TRUE(found) << t.dump();
+    }
+  }
+  // Vive brought pieces to the table, and Phantom felt the first it was handed (a verdict may come
+  // after the end: the round does not wait for Phantom)
+  EXPECT_GE(out["events"]["items_delivered"].get<int>(), 1) << out["events"].dump();
+  EXPECT_GE(out["verdicts"].size(), std::max<std::size_t>(1, static_cast<std::size_t>(settled)));
+  for (const auto& v : out["verdicts"]) {
+    bool differs = false;
+    for (const auto& f : v["evidence"]) differs = differs || f["differs"].get<bool>();
+    EXPECT_EQ(differs, v["verdict"] == "forgery") << v.dump();
+    EXPECT_GT(v["simulated_s"].get<double>(), 10.0) << "each piece is explored by touch";
+  }
+
+  const CommandRun alone = uh("museum play --seed 2");
+  EXPECT_NE(alone.exit_code, 0);
+  EXPECT_NE(alone.err.find("give --bots, or --bot vive|phantom with --server URL"), std::string::npos) << alone.err;
+  const CommandRun nobody = uh("museum play --bot phantom --server ws://127.0.0.1:1/ws");
+  EXPECT_NE(nobody.exit_code, 0);
+  EXPECT_NE(nobody.err.find("cannot reach the game server at 127.0.0.1:1"), std::string::npos) << nobody.err;
+}
+
 TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {
   const CommandRun bad = uh(fmt::format("explore '{}' --object marble", materials_scene_path().string()),
                             fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));

@@ -46,8 +46,8 @@ class SightedBot {
   bool safe(const GameState& state, Plan plan, Vec2 goal) const;
 
   const Level& level_;
-  int waited_ticks_ = 0;
-  int replan_in_ticks_ = 0;
+  std::int64_t waiting_since_tick_ = -1;  ///< by a case for the guards to be out of earshot, since
+  std::int64_t replan_at_tick_ = 0;  ///< looks ahead again at this tick
   Plan plan_ = Plan::go_on;
 };
 

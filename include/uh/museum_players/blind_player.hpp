@@ -92,6 +92,10 @@ struct Judgement {
 Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
                       const PieceSurvey& reference_again);
 
+/// Whether a piece of this kind may lie on the table turned any way about its vertical axis
+/// (pieces made on the lathe); slabs lie as they were made.
+bool turned_on_the_table(museum_artifacts::ArtifactKind kind);
+
 /// The judge: every artifact kind of a level, its genuine piece and its forgery put before the
 /// blind player in an order and at turns dealt by the seed.
 struct JudgeOptions {
