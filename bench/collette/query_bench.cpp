@@ -16,6 +16,9 @@
 // which goes first), so both see the same machine load, and the query's reference path
 // (`reference_kernel`: the scalar path before the SIMD kernels) on the same pose; each pose 10 times.
 // Counters: median, p90 and max of both over all poses and repetitions, and the ratio of the medians.
+// Each iteration also runs the query with the baseline kernels (`sse2_median_us`: `use_avx2` off;
+// `avx2` says which the default took) and with its worker thread (`two_threads_*`, and how many of
+// the frontier's chunks the worker ran per query), after the three above.
 
 #include <benchmark/benchmark.h>
 
@@ -442,11 +445,16 @@ void BM_DeepRandomPoses(benchmark::State& state) {
   const Scene& s = scene();
   VolumeQuery query;
   VolumeQuery reference({.reference_kernel = true});
+  VolumeQuery baseline({.use_avx2 = false});
+  VolumeQuery shared({.worker_thread = true});
   fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
   fcl::CollisionObjectd b(s.fcl_model, fcl::Transform3d::Identity());
   const fcl::CollisionRequestd request(1000000, true);
-  std::vector<double> ours, reference_times, fcl_times;
+  std::vector<double> ours, reference_times, fcl_times, baseline_times, shared_times;
   ours.reserve(1 << 14);
+  baseline_times.reserve(1 << 14);
+  shared_times.reserve(1 << 14);
+  double worker_chunks = 0.0;
   reference_times.reserve(1 << 14);
   fcl_times.reserve(1 << 14);
   std::int64_t mismatches = 0;
@@ -472,6 +480,12 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       reference_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       benchmark::DoNotOptimize(r.total_volume);
     };
+    const auto run_other = [&](VolumeQuery& q, std::vector<double>& times) {
+      const auto t0 = Clock::now();
+      const VolumeQueryResult& r = q.run(s.tree, s.tree, p);
+      times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      benchmark::DoNotOptimize(r.total_volume);
+    };
     const auto run_fcl = [&] {
       b.setTransform(to_fcl(p));
       fcl::CollisionResultd result;
@@ -493,10 +507,15 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       run_ours();
       run_reference();
     }
-    // the fast path must give exactly the reference path's totals and pairs
-    if (query.result().total_volume != reference.result().total_volume ||
-        query.result().pair_count != reference.result().pair_count)
-      ++mismatches;
+    run_other(baseline, baseline_times);
+    run_other(shared, shared_times);
+    worker_chunks += shared.worker_chunks();
+    // the fast path (each kernel width, one or two threads) must give exactly the reference path's
+    // totals and pairs
+    for (const VolumeQuery* q : {&query, &baseline, &shared})
+      if (q->result().total_volume != reference.result().total_volume ||
+          q->result().pair_count != reference.result().pair_count)
+        ++mismatches;
     state.SetIterationTime(ours.back());
     ++k;
   }
@@ -504,7 +523,14 @@ void BM_DeepRandomPoses(benchmark::State& state) {
   std::sort(ours.begin(), ours.end());
   std::sort(fcl_times.begin(), fcl_times.end());
   std::sort(reference_times.begin(), reference_times.end());
+  std::sort(baseline_times.begin(), baseline_times.end());
+  std::sort(shared_times.begin(), shared_times.end());
   state.counters["reference_median_us"] = quantile(reference_times, 0.5) * 1e6;
+  state.counters["sse2_median_us"] = quantile(baseline_times, 0.5) * 1e6;
+  state.counters["two_threads_median_us"] = quantile(shared_times, 0.5) * 1e6;
+  state.counters["two_threads_p90_us"] = quantile(shared_times, 0.9) * 1e6;
+  state.counters["two_threads_worker_chunks"] = worker_chunks / n;
+  state.counters["avx2"] = query.uses_avx2() ? 1.0 : 0.0;
   state.counters["reference_p90_us"] = quantile(reference_times, 0.9) * 1e6;
   state.counters["mismatches"] = static_cast<double>(mismatches);
   state.counters["median_us"] = quantile(ours, 0.5) * 1e6;

@@ -143,15 +143,16 @@ inline void flush(Traversal& t) {
 // about once per hit). Leaf pairs are evaluated a SIMD group at a time by flush(). Within a visit,
 // both the leaf pairs and the pushes come in the reference's (child of B, child of A) order, so
 // pairs are found, stored and summed in the same order: the results are identical.
+// Runs until the stack is empty or holds `stop_at` entries (expand()), then evaluates the batch.
 template <int WA, int WB>
-void run_fast(Traversal& t) {
+void run_fast(Traversal& t, std::size_t stop_at) {
   static_assert(WA <= 8 && WB <= 8);
   alignas(32) float tb[4 * WB];
   LeafBatch& lb = *t.batch;
   const SphereTree::Blocks& a = t.a;
   const SphereTree::Blocks& b = t.b;
   const float sm = t.search_margin;
-  while (t.top > 0) {
+  while (t.top > 0 && t.top < stop_at) {
     if (lb.count > LeafBatch::kCapacity - WA * WB) flush(t);
     const VolumeQuery::StackEntry e = (*t.stack)[--t.top];
     ++t.visited;
@@ -233,10 +234,14 @@ void run_fast(Traversal& t) {
 }
 
 // one loop per pair of block widths (trees built with arity <= 4 and > 4 can meet)
-void run_fast(Traversal& t) {
+void run_until(Traversal& t, std::size_t stop_at) {
   const bool wide_a = t.a.width != 4, wide_b = t.b.width != 4;
   if (!wide_a)
-    wide_b ? run_fast<4, 8>(t) : run_fast<4, 4>(t);
+    wide_b ? run_fast<4, 8>(t, stop_at) : run_fast<4, 4>(t, stop_at);
   else
-    wide_b ? run_fast<8, 8>(t) : run_fast<8, 4>(t);
+    wide_b ? run_fast<8, 8>(t, stop_at) : run_fast<8, 4>(t, stop_at);
 }
+
+void run_fast(Traversal& t) { run_until(t, std::numeric_limits<std::size_t>::max()); }
+
+void expand(Traversal& t, std::size_t entries) { run_until(t, entries); }

@@ -1,12 +1,14 @@
 #include "uh/collette/volume_query.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <thread>
 #include <type_traits>
 
 #include "lanes_sse2.hpp"
@@ -21,10 +23,118 @@ using V = F4;
 
 using detail::Traversal;
 
+namespace detail {
+
+// The second thread of a query with worker_thread, and what the two threads share during a run.
+//
+// A run's frontier (the stack after the caller's first visits, in the order the one-thread
+// traversal would take it) is cut into chunks of contiguous entries. One atomic word holds the
+// next chunk from the front (the caller's) and the end of the unclaimed chunks (the worker takes
+// from there, backwards): each claims with a compare-and-swap, so every chunk runs exactly once
+// and the caller's chunks are a prefix. The worker evaluates its chunks into its own stack, batch
+// and pair buffer, notes where each chunk's pairs start, and counts finished chunks with a release
+// store; the caller waits (spinning) until every chunk the worker claimed is finished, then adds
+// those pairs after its own, chunk by chunk in frontier order: the pairs and the order of the sums
+// are the one-thread traversal's. Data crosses threads only through these atomics (acquire and
+// release): the caller writes the job before it publishes the chunk word and the posted count.
+struct QueryWorker {
+  static constexpr int kMaxChunks = 16;
+  static constexpr std::size_t kFrontier = 40;  // node pairs to share out
+
+  // the job (written by the caller before it posts, read by the worker after it claims a chunk)
+  Traversal traversal{};
+  std::vector<VolumeQuery::StackEntry> frontier;  // in the order the one-thread traversal takes them
+  int chunk_begin[kMaxChunks + 1] = {};           // chunk c: frontier[chunk_begin[c], chunk_begin[c + 1])
+  bool avx2 = false;
+  // the worker's scratch and results
+  std::vector<VolumeQuery::StackEntry> stack;
+  std::unique_ptr<LeafBatch> batch = std::make_unique<LeafBatch>();
+  std::vector<PairOverlap> pairs;
+  int chunk_first_pair[kMaxChunks] = {};  // where chunk c's pairs start in `pairs` (worker's chunks)
+  int chunk_pair_count[kMaxChunks] = {};
+
+  std::atomic<std::uint32_t> claim{0};   // low 16 bits: the caller's next chunk; high: end of the unclaimed
+  std::atomic<int> finished{0};          // chunks the worker finished this run
+  std::atomic<std::uint32_t> posted{0};  // runs posted; the worker wakes when it changes
+  std::atomic<bool> stop{false};
+  std::thread thread;
+
+  explicit QueryWorker(int pair_capacity)
+      : stack(4096), pairs(static_cast<std::size_t>(std::max(pair_capacity, 1))) {
+    frontier.reserve(kFrontier + 64);
+    thread = std::thread([this] { loop(); });
+  }
+  ~QueryWorker() {
+    stop.store(true, std::memory_order_release);
+    posted.fetch_add(1, std::memory_order_release);
+    posted.notify_one();
+    thread.join();
+  }
+  QueryWorker(const QueryWorker&) = delete;
+  QueryWorker& operator=(const QueryWorker&) = delete;
+
+  // the caller's next chunk, or -1 when none is left
+  int claim_front() {
+    std::uint32_t cur = claim.load(std::memory_order_acquire);
+    for (;;) {
+      const std::uint32_t lo = cur & 0xffffu, hi = cur >> 16;
+      if (lo >= hi) return -1;
+      if (claim.compare_exchange_weak(cur, (hi << 16) | (lo + 1), std::memory_order_acq_rel))
+        return static_cast<int>(lo);
+    }
+  }
+  int claim_back() {
+    std::uint32_t cur = claim.load(std::memory_order_acquire);
+    for (;;) {
+      const std::uint32_t lo = cur & 0xffffu, hi = cur >> 16;
+      if (lo >= hi) return -1;
+      if (claim.compare_exchange_weak(cur, ((hi - 1) << 16) | lo, std::memory_order_acq_rel))
+        return static_cast<int>(hi - 1);
+    }
+  }
+
+  // runs chunk c of the frontier on `t` (whose stack is empty): its entries pushed so that the
+  // first is on top, then traversed to the end
+  void run_chunk(Traversal& t, int c) const {
+    for (int i = chunk_begin[c + 1] - 1; i >= chunk_begin[c]; --i)
+      (*t.stack)[t.top++] = frontier[static_cast<std::size_t>(i)];
+    avx2 ? avx2::run_fast(t) : sse2::run_fast(t);
+  }
+
+  void loop() {
+    std::uint32_t seen = 0;
+    for (;;) {
+      // spin briefly (the next run of a kilohertz loop comes soon), then sleep until posted
+      std::uint32_t now = posted.load(std::memory_order_acquire);
+      for (int spin = 0; now == seen && spin < 20000; ++spin) {
+#if defined(__SSE2__)
+        _mm_pause();
+#endif
+        now = posted.load(std::memory_order_acquire);
+      }
+      while (now == seen) {
+        posted.wait(seen, std::memory_order_acquire);
+        now = posted.load(std::memory_order_acquire);
+      }
+      seen = now;
+      if (stop.load(std::memory_order_acquire)) return;
+      for (int c = claim_back(); c >= 0; c = claim_back()) {
+        chunk_first_pair[c] = traversal.stored;
+        run_chunk(traversal, c);
+        chunk_pair_count[c] = traversal.stored - chunk_first_pair[c];
+        finished.fetch_add(1, std::memory_order_release);
+      }
+    }
+  }
+};
+
+}  // namespace detail
+
 VolumeQuery::VolumeQuery(const VolumeQueryOptions& options)
     : options_(options),
       batch_(std::make_unique<detail::LeafBatch>()),
       uses_avx2_(options.use_avx2 && detail::avx2::supported()) {
+  if (options_.worker_thread) worker_ = std::make_unique<detail::QueryWorker>(options_.pair_capacity);
   options_.pair_capacity = std::max(0, options_.pair_capacity);
   // the traversal keeps its own top: the vector is storage, sized to its capacity
   stack_.resize(static_cast<std::size_t>(std::max(64, options_.stack_reserve)));
@@ -41,6 +151,97 @@ VolumeQuery::VolumeQuery(VolumeQuery&&) noexcept = default;
 VolumeQuery& VolumeQuery::operator=(VolumeQuery&&) noexcept = default;
 
 namespace {
+
+// The fast path shared with the worker thread (QueryWorker): returns the chunks the worker ran.
+int run_shared(detail::QueryWorker& w, Traversal& t, bool avx2, const SphereTree& a, const SphereTree& b,
+               const Pose& b_in_a, const VolumeQueryOptions& options) {
+  using detail::QueryWorker;
+  avx2 ? detail::avx2::expand(t, QueryWorker::kFrontier) : detail::sse2::expand(t, QueryWorker::kFrontier);
+  if (t.top < 2) {
+    avx2 ? detail::avx2::run_fast(t) : detail::sse2::run_fast(t);
+    return 0;
+  }
+  // the frontier in the order one thread would take it (top of the stack first), cut into chunks
+  // of about equal expected work: the lens volume of a pair's two node spheres
+  w.frontier.clear();
+  float total = 0.f;
+  for (std::size_t i = t.top; i-- > 0;) {
+    const VolumeQuery::StackEntry& e = (*t.stack)[i];
+    w.frontier.push_back(e);
+    const float dx = e.bx - e.ax, dy = e.by - e.ay, dz = e.bz - e.az;
+    total += sphere_overlap(std::sqrt(dx * dx + dy * dy + dz * dz), e.ar, e.br).volume;
+  }
+  t.top = 0;
+  const int n = static_cast<int>(w.frontier.size());
+  const int wanted = std::min(QueryWorker::kMaxChunks, n);
+  int chunks = 0;
+  float acc = 0.f;
+  w.chunk_begin[0] = 0;
+  for (int i = 0; i < n && chunks + 1 < wanted; ++i) {
+    const VolumeQuery::StackEntry& e = w.frontier[static_cast<std::size_t>(i)];
+    const float dx = e.bx - e.ax, dy = e.by - e.ay, dz = e.bz - e.az;
+    acc += sphere_overlap(std::sqrt(dx * dx + dy * dy + dz * dz), e.ar, e.br).volume;
+    if (acc >= total * static_cast<float>(chunks + 1) / static_cast<float>(wanted))
+      w.chunk_begin[++chunks] = i + 1;
+  }
+  if (w.chunk_begin[chunks] < n) w.chunk_begin[++chunks] = n;
+
+  // post the run, then take chunks from the front until none is left
+  w.traversal =
+      detail::make_traversal(a, b, b_in_a, options, &w.stack, w.pairs.data(), nullptr, w.batch.get());
+  w.traversal.capacity = static_cast<std::int32_t>(w.pairs.size());
+  w.traversal.search_margin = t.search_margin;
+  w.avx2 = avx2;
+  w.finished.store(0, std::memory_order_relaxed);
+  w.claim.store(static_cast<std::uint32_t>(chunks) << 16, std::memory_order_release);
+  w.posted.fetch_add(1, std::memory_order_release);
+  w.posted.notify_one();
+  if (options.worker_claims_first) {
+    while (w.claim.load(std::memory_order_acquire) >> 16 == static_cast<std::uint32_t>(chunks)) {
+#if defined(__SSE2__)
+      _mm_pause();
+#endif
+    }
+  }
+  int mine = 0;
+  for (int c = w.claim_front(); c >= 0; c = w.claim_front(), ++mine) {
+    t.reserve_stack(static_cast<std::size_t>(w.chunk_begin[c + 1] - w.chunk_begin[c]));
+    w.run_chunk(t, c);
+  }
+  const int theirs = chunks - mine;
+  while (w.finished.load(std::memory_order_acquire) != theirs) {
+#if defined(__SSE2__)
+    _mm_pause();
+#endif
+  }
+
+  const Traversal& wt = w.traversal;
+  if (wt.overlapping + wt.near > wt.stored) {
+    // the worker's buffer overflowed, so its pairs cannot all be added: run its chunks again here,
+    // after the caller's, which is the one-thread order
+    for (int c = mine; c < chunks; ++c) {
+      t.reserve_stack(static_cast<std::size_t>(w.chunk_begin[c + 1] - w.chunk_begin[c]));
+      w.run_chunk(t, c);
+    }
+    return 0;
+  }
+  // the worker's pairs after the caller's, chunk by chunk in frontier order
+  for (int c = mine; c < chunks; ++c) {
+    const PairOverlap* p = w.pairs.data() + w.chunk_first_pair[c];
+    for (const PairOverlap* end = p + w.chunk_pair_count[c]; p != end; ++p) {
+      if (p->volume > 0.f) {
+        t.add_overlap(p->volume, p->area, p->normal[0], p->normal[1], p->normal[2], p->centroid[0],
+                      p->centroid[1], p->centroid[2], p->leaf_a, p->leaf_b);
+      } else {
+        ++t.near;  // a near pair of the contact margin, stored as the worker stored it
+        if (t.stored < t.capacity) t.out[t.stored++] = *p;
+      }
+    }
+  }
+  t.visited += wt.visited;
+  t.leaf_tests += wt.leaf_tests;
+  return theirs;
+}
 
 // Fills a result from a finished traversal or candidate test.
 void finish(const Traversal& t, bool collect_pairs, VolumeQueryResult& result) {
@@ -93,6 +294,8 @@ void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose&
   } else if (options_.reference_kernel) {
     if (!wide_a) wide_b ? t.run<4, 8, false>() : t.run<4, 4, false>();
     else wide_b ? t.run<8, 8, false>() : t.run<8, 4, false>();
+  } else if (worker_) {
+    worker_chunks_ = run_shared(*worker_, t, uses_avx2_, a, b, b_in_a, options_);
   } else if (uses_avx2_) {
     detail::avx2::run_fast(t);
   } else {

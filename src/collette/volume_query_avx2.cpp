@@ -61,6 +61,7 @@ namespace uh::collette::detail::avx2 {
 bool supported() { return false; }
 // never called (supported() is false); the baseline path, should it be
 void run_fast(Traversal& t) { sse2::run_fast(t); }
+void expand(Traversal& t, std::size_t entries) { sse2::expand(t, entries); }
 }  // namespace uh::collette::detail::avx2
 
 #endif

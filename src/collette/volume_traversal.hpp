@@ -345,15 +345,20 @@ inline Traversal make_traversal(const SphereTree& a, const SphereTree& b, const 
                    Totals{}};
 }
 
-// The fast path for the baseline ISA (volume_query.cpp) and for AVX2 (volume_query_avx2.cpp).
+// The fast path for the baseline ISA (volume_query.cpp) and for AVX2 (volume_query_avx2.cpp):
+// run_fast() traverses until the stack is empty; expand() traverses (in the same order) only until
+// the stack holds `entries` node pairs, the frontier that a two-thread query shares out. Both
+// evaluate the leaf pairs found so far before they return.
 namespace sse2 {
 void run_fast(Traversal& t);
-}
+void expand(Traversal& t, std::size_t entries);
+}  // namespace sse2
 namespace avx2 {
-/// True when this build has the AVX2 path and the CPU running it supports AVX2 (checked once).
+/// True when this build has the AVX2 path and the CPU running it supports AVX2.
 bool supported();
 /// Only when supported().
 void run_fast(Traversal& t);
+void expand(Traversal& t, std::size_t entries);
 }  // namespace avx2
 
 }  // namespace uh::collette::detail

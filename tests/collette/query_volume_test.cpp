@@ -83,34 +83,6 @@ void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector
   EXPECT_GT(overlapping_poses, poses / 3) << "the random poses hardly overlap: the test would prove little";
 }
 
-// Deep poses as in the query benchmark: B at random orientations, each moved along a random
-// direction until the packings overlap by half of what they overlap when centred on each other
-// (the benchmark's bunny packings are dense, 0.86, and there a quarter of the packing volume is
-// about half of it; the test packings are sparse). Bisection on the reference path's volume.
-std::vector<Pose> deep_poses(const SphereTree& ta, const SphereTree& tb, int count, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
-  VolumeQuery q({.collect_pairs = false, .reference_kernel = true});
-  const Vec3 ca = testing::centre({ta.root().x, ta.root().y, ta.root().z, 0.f});
-  const Vec3 cb = testing::centre({tb.root().x, tb.root().y, tb.root().z, 0.f});
-  const double reach = static_cast<double>(ta.root().radius + tb.root().radius);
-  std::vector<Pose> out;
-  while (static_cast<int>(out.size()) < count) {
-    const Quat rot = normalized(Quat{g(rng), g(rng), g(rng), g(rng)});
-    const Vec3 dir = normalized(Vec3{g(rng), g(rng), g(rng)});
-    const auto at = [&](double s) { return Pose{rot, ca + s * dir - rotate(rot, cb)}; };
-    const auto volume = [&](double s) { return q.run(ta, tb, at(s)).total_volume; };
-    const double target = 0.5 * volume(0.0);
-    double lo = 0.0, hi = reach;
-    for (int i = 0; i < 30; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (volume(mid) > target ? lo : hi) = mid;
-    }
-    out.push_back(at(lo));
-  }
-  return out;
-}
-
 TEST(VolumeQuery, MatchesBruteForceOnRandomPoses) {
   const auto ball = make_packing(0.16, Shape::kBall, 21);
   const auto box = make_packing(0.14, Shape::kBox, 22);
@@ -211,7 +183,7 @@ TEST(VolumeQuery, DeepPosesMatchBruteForce) {
     const auto tb = build_sphere_tree(lb, {.arity = arity_b});
     ASSERT_TRUE(ta && tb);
     const std::vector<Pose> poses =
-        deep_poses(*ta, *tb, 3, 300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
+        testing::deep_poses(*ta, *tb, 3, 300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
     for (const bool avx2 : {true, false}) {
       VolumeQuery query({.use_avx2 = avx2});
       for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -332,7 +304,7 @@ void expect_fast_equals_reference(float margin) {
       VolumeQuery fast({.contact_margin = margin, .use_avx2 = avx2});
       VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
       for (const Pose& pose :
-           deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {
+           testing::deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {
         const VolumeQueryResult f = fast.run(*ta, *tb, pose);
         const VolumeQueryResult& r = reference.run(*ta, *tb, pose);
         ASSERT_GT(r.pair_count, 150);
@@ -350,16 +322,7 @@ void expect_fast_equals_reference(float margin) {
               << " against (" << pr.leaf_a << ", " << pr.leaf_b << ") volume " << pr.volume;
         }
         // summed in the same order: equal, not merely close
-        EXPECT_EQ(f.total_volume, r.total_volume);
-        EXPECT_EQ(f.weighted_normal_sum.x, r.weighted_normal_sum.x);
-        EXPECT_EQ(f.weighted_normal_sum.y, r.weighted_normal_sum.y);
-        EXPECT_EQ(f.weighted_normal_sum.z, r.weighted_normal_sum.z);
-        EXPECT_EQ(f.volume_gradient.x, r.volume_gradient.x);
-        EXPECT_EQ(f.volume_gradient.y, r.volume_gradient.y);
-        EXPECT_EQ(f.volume_gradient.z, r.volume_gradient.z);
-        EXPECT_EQ(f.volume_centroid.x, r.volume_centroid.x);
-        EXPECT_EQ(f.volume_centroid.y, r.volume_centroid.y);
-        EXPECT_EQ(f.volume_centroid.z, r.volume_centroid.z);
+        testing::expect_identical_totals(f, r);
       }
     }
   }

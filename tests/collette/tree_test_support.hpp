@@ -1,12 +1,16 @@
 #pragma once
 // Leaf-set generators and brute-force references shared by the sphere-tree tests.
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
 
 #include "lens_reference.hpp"
+#include "uh/collette/sphere_tree.hpp"
+#include "uh/collette/volume_query.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
 
@@ -96,6 +100,48 @@ inline double brute_gap(const std::vector<Sphere>& a, const std::vector<Sphere>&
       best = std::min(best, norm(cb - centre(sa)) - static_cast<double>(sa.radius) - static_cast<double>(sb.radius));
   }
   return best;
+}
+
+// Deep poses as in the query benchmark: B at random orientations, each moved along a random
+// direction until the packings overlap by half of what they overlap when centred on each other
+// (the benchmark's bunny packings are dense, 0.86, and there a quarter of the packing volume is
+// about half of it; the test packings are sparse). Bisection on the reference path's volume.
+inline std::vector<Pose> deep_poses(const SphereTree& ta, const SphereTree& tb, int count,
+                                    std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  VolumeQuery q({.collect_pairs = false, .reference_kernel = true});
+  const Vec3 ca = centre({ta.root().x, ta.root().y, ta.root().z, 0.f});
+  const Vec3 cb = centre({tb.root().x, tb.root().y, tb.root().z, 0.f});
+  const double reach = static_cast<double>(ta.root().radius + tb.root().radius);
+  std::vector<Pose> out;
+  while (static_cast<int>(out.size()) < count) {
+    const Quat rot = normalized(Quat{g(rng), g(rng), g(rng), g(rng)});
+    const Vec3 dir = normalized(Vec3{g(rng), g(rng), g(rng)});
+    const auto at = [&](double s) { return Pose{rot, ca + s * dir - rotate(rot, cb)}; };
+    const auto volume = [&](double s) { return q.run(ta, tb, at(s)).total_volume; };
+    const double target = 0.5 * volume(0.0);
+    double lo = 0.0, hi = reach;
+    for (int i = 0; i < 30; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (volume(mid) > target ? lo : hi) = mid;
+    }
+    out.push_back(at(lo));
+  }
+  return out;
+}
+
+// Two runs' totals equal, not merely close (the same pairs summed in the same order).
+inline void expect_identical_totals(const VolumeQueryResult& got, const VolumeQueryResult& want) {
+  EXPECT_EQ(got.total_volume, want.total_volume);
+  const Vec3 pairs[3][2] = {{got.weighted_normal_sum, want.weighted_normal_sum},
+                            {got.volume_gradient, want.volume_gradient},
+                            {got.volume_centroid, want.volume_centroid}};
+  for (const auto& [g, w] : pairs) {
+    EXPECT_EQ(g.x, w.x);
+    EXPECT_EQ(g.y, w.y);
+    EXPECT_EQ(g.z, w.z);
+  }
 }
 
 }  // namespace uh::collette::testing

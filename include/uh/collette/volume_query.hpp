@@ -33,7 +33,8 @@ namespace uh::collette {
 
 namespace detail {
 struct LeafBatch;
-}
+struct QueryWorker;
+}  // namespace detail
 
 /// One overlapping leaf pair as the query stores it, in A's mesh frame. 40 bytes.
 struct PairOverlap {
@@ -78,6 +79,22 @@ struct VolumeQueryOptions {
   /// (SSE2, four lanes), which every x86-64 runs. Both give the same results, bit for bit. Builds
   /// for Windows have the baseline kernels only.
   bool use_avx2 = true;
+  /// Share each traversal with a second thread that the query owns (started at construction,
+  /// joined by the destructor; it sleeps between runs): the calling thread runs the first node
+  /// pairs, then both take chunks of the remaining frontier, the caller from the front and the
+  /// worker from the back, and the caller adds the worker's pairs after its own. Same results as
+  /// one thread, bit for bit (pairs in the same order, totals summed in the same order). Pays only
+  /// when a second core is free: if the worker is not running when the caller gets to its chunks,
+  /// the caller takes them all and the run costs what one thread costs. The fast path only (not
+  /// the reference kernel, not runs that keep coherence candidates). The worker keeps up to
+  /// pair_capacity pairs (whether or not collect_pairs); when its chunks find more, the caller runs
+  /// them again itself. Allocates the worker's buffers (40 bytes a pair of pair_capacity) at
+  /// construction; runs stay free of allocation and locks.
+  bool worker_thread = false;
+  /// With worker_thread: the caller takes no chunk until the worker has claimed one, so that the
+  /// worker's part runs in every run (for tests: without it, a worker that a loaded machine does
+  /// not schedule in time leaves every chunk to the caller). Costs the worker's wake-up time.
+  bool worker_claims_first = false;
 };
 
 /// Totals of one VolumeQuery::run, in A's mesh frame. Trivially copyable.
@@ -144,6 +161,9 @@ class VolumeQuery {
   const VolumeQueryOptions& options() const { return options_; }
   /// True when runs take the AVX2 kernels (options().use_avx2 and the CPU has AVX2).
   bool uses_avx2() const { return uses_avx2_; }
+  /// Node-pair chunks that the worker thread ran in the last run (worker_thread only; 0 when the
+  /// calling thread ran them all).
+  int worker_chunks() const { return worker_chunks_; }
 
   /// One entry of the traversal stack: a node pair known to overlap, as traversal ids
   /// (SphereTree::Blocks), with both node spheres, B's already in A's frame (so each B node is
@@ -172,6 +192,8 @@ class VolumeQuery {
   std::vector<PairOverlap> pairs_;
   VolumeQueryResult result_;
   bool uses_avx2_ = false;
+  int worker_chunks_ = 0;
+  std::unique_ptr<detail::QueryWorker> worker_;  // the second thread and its buffers (worker_thread only)
   // coherence: the kept pairs, B's leaves among them (by index) and where they are this run, and
   // the trees and pose of the traversal that kept them
   std::vector<Candidate> candidates_;
