@@ -176,6 +176,9 @@ void add_museum_commands(CLI::App& app, CommandRunner& runner) {
   j->callback([&runner] { runner = [] { return museum_judge(judge); }; });
 
   add_museum_play_command(*museum, runner);
+#ifdef UH_HAS_MUSEUM_STATION
+  add_museum_station_command(*museum, runner);
+#endif
 }
 
 }  // namespace uh::cli

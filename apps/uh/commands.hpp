@@ -20,6 +20,8 @@ void add_query_command(CLI::App& app, CommandRunner& runner);
 void add_run_command(CLI::App& app, CommandRunner& runner);
 void add_serve_command(CLI::App& app, CommandRunner& runner);
 void add_museum_commands(CLI::App& app, CommandRunner& runner);
+/// `uh museum station` (Phantom's station), on `museum`, when the build has sound.
+void add_museum_station_command(CLI::App& museum, CommandRunner& runner);
 
 /// Blocks SIGINT and SIGTERM in the calling thread, before a server's threads start (they inherit
 /// the mask, so no thread is interrupted by them); wait_for_stop_signal() then takes them.

@@ -226,6 +226,20 @@ DelegateSink<const SessionState&> HapticSession::on_haptic_tick(std::size_t tool
   return DelegateSink{rigs_[tool]->tick_event};
 }
 
+DelegateSink<const haptico::DeviceState&, haptico::DeviceCommand&> HapticSession::force_on_haptic_tick(
+    std::size_t tool) {
+  assert(tool < rigs_.size() && "uh::controllers::HapticSession::force_on_haptic_tick(): no such tool");
+  return rigs_[tool]->manager->force_on_haptic_tick();
+}
+
+void HapticSession::halt() {
+  for (auto& rig : rigs_) rig->manager->halt();
+}
+
+void HapticSession::resume() {
+  for (auto& rig : rigs_) rig->manager->resume();
+}
+
 Status HapticSession::begin_run() {
   if (phase_ != Phase::kReady)
     return Error{"HapticSession: a session runs once; create a new one to run again"};

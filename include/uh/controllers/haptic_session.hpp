@@ -209,6 +209,19 @@ class HapticSession {
   /// runs). Delegates must be real-time safe. Bind before start(), from the owner thread.
   DelegateSink<const SessionState&> on_haptic_tick(std::size_t tool = 0);
 
+  /// Binding side of tool `tool`'s ForceOnHapticTick(const DeviceState&, DeviceCommand&): a force
+  /// added to the contact force in the device's frame (e.g. the museum station's home spring), on
+  /// the haptic thread, summed before the tool's limit chain (every limit, the fade and halt() apply
+  /// to it). Delegates must be real-time safe. Bind before start(), from the owner thread.
+  DelegateSink<const haptico::DeviceState&, haptico::DeviceCommand&> force_on_haptic_tick(
+      std::size_t tool = 0);
+
+  /// Sends every device zero force from its next tick on, whatever the controllers ask, until
+  /// resume() (which fades the forces back in). Any thread; real-time safe. The station holds its
+  /// session here while the game server is away or the round is paused.
+  void halt();
+  void resume();
+
   /// Sends zero force at once, stops and joins all threads, and completes the report. Idempotent:
   /// later calls return what the first returned. An error says which thread ended on its own or
   /// what failed (the report is still complete). Without a start(), does nothing. Owner thread.

@@ -1,0 +1,76 @@
+#pragma once
+/// \file
+/// GameLink: Phantom's connection to the museum server, on its own network thread. What the
+/// server says crosses to the station's thread through an SpscQueue (parsed on the network thread);
+/// what the station sends (verdicts) crosses the other way through another. Nothing here ever
+/// waits on the haptic thread, and the haptic thread never waits on it.
+///
+/// After a drop the link says so once and reconnects every `retry_s` (the server resumes a paused
+/// round when Phantom says hello again).
+
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "uh/core/result.hpp"
+#include "uh/museum_station/server_messages.hpp"
+
+namespace uh::museum_station {
+
+struct LinkOptions {
+  /// ws://HOST:PORT/ws, http://HOST:PORT/ (what `uh museum serve` prints) or HOST:PORT.
+  std::string url = "ws://127.0.0.1:7780/ws";
+  std::string token{};     ///< sent in the hello when the server needs one
+  double welcome_s = 5.0;  ///< how long connect() waits for the welcome [s]
+  double retry_s = 1.0;    ///< between reconnection attempts after a drop [s]
+};
+
+/// Something the network thread tells the station.
+struct LinkNote {
+  enum class Kind : std::uint8_t {
+    message,      ///< `message` arrived
+    bad_message,  ///< a frame that did not parse: `text` says why (logged, ignored)
+    dropped,      ///< the connection ended: `text` says why; the link tries again
+    reconnected,  ///< connected again and said hello (a welcome follows)
+  };
+  Kind kind = Kind::message;
+  ServerMessage message{};
+  std::string text{};
+};
+
+class GameLink {
+ public:
+  /// Connects, says hello as Phantom and waits for the welcome. Errors: the URL is not one the
+  /// station understands, the server is unreachable, it refused the hello (a wrong token, Phantom
+  /// already playing), or no welcome came.
+  static Result<std::unique_ptr<GameLink>> connect(const LinkOptions& options);
+  ~GameLink();
+  GameLink(const GameLink&) = delete;
+  GameLink& operator=(const GameLink&) = delete;
+
+  const Welcome& welcome() const { return welcome_; }
+  /// The next note from the network thread; false when none waits. Owner thread.
+  bool poll(LinkNote& out);
+  /// Queues a text frame for the server; false when the queue is full. Owner thread.
+  bool send(std::string text);
+  /// Whether the connection is up now. Any thread.
+  bool connected() const;
+  /// Closes the connection and joins the network thread. Idempotent. Owner thread.
+  void stop();
+
+ private:
+  struct Impl;
+  explicit GameLink(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+  Welcome welcome_{};
+};
+
+/// HOST, PORT and the WebSocket path from a URL as LinkOptions::url takes it; an error names it.
+struct ServerAddress {
+  std::string host;
+  std::string port;
+  std::string path = "/ws";
+};
+Result<ServerAddress> parse_server_url(const std::string& url);
+
+}  // namespace uh::museum_station

@@ -1,0 +1,96 @@
+#pragma once
+/// \file
+/// What the museum server tells Phantom's station (the messages of docs/museum.md, protocol 1),
+/// parsed into plain data. A message that does not parse is an error naming the field; the station
+/// logs it and carries on.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "uh/core/result.hpp"
+#include "uh/museum/level.hpp"
+#include "uh/museum/rules.hpp"
+#include "uh/museum_artifacts/artifact.hpp"
+
+namespace uh::museum_station {
+
+/// An artifact as clients see it: its index in the round and its kind's name.
+struct ItemView {
+  int item = -1;
+  std::string kind{};
+};
+
+/// `welcome`: the level (rooms, cases, the table, the kinds; the rule numbers the station needs).
+struct Welcome {
+  std::string role{};
+  museum::Level level{};
+  std::vector<std::string> targets{};
+};
+
+struct GuardView {
+  museum::Vec2 pos{};
+  museum::Vec2 facing{1.0, 0.0};
+  std::string mode{};
+};
+
+/// `snapshot`: what the station needs of it.
+struct Snapshot {
+  std::int64_t tick = 0;
+  double time_left_s = 0.0;
+  std::string phase{};  ///< waiting, playing, paused or ended
+  museum::Vec2 vive_pos{};
+  museum::Vec2 vive_facing{1.0, 0.0};
+  std::vector<ItemView> carried{};
+  std::vector<GuardView> guards{};
+  std::vector<ItemView> cases{};  ///< per case: what it holds (item -1: nothing)
+  std::vector<ItemView> table{};  ///< in the order Phantom judges them
+  int judged = 0;
+};
+
+/// `event`: the rules' event (a verdict's `correct` is not told during the round).
+struct GameEvent {
+  museum::Event event{};
+};
+
+/// `in_hands` (Phantom only): the artifact that came to the front of the table and which piece it
+/// is, so that the station renders that piece (item -1: the station's own "nothing in hand").
+struct InHand {
+  int item = -1;
+  std::string kind{};
+  museum_artifacts::Piece piece = museum_artifacts::Piece::genuine;
+};
+
+/// `summary`: the end of the round.
+struct Summary {
+  int points = 0;
+  int genuine_kept = 0;
+  int forgeries_kept = 0;
+  int genuine_rejected = 0;
+  int forgeries_rejected = 0;
+  int time_bonus = 0;
+};
+
+/// `error`: a request the server refused.
+struct ServerError {
+  std::string request{};
+  std::string message{};
+};
+
+/// `pong` and anything else the station does not act on.
+struct Ignored {
+  std::string type{};
+};
+
+using ServerMessage = std::variant<Welcome, Snapshot, GameEvent, InHand, Summary, ServerError, Ignored>;
+
+/// Parses one text frame. Errors name the field and what is wrong (the frame is then ignored).
+Result<ServerMessage> parse_server_message(std::string_view text);
+
+/// The JSON text of Phantom's hello and of a verdict.
+std::string hello_text(std::string_view token);
+std::string verdict_text(int item, museum::Verdict verdict);
+
+}  // namespace uh::museum_station
