@@ -12,13 +12,13 @@
 // Deep random poses (BM_DeepRandomPoses, `--benchmark_filter=DeepRandom`): B at kDeepPoses random
 // orientations (fixed seed), each moved along its own random direction until the packings overlap
 // by a quarter of the packing volume (bisection on the exact query's volume). Every iteration runs
-// the volume query and FCL's all-contacts query on the same pose, one after the other (alternating
+// the volume query and FCL's all-contacts query on the same pose, one after the other (rotating
 // which goes first), so both see the same machine load, and the query's reference path
 // (`reference_kernel`: the scalar path before the SIMD kernels) on the same pose; each pose 10 times.
 // Counters: median, p90 and max of both over all poses and repetitions, and the ratio of the medians.
 // Each iteration also runs the query with the baseline kernels (`sse2_median_us`: `use_avx2` off;
 // `avx2` says which the default took) and with its worker thread (`two_threads_*`, and how many of
-// the frontier's chunks the worker ran per query), after the three above.
+// the frontier's chunks the worker ran per query); the five run in a rotating order.
 
 #include <benchmark/benchmark.h>
 
@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -440,7 +441,7 @@ void BM_FclMeshMesh(benchmark::State& state) {
 BENCHMARK(BM_FclMeshMesh)->ArgsProduct({{0, 1}, {1, 0}})->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 
 // The deep random poses: our volume query (pairs + totals) and FCL's all-contacts query on the
-// same pose in each iteration; the manual time is ours.
+// same pose in each iteration (and the other paths of ours); the manual time is ours.
 void BM_DeepRandomPoses(benchmark::State& state) {
   const Scene& s = scene();
   VolumeQuery query;
@@ -494,21 +495,12 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       fcl_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       contacts += static_cast<double>(result.numContacts());
     };
-    if (k % 3 == 0) {
-      run_ours();
-      run_reference();
-      run_fcl();
-    } else if (k % 3 == 1) {
-      run_reference();
-      run_fcl();
-      run_ours();
-    } else {
-      run_fcl();
-      run_ours();
-      run_reference();
-    }
-    run_other(baseline, baseline_times);
-    run_other(shared, shared_times);
+    // all five on the same pose, in an order that rotates, so that each sees the same load and
+    // the same share of caches warmed by the one before
+    const std::function<void()> runs[5] = {run_ours, run_reference, run_fcl,
+                                           [&] { run_other(baseline, baseline_times); },
+                                           [&] { run_other(shared, shared_times); }};
+    for (std::size_t i = 0; i < 5; ++i) runs[(k + i) % 5]();
     worker_chunks += shared.worker_chunks();
     // the fast path (each kernel width, one or two threads) must give exactly the reference path's
     // totals and pairs
