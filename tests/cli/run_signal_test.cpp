@@ -1,6 +1,8 @@
 // `uh run` interrupted as a user interrupts it: SIGINT (Ctrl-C) or SIGTERM sent to the running
 // program, with and without the live view (--view). It must send zero force, print its summary,
-// keep the trace (whose last row is that zero) and exit with 128 + the signal number.
+// keep the trace (whose last row is that zero) and exit with 128 + the signal number; on each
+// hardware driver (its stand-in) and with two devices of different drivers in one session, each
+// device itself is left with zero.
 
 #include <gtest/gtest.h>
 
@@ -12,6 +14,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include "haply_standin.hpp"
 #include "test_paths.hpp"
 
 namespace uh {
@@ -53,6 +57,28 @@ std::string long_scene_json(const fs::path& assets) {
   "watch": ["bunny"]
 }})",
                      assets.string());
+}
+
+// Two hands on two drivers in one session: an OpenHaptics device (the stand-in libHD) and a Haply
+// Inverse3 (the stand-in service at `haply_url`); both handles rest inside the bunny.
+std::string long_two_tool_scene_json(const fs::path& assets, const std::string& haply_url) {
+  return fmt::format(R"({{
+  "name": "signal-test",
+  "rates": {{ "haptic_hz": 1000, "collision_hz": 500 }},
+  "seconds": 60,
+  "objects": [{{ "name": "bunny", "mesh": "{0}/meshes/bunny_npm_3674.obj", "meters_per_unit": 0.01, "spheres": 600,
+                "pose": {{ "position": [0, 0, 0], "rotation": [0.70710678, 0.70710678, 0, 0] }} }}],
+  "tools": [
+    {{ "name": "left", "mesh": "{0}/meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
+      "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "center_of_mass": [0, 0, 0.025], "max_force_n": 3.0 }},
+      "device": {{ "driver": "openhaptics", "config": {{}} }} }},
+    {{ "name": "right", "mesh": "{0}/meshes/stylus.obj", "meters_per_unit": 0.01, "spheres": 150,
+      "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "center_of_mass": [0, 0, 0.025], "max_force_n": 2.0 }},
+      "device": {{ "driver": "haply", "config": {{ "url": "{1}" }} }} }}
+  ],
+  "watch": ["bunny"]
+}})",
+                     assets.string(), haply_url);
 }
 
 // True once process `pid` has a thread named `name` (Linux: /proc/PID/task/*/comm).
@@ -95,12 +121,19 @@ struct Interrupt {
   // uh run --device openhaptics on the stand-in libHD: the tick runs on the library's own servo
   // thread, and the stand-in records what the device was last commanded as uh released it
   bool open_haptics = false;
+  // uh run --device haply against the stand-in Inverse Service (in this process, on its own
+  // thread), which keeps every force it was commanded
+  bool haply = false;
+  // a two-tool scene: openhaptics (stand-in libHD) and haply (stand-in service) in one session;
+  // both devices must be left with zero
+  bool two_devices = false;
 };
 
 // names the case in test output (instead of the struct's bytes)
 void PrintTo(const Interrupt& i, std::ostream* out) {
   *out << (i.signal_number == SIGINT ? "SIGINT" : "SIGTERM") << (i.view ? " with --view" : "")
-       << (i.force_dimension ? " on forcedimension" : "") << (i.open_haptics ? " on openhaptics" : "");
+       << (i.force_dimension ? " on forcedimension" : "") << (i.open_haptics ? " on openhaptics" : "")
+       << (i.haply ? " on haply" : "") << (i.two_devices ? " on openhaptics and haply at once" : "");
 }
 
 class RunSignalTest : public ::testing::TestWithParam<Interrupt> {};
@@ -109,18 +142,29 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   const int signal_number = GetParam().signal_number;
   const bool view = GetParam().view;
   const bool force_dimension = GetParam().force_dimension;
-  const bool open_haptics = GetParam().open_haptics;
+  const bool haply = GetParam().haply;
+  const bool two_devices = GetParam().two_devices;
+  // the stand-in libHD serves the one-device openhaptics case and the two-device scene's left hand
+  const bool open_haptics = GetParam().open_haptics || two_devices;
   const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
   const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}{}", ::getpid(),
                                                                signal_number, view ? "_view" : "",
                                                                force_dimension ? "_dhd"
+                                                               : two_devices   ? "_hd_haply"
                                                                : open_haptics  ? "_hd"
+                                                               : haply         ? "_haply"
                                                                                : "");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.json", trace = dir / "trace.csv", out = dir / "stdout.txt",
                  err = dir / "stderr.txt", hd_record = dir / "hd_release.txt";
-  std::ofstream(scene) << long_scene_json(fs::path(UH_TEST_DATA_DIR));
+  // the stand-in service runs before fork(): the child inherits none of its thread, only execs
+  std::unique_ptr<devices::testing::HaplyStandinService> haply_service;
+  if (haply || two_devices) haply_service = std::make_unique<devices::testing::HaplyStandinService>();
+  if (two_devices)
+    std::ofstream(scene) << long_two_tool_scene_json(fs::path(UH_TEST_DATA_DIR), haply_service->url());
+  else
+    std::ofstream(scene) << long_scene_json(fs::path(UH_TEST_DATA_DIR));
 
   // everything the child needs is prepared before fork(): it only redirects and execs
   const std::string cache_env = "UH_CACHE_DIR=" + (dir / "cache").string();
@@ -128,7 +172,8 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
                                    "--trace",   trace.string(), "--no-realtime"};
   if (view) args.insert(args.end(), {"--view", "--port", "0"});
   if (force_dimension) args.insert(args.end(), {"--device", "forcedimension:0"});
-  if (open_haptics) args.insert(args.end(), {"--device", "openhaptics"});
+  if (open_haptics && !two_devices) args.insert(args.end(), {"--device", "openhaptics"});
+  if (haply) args.insert(args.end(), {"--device", "haply"});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -138,11 +183,12 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
     env_storage.push_back(std::string("UH_OPENHAPTICS_LIBRARY=") + UH_STANDIN_HD);
     env_storage.push_back("UH_STANDIN_HD_RECORD=" + hd_record.string());
   }
+  if (haply) env_storage.push_back("UH_HAPLY_URL=" + haply_service->url());
   for (char** e = environ; *e != nullptr; ++e) {
     const std::string entry(*e);
     if (entry.rfind("UH_CACHE_DIR=", 0) != 0 && entry.rfind("CI=", 0) != 0 &&
         entry.rfind("UH_FORCEDIMENSION_LIBRARY=", 0) != 0 && entry.rfind("UH_OPENHAPTICS_LIBRARY=", 0) != 0 &&
-        entry.rfind("UH_STANDIN_HD_RECORD=", 0) != 0)
+        entry.rfind("UH_STANDIN_HD_RECORD=", 0) != 0 && entry.rfind("UH_HAPLY_URL=", 0) != 0)
       env_storage.push_back(entry);
   }
   std::vector<char*> envp;
@@ -161,9 +207,12 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   }
 
   // running: the haptic thread exists (the handlers are in place before it starts; on openhaptics
-  // the haptic tick runs on HD's servo thread, the collision thread starts with it); then some
-  // ticks in contact, so that there is a force to take away
+  // the haptic tick runs on HD's servo thread, the collision thread starts with it; with two
+  // devices, haply's loop runs beside it on its own thread); then some ticks in contact, so that
+  // there is a force to take away
   const auto running = [&] {
+    if (two_devices)
+      return has_thread(pid, "uh-collision") && has_thread(pid, "hd-servo") && has_thread(pid, "uh-haptic");
     return open_haptics ? has_thread(pid, "uh-collision") && has_thread(pid, "hd-servo")
                         : has_thread(pid, "uh-haptic");
   };
@@ -249,6 +298,17 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
     EXPECT_EQ(force_output, 0);
     EXPECT_GT(largest, 0.1) << "the device rendered the contact force before the signal";
   }
+  if (haply_service) {
+    // what the Inverse3 was last commanded: zero, after contact forces
+    const std::vector<Vec3> received = haply_service->received();
+    ASSERT_FALSE(received.empty()) << stderr_text;
+    double largest = 0.0;
+    for (const Vec3& f : received) largest = std::max(largest, norm(f));
+    EXPECT_GT(largest, 0.1) << "the Inverse3 rendered the contact force before the signal";
+    EXPECT_EQ(received.back().x, 0.0);
+    EXPECT_EQ(received.back().y, 0.0);
+    EXPECT_EQ(received.back().z, 0.0);
+  }
   fs::remove_all(dir);
 }
 
@@ -257,12 +317,17 @@ INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest,
                                            Interrupt{SIGINT, true}, Interrupt{SIGTERM, true},
                                            Interrupt{SIGINT, false, true}, Interrupt{SIGTERM, false, true},
                                            Interrupt{SIGINT, false, false, true},
-                                           Interrupt{SIGTERM, false, false, true}),
+                                           Interrupt{SIGTERM, false, false, true},
+                                           Interrupt{SIGINT, false, false, false, true},
+                                           Interrupt{SIGTERM, false, false, false, true},
+                                           Interrupt{SIGINT, false, false, false, false, true},
+                                           Interrupt{SIGTERM, false, false, false, false, true}),
                          [](const ::testing::TestParamInfo<Interrupt>& p) {
                            return std::string(p.param.signal_number == SIGINT ? "Sigint" : "Sigterm") +
                                   (p.param.view ? "WithView" : "") +
                                   (p.param.force_dimension ? "OnForceDimension" : "") +
-                                  (p.param.open_haptics ? "OnOpenHaptics" : "");
+                                  (p.param.open_haptics ? "OnOpenHaptics" : "") + (p.param.haply ? "OnHaply" : "") +
+                                  (p.param.two_devices ? "OnTwoDevices" : "");
                          });
 
 }  // namespace
