@@ -66,6 +66,7 @@ int explore(const ExploreArgs& args) {
       objects.push_back(
           {{"name", o.object},
            {"stiffness_n_per_mm", optional_number(e.stiffness_n_per_mm)},
+           {"stiffness_per_press_n_per_mm", e.stiffness_per_press_n_per_mm},
            {"friction_static", optional_number(e.friction_static)},
            {"friction_dynamic", optional_number(e.friction_dynamic)},
            {"texture_period_m", optional_number(e.texture_period_m)},

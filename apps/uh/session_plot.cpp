@@ -191,7 +191,22 @@ Status write_exploration_plot(const std::string& scene,
   std::vector<Panel> panels;
   double t_max = 0.0;
   for (const auto& o : objects) {
-    // the strokes and the contour, back to back (the presses and taps between them left out)
+    // the first press and its release (the force against time at the press's constant speed is
+    // the force against depth: the stiffness), then the strokes and the contour, back to back
+    // (the other presses, the moves and the taps between them left out)
+    std::vector<double> t_press, pressed;
+    bool pressing = false;
+    for (const auto& s : o.trace.samples) {
+      const bool first = (s.phase == controllers::ExplorePhase::kPress && s.leg <= 0) ||
+                         (pressing && s.phase == controllers::ExplorePhase::kRelease);
+      if (!first && pressing) break;
+      pressing = pressing || first;
+      if (!first) continue;
+      t_press.push_back(s.time_s);
+      pressed.push_back(norm(s.force));
+    }
+    for (double& x : t_press) x -= t_press.front();
+    const double press_end = t_press.empty() ? 0.0 : t_press.back() + 0.2;
     std::vector<double> t, normal, friction;
     double last = -1.0, shift = 0.0;
     for (const auto& f : controllers::stroke_forces(o.trace)) {
@@ -202,7 +217,7 @@ Status write_exploration_plot(const std::string& scene,
       friction.push_back(std::max(0.0, f.tangential_n));
     }
     if (!t.empty()) {
-      const double t0 = t.front();
+      const double t0 = t.front() - press_end;
       for (double& x : t) x -= t0;
       t_max = std::max(t_max, t.back());
     }
@@ -215,9 +230,10 @@ Status write_exploration_plot(const std::string& scene,
                         e.friction_dynamic ? fmt::format("{:.2f}", *e.friction_dynamic) : "none",
                         e.texture_period_m ? fmt::format("{:.2f} mm", *e.texture_period_m * 1e3) : "none"),
         .unit = "force [N]",
-        .series = {decimate(t, normal), decimate(t, friction)},
-        .colours = {{0.80, 0.20, 0.15}, {0.15, 0.35, 0.75}},
-        .labels = {"normal force", "friction (against the motion)"}});
+        .series = {decimate(t_press, pressed), decimate(t, normal), decimate(t, friction)},
+        .colours = {{0.20, 0.60, 0.25}, {0.80, 0.20, 0.15}, {0.15, 0.35, 0.75}},
+        .labels = {fmt::format("press and release at {:.0f} mm/s", o.trace.options.press_speed_m_per_s * 1e3),
+                   "normal force while stroking", "friction (against the motion)"}});
   }
   if (panels.empty()) return Error{fmt::format("{}: nothing was explored to plot", png.string())};
   return write_panels(panels, t_max, png);

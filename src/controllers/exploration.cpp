@@ -15,6 +15,9 @@ namespace {
 
 constexpr double kTouchN = 0.05;      // a force above this means contact [N]
 constexpr double kFreeN = 0.02;       // below this the tool is free [N]
+// a press begins at the first force felt at all: its depth is counted from the surface whatever
+// the stiffness (at kTouchN a soft surface would already be further in than a stiff one)
+constexpr double kFirstContactN = 1e-4;
 constexpr double kForceGain = 0.015;  // normal force loop: speed per newton of error [m / (N s)]
 constexpr double kNormalTauS = 0.02;  // low-pass of the normal estimate [s]
 constexpr double kHoldS = 0.3;        // rest between strokes [s]
@@ -24,6 +27,7 @@ constexpr double kPlaneWaveShare = 0.45;
 // an axis whose strokes ripple less than this share of the other's may see the texture's slow component only
 constexpr double kSlowAxisRipple = 0.6;
 constexpr double kApproachSpeed = 0.01;  // [m/s]
+constexpr double kMoveSpeed = 0.03;      // in the air between presses and strokes [m/s]
 
 // Where the hand starts, which way it goes in and how the strokes are turned (planned from the
 // geometry before the run)
@@ -100,24 +104,46 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
     switch (phase_) {
       case ExplorePhase::kApproach:
         v = kApproachSpeed * plan_.approach;
-        if (touching > kTouchN) {
+        if (touching >
+            (after_approach_ == ExplorePhase::kPress && options_.press_depth_m ? kFirstContactN : kTouchN)) {
           touched_ = true;
           normal_ = normalized(f);
-          begin(ExplorePhase::kPress, t);
+          touch_ = position_;
+          begin(after_approach_, t);
         } else if (travelled_m_ > 0.03) {
           begin(ExplorePhase::kReturn, t);  // nothing there
         }
         break;
       case ExplorePhase::kPress:
         update_normal(f, {}, dt);
+        leg_ = press_;
         v = -options_.press_speed_m_per_s * normal_;
-        if (dot(f, normal_) >= options_.press_force_n || in_phase > 5.0) begin(ExplorePhase::kRelease, t);
+        if (dot(f, normal_) >= options_.press_force_n || in_phase > 5.0 ||
+            (options_.press_depth_m && dot(touch_ - position_, normal_) >= *options_.press_depth_m)) {
+          leg_ = -1;
+          begin(ExplorePhase::kRelease, t);
+        }
         break;
       case ExplorePhase::kRelease:
         v = options_.press_speed_m_per_s * normal_;
-        if (touching < kFreeN) begin(ExplorePhase::kSeat, t);
+        if (touching < kFreeN) next_after_release(t);
         if (in_phase > 5.0) begin(ExplorePhase::kReturn, t);
         break;
+      case ExplorePhase::kMove: {
+        // up to the level of the target first (never across the object), then across to it
+        const Vec3 to = move_to_ - position_;
+        const double below = -dot(to, plan_.approach);
+        if (below > 1e-9) {
+          v = -kMoveSpeed * plan_.approach;
+        } else if (norm(to) <= kMoveSpeed * dt) {
+          v = to / dt;
+          begin(ExplorePhase::kApproach, t);
+        } else {
+          v = to * (kMoveSpeed / norm(to));
+        }
+        if (in_phase > 5.0) begin(ExplorePhase::kReturn, t);
+        break;
+      }
       case ExplorePhase::kSeat:
         update_normal(f, {}, dt);
         v = -options_.press_speed_m_per_s * normal_;
@@ -237,6 +263,44 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
     free_m_ += norm(step);
   }
 
+  // where the hand goes after it came free: the next press, the start of the next pair of strokes,
+  // back to the site for the contour, or it sits down again where it is
+  void next_after_release(double t) {
+    const auto move = [&](const Vec3& to, ExplorePhase then) {
+      move_to_ = to;
+      after_approach_ = then;
+      begin(ExplorePhase::kMove, t);
+    };
+    const int legs = std::min(options_.stroke_legs, 4);
+    const bool through = options_.strokes_through_site;
+    if (after_approach_ == ExplorePhase::kPress) {  // a press ended
+      if (++press_ < options_.presses) {
+        const double angle = kPi / 4.0 + kPi / 2.0 * (press_ - 1);
+        move(plan_.start + options_.press_spread_m *
+                               (std::cos(angle) * plan_.axes[0] + std::sin(angle) * plan_.axes[1]),
+             ExplorePhase::kPress);
+      } else if (through && legs > 0) {
+        move(stroke_start(0), ExplorePhase::kSeat);
+      } else if (options_.presses > 1) {
+        move(plan_.start, ExplorePhase::kSeat);
+      } else {
+        after_approach_ = ExplorePhase::kSeat;
+        begin(ExplorePhase::kSeat, t);
+      }
+      return;
+    }
+    if (through && next_leg_ > 0 && next_leg_ % 2 == 0) {  // a pair of strokes ended
+      move(next_leg_ < legs ? stroke_start(next_leg_) : plan_.start, ExplorePhase::kSeat);
+      return;
+    }
+    begin(ExplorePhase::kSeat, t);
+  }
+
+  // half a stroke before the site along the pair's axis (strokes_through_site)
+  Vec3 stroke_start(std::int32_t leg) const {
+    return plan_.start - 0.5 * leg_length(options_, leg) * plan_.axes[leg / 2];
+  }
+
   ExploreOptions options_;
   ExplorePlan plan_;
   std::vector<ExploreSample> trace_;
@@ -257,6 +321,10 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
   int tap_ = 0;
   bool tap_in_ = true;
   bool touched_ = false;
+  int press_ = 0;                                       // which press (the site's is 0)
+  ExplorePhase after_approach_ = ExplorePhase::kPress;  // what a touch on the way in starts
+  Vec3 move_to_{};                                      // where kMove goes
+  Vec3 touch_{};                                        // where the press began
 };
 
 // splitmix64 for the seed's choices (the same run on every platform)
@@ -698,24 +766,52 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
   const ExploreOptions& o = trace.options;
   const auto& x = trace.samples;
 
-  // stiffness: normal force against depth while pressing in, between 10 % and 95 % of the press
-  // force, fitted with F = c0 + c1 s + c2 s^2 (a round contact stiffens or softens with depth:
-  // a ball on a plane is exactly quadratic, k pi (2 r d - d^2)); the stiffness reported is the
-  // slope where the fit reaches zero force, at first touch: for a round tip 2 pi r k
+  // stiffness: per press, normal force against depth while pressing in, fitted with
+  // F = c0 + c1 s + c2 s^2 (a round contact stiffens or softens with depth: a ball on a plane is
+  // exactly quadratic, k pi (2 r d - d^2)); the press's stiffness is the slope where the fit
+  // reaches zero force, at first touch: for a round tip 2 pi r k. The fit takes the depths from 15 %
+  // to 95 % of the press's (a press to a depth: the same depths for every material) or the forces
+  // from 10 % to 95 % of the press force (a press to a force). The estimate is the presses' median
+  // (each also reads the packing's grain under the tip)
   {
-    Vec3 sum{};
+    std::int32_t presses = 0;
     for (const auto& s : x)
-      if (s.phase == ExplorePhase::kPress && norm(s.force) > 0.2 * o.press_force_n) sum += s.force;
-    const Vec3 n = normalized(sum);
-    std::vector<double> depth, force;
-    for (const auto& s : x) {
-      if (s.phase != ExplorePhase::kPress) continue;
-      const double fn = dot(s.force, n);
-      if (fn < 0.1 * o.press_force_n || fn > 0.95 * o.press_force_n) continue;
-      depth.push_back(-dot(s.position, n));
-      force.push_back(fn);
+      if (s.phase == ExplorePhase::kPress) presses = std::max(presses, s.leg + 1);
+    for (std::int32_t press = 0; press < std::max(presses, 1); ++press) {
+      const auto in_press = [&](const ExploreSample& s) {
+        return s.phase == ExplorePhase::kPress && (presses == 0 || s.leg == press);
+      };
+      Vec3 sum{};
+      double f_max = 0.0;
+      for (const auto& s : x)
+        if (in_press(s)) f_max = std::max(f_max, norm(s.force));
+      for (const auto& s : x)
+        if (in_press(s) && norm(s.force) > 0.2 * f_max) sum += s.force;
+      const Vec3 n = normalized(sum);
+      double first = 0.0, deepest = -1e300;
+      bool any = false;
+      for (const auto& s : x)
+        if (in_press(s)) {
+          const double d = -dot(s.position, n);
+          if (!any) first = d;
+          any = true;
+          deepest = std::max(deepest, d);
+        }
+      const double reach = deepest - first;
+      std::vector<double> depth, force;
+      for (const auto& s : x) {
+        if (!in_press(s)) continue;
+        const double fn = dot(s.force, n), d = -dot(s.position, n);
+        const bool in_band = o.press_depth_m ? d - first >= 0.15 * reach && d - first <= 0.95 * reach
+                                             : fn >= 0.1 * o.press_force_n && fn <= 0.95 * o.press_force_n;
+        if (!in_band || fn < 2.0 * kTouchN) continue;
+        depth.push_back(d);
+        force.push_back(fn);
+      }
+      if (depth.size() >= 10) e.stiffness_per_press_n_per_mm.push_back(touch_slope(depth, force) * 1e-3);
     }
-    if (depth.size() >= 10) e.stiffness_n_per_mm = touch_slope(depth, force) * 1e-3;
+    if (!e.stiffness_per_press_n_per_mm.empty())
+      e.stiffness_n_per_mm = median(e.stiffness_per_press_n_per_mm);
   }
 
   // friction: per stroke, the largest ratio before a third of the stroke (breakaway) and the
@@ -729,13 +825,20 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     legs[leg] = slide_of(trace, idx);
     const Slide& s = legs[leg];
     if (s.travel.empty()) continue;
+    // the breakaway: the largest force against the motion over the first third, over the median
+    // force across it there (a texture ripples the force across the motion, not the friction the
+    // stick point holds: a tick's own ratio would read the ripple's troughs)
+    const double length = leg_length(o, leg);
     double peak = -1e300;
-    std::vector<double> slid;
-    for (std::size_t j = 0; j < s.travel.size(); ++j) {
-      const double length = leg_length(o, leg);
-      if (s.travel[j] < length / 3.0) peak = std::max(peak, s.friction_ratio[j]);
+    std::vector<double> across, slid;
+    for (std::size_t j = 0; j < s.travel.size(); ++j)
+      if (s.travel[j] < length / 3.0) {
+        peak = std::max(peak, s.friction_ratio[j] * s.normal_n[j]);
+        across.push_back(s.normal_n[j]);
+      }
+    if (!across.empty()) peak /= median(across);
+    for (std::size_t j = 0; j < s.travel.size(); ++j)
       if (s.travel[j] > 0.5 * length && s.travel[j] < 0.95 * length) slid.push_back(s.friction_ratio[j]);
-    }
     if (peak > -1e300) breakaway.push_back(peak);
     if (!slid.empty()) sliding.push_back(median(slid));
   }

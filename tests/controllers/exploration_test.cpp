@@ -32,17 +32,26 @@ double normal_force(const Synthetic& m, const ExploreOptions& o, const Vec3& p) 
   return o.stroke_force_n + m.ripple * std::sin(2 * kPi * dot(m.grating, p) / m.period);
 }
 
+// a ball pressed into a plane, F = k pi (2 r d - d^2) (the surface at z = `surface`, first touch
+// at d = 0), labelled as press `press` (-1: unnumbered, as one press alone)
+void add_press(ExploreTrace& trace, double& t, double k, double r, double surface, std::int32_t press) {
+  const ExploreOptions& o = trace.options;
+  const double dt = 0.001;
+  for (double d = -0.0005;; d += o.press_speed_m_per_s * dt) {
+    const double f = d > 0.0 ? k * kPi * (2 * r * d - d * d) : 0.0;
+    trace.samples.push_back({t += dt, {0, 0, surface + r - d}, {0, 0, f}, ExplorePhase::kPress, press});
+    if (f >= o.press_force_n || d >= o.press_depth_m.value_or(r)) break;  // as the hand does
+  }
+  for (int i = 0; i < 10; ++i)
+    trace.samples.push_back({t += dt, {0, 0, surface + r}, {}, ExplorePhase::kRelease, -1});
+}
+
 ExploreTrace synthetic_trace(const Synthetic& m) {
   ExploreTrace trace;
   const ExploreOptions& o = trace.options;
   double t = 0.0;
   const double dt = 0.001;
-  // press: a ball into a plane, F = k pi (2 r d - d^2) (the surface at z = 0, first touch at d = 0)
-  for (double d = -0.0005;; d += o.press_speed_m_per_s * dt) {
-    const double f = d > 0.0 ? m.k * kPi * (2 * m.r * d - d * d) : 0.0;
-    trace.samples.push_back({t += dt, {0, 0, m.r - d}, {0, 0, f}, ExplorePhase::kPress, -1});
-    if (f >= o.press_force_n) break;
-  }
+  add_press(trace, t, m.k, m.r, 0.0, -1);
   trace.stroke_axes[0] = {1, 0, 0};
   trace.stroke_axes[1] = {0, 1, 0};
   // strokes at the stroke force with a grating ripple; friction loads a stick spring up to
@@ -86,6 +95,25 @@ TEST(Exploration, EstimatorsReadBackATextbookTrace) {
   EXPECT_NEAR(e.period_axis_m[0], m.period / std::cos(0.4), 0.02 * m.period / std::cos(0.4));
   EXPECT_NEAR(e.period_axis_m[1], m.period / std::sin(0.4), 0.03 * m.period / std::sin(0.4));
   EXPECT_NEAR(e.texture_ripple_n, m.ripple / std::sqrt(2.0), 0.1 * m.ripple / std::sqrt(2.0));
+}
+
+// Several presses (each at its own spot, on surfaces at different heights): each press's own
+// stiffness, and their median, so that one press on an unusual spot (a packing's grain under the
+// tip) does not move the estimate
+TEST(Exploration, TheStiffnessIsTheMedianOfThePresses) {
+  const double r = 0.01;
+  const double k[] = {3e4, 2.9e4, 4.5e4, 3.1e4, 1.5e4};  // N/m^2; median 3e4
+  ExploreTrace trace;
+  double t = 0.0;
+  for (std::int32_t press = 0; press < 5; ++press) add_press(trace, t, k[press], r, 0.001 * press, press);
+  const MaterialEstimate e = estimate_material(trace);
+  ASSERT_EQ(e.stiffness_per_press_n_per_mm.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i)
+    EXPECT_NEAR(e.stiffness_per_press_n_per_mm[i], 2 * kPi * r * k[i] * 1e-3,
+                0.005 * 2 * kPi * r * k[i] * 1e-3)
+        << "press " << i;
+  ASSERT_TRUE(e.stiffness_n_per_mm.has_value());
+  EXPECT_NEAR(*e.stiffness_n_per_mm, 2 * kPi * r * 3e4 * 1e-3, 0.005 * 2 * kPi * r * 3e4 * 1e-3);
 }
 
 TEST(Exploration, ASmoothFrictionlessTraceHasNoFrictionAndNoPeriod) {

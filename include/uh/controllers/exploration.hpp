@@ -43,8 +43,18 @@ enum class ContourPath : std::uint8_t {
 /// Settings of the exploration script (options aggregate).
 struct ExploreOptions {
   ExploreSite site{};
-  double press_force_n = 3.0;          ///< press to this normal force, then release [N]
+  /// Press this far past the first touch, then release [m]: every material is read over the same
+  /// depths, so the packing's fill under the surface (which grows with depth under a packed face)
+  /// scales every stiffness alike. Empty: press to `press_force_n` instead.
+  std::optional<double> press_depth_m = 0.0025;
+  double press_force_n = 7.0;  ///< press to this normal force (a press to a depth stops there too) [N]
   double press_speed_m_per_s = 0.004;  ///< speed of the press and release [m/s]
+  /// How many presses: the first at the site, the others round it, `press_spread_m` away on the
+  /// diagonals between the stroke axes, the hand moving between them in the air. A press reads the
+  /// packing's grain under the tip as well as the material (a few percent from spot to spot on a
+  /// packed face): the stiffness is the median of the presses'.
+  int presses = 5;
+  double press_spread_m = 0.008;       ///< how far from the site the other presses are [m]
   double stroke_force_n = 2.0;         ///< normal force held while stroking [N]
   double stroke_speed_m_per_s = 0.02;  ///< stroke speed [m/s]
   double stroke_length_m = 0.024;      ///< length of each stroke [m]
@@ -54,6 +64,11 @@ struct ExploreOptions {
   /// edge, as a finger stops at a rim) [rad]; strokes go their whole length when empty.
   std::optional<double> stroke_stops_at_edge_rad;
   int stroke_legs = 4;  ///< how many of the four strokes (+e1, -e1, +e2, -e2) to make, in that order
+  /// Each axis's strokes run through the site: the hand moves in the air to half a stroke before it
+  /// and strokes across and back, so that on a round object they cross its top rather than run down
+  /// one flank; the contour is then made at the site again. Off: each stroke starts where the last
+  /// ended, the first at the site.
+  bool strokes_through_site = true;
   /// The stroke axes: top sites turn e1 = +x by this about the vertical (the seed's turn when
   /// empty); side sites stroke along e1 = up and e2 = the level tangent.
   std::optional<double> stroke_turn_rad;
@@ -83,7 +98,8 @@ enum class ExplorePhase : std::uint8_t {
   kLift,
   kTap,
   kReturn,
-  kDone
+  kDone,
+  kMove,  ///< in the air to the next press or stroke (up to the start's level, then across)
 };
 
 /// One haptic tick of an exploration: the device position and the force commanded (world frame,
@@ -93,7 +109,8 @@ struct ExploreSample {
   Vec3 position{};  ///< handle position [m]
   Vec3 force{};     ///< force commanded to the device [N]
   ExplorePhase phase = ExplorePhase::kApproach;
-  std::int32_t leg = -1;  ///< which stroke (0..3: +e1, -e1, +e2, -e2), -1 outside the strokes
+  /// which stroke (0..3: +e1, -e1, +e2, -e2) or, while pressing, which press (0..); -1 otherwise
+  std::int32_t leg = -1;
 };
 
 struct ExploreTrace {
@@ -106,7 +123,9 @@ struct ExploreTrace {
 /// What the estimators found on one object. Optional fields are empty when the trace holds no
 /// evidence (no contact, no significant ripple).
 struct MaterialEstimate {
-  std::optional<double> stiffness_n_per_mm;  ///< slope of normal force against depth while pressing
+  /// slope of normal force against depth at first touch, the median of the presses'
+  std::optional<double> stiffness_n_per_mm;
+  std::vector<double> stiffness_per_press_n_per_mm;  ///< each press's slope, in the order pressed
   std::optional<double> friction_static;     ///< tangential over normal force at breakaway
   std::optional<double> friction_dynamic;    ///< tangential over normal force while sliding
   std::optional<double> texture_period_m;    ///< dominant spatial period of the normal force ripple
