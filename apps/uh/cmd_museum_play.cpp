@@ -276,11 +276,21 @@ struct BlindVerdict {
   double simulated_s = 0.0;
 };
 
-// Plays Phantom with the blind bot: each piece that comes into its hands (in_hands) is put under
-// a simulated device, explored and judged against the genuine reference of its kind (explored
-// twice the first time the kind comes up); only the device's trace decides.
-Status play_phantom(Link& link, const json& welcome, std::uint64_t seed, std::vector<BlindVerdict>& verdicts,
-                    std::mutex& verdicts_mutex) {
+// Plays Phantom with the blind bot: first it explores the genuine reference of each target twice;
+// then each piece that comes into its hands (in_hands) is put under a simulated device, explored
+// and judged against the reference of its kind; only the device's trace decides.
+Status play_phantom(const std::string& host, std::uint16_t port, std::uint64_t seed,
+                    std::vector<BlindVerdict>& verdicts, std::mutex& verdicts_mutex, bool announce) {
+  // first a look at the round as a watcher: which targets to study
+  json welcome;
+  {
+    auto watcher = Link::open(host, port);
+    if (!watcher) return watcher.error();
+    auto w = (*watcher)->hello("watcher");
+    if (!w) return w.error();
+    welcome = std::move(*w);
+    (*watcher)->close();
+  }
   using museum_artifacts::Piece;
   const museum::Difficulty difficulty = welcome.at("level").value("difficulty", "") == "hard"
                                             ? museum::Difficulty::hard
@@ -306,6 +316,29 @@ Status play_phantom(Link& link, const json& welcome, std::uint64_t seed, std::ve
   };
   // the genuine reference of each kind, explored twice
   std::map<std::string, std::pair<museum_players::PieceSurvey, museum_players::PieceSurvey>> references;
+  const auto study = [&](museum_artifacts::ArtifactKind kind) -> Status {
+    const std::string name = museum_artifacts::to_string(kind);
+    if (references.contains(name)) return Ok{};
+    auto reference = explore(kind, Piece::genuine, false);
+    if (!reference) return reference.error();
+    auto again = explore(kind, Piece::genuine, true);
+    if (!again) return again.error();
+    references.emplace(name, std::pair{std::move(*reference), std::move(*again)});
+    return Ok{};
+  };
+  // Phantom studies the genuine pieces of Falcon's targets before taking its seat: the round
+  // starts when it says hello as Phantom (the game clock does not run meanwhile)
+  for (const json& target : welcome.at("targets"))
+    if (const auto kind = museum_artifacts::artifact_kind(target.get<std::string>()))
+      if (const Status studied = study(*kind); !studied) return studied;
+  auto opened = Link::open(host, port);
+  if (!opened) return opened.error();
+  Link& link = **opened;
+  if (auto w = link.hello("phantom"); !w) return w.error();
+  if (announce) {
+    std::printf("uh museum play: Phantom is at the table\n");
+    std::fflush(stdout);
+  }
   for (;;) {
     const auto m = link.read();
     if (!m) return Ok{};
@@ -316,13 +349,7 @@ Status play_phantom(Link& link, const json& welcome, std::uint64_t seed, std::ve
     const std::string kind_name = m->at("kind").get<std::string>();
     const auto kind = museum_artifacts::artifact_kind(kind_name);
     if (!kind) return Error{fmt::format("the server handed Phantom a '{}', which is no artifact kind", kind_name)};
-    if (!references.contains(kind_name)) {
-      auto reference = explore(*kind, Piece::genuine, false);
-      if (!reference) return reference.error();
-      auto again = explore(*kind, Piece::genuine, true);
-      if (!again) return again.error();
-      references.emplace(kind_name, std::pair{std::move(*reference), std::move(*again)});
-    }
+    if (const Status studied = study(*kind); !studied) return studied;
     // the piece under the device: the server says which (as the station loads it); the bot's
     // verdict reads only the trace of exploring it
     auto survey = explore(*kind, m->value("piece", "") == "genuine" ? Piece::genuine : Piece::forgery, true);
@@ -336,6 +363,19 @@ Status play_phantom(Link& link, const json& welcome, std::uint64_t seed, std::ve
     const std::lock_guard lock(verdicts_mutex);
     verdicts.push_back(std::move(v));
   }
+}
+
+// One bot's round on the server at host:port.
+Status play_bot(const std::string& role, const std::string& host, std::uint16_t port, std::uint64_t seed,
+                std::vector<BlindVerdict>& verdicts, std::mutex& verdicts_mutex, bool announce) {
+  if (role == "phantom") return play_phantom(host, port, seed, verdicts, verdicts_mutex, announce);
+  auto link = Link::open(host, port);
+  if (!link) return link.error();
+  auto welcome = (*link)->hello(role);
+  if (!welcome) return welcome.error();
+  Status played = play_vive(**link, *welcome);
+  (*link)->close();
+  return played;
 }
 
 struct MuseumPlayArgs {
@@ -399,18 +439,11 @@ int museum_play_one(const MuseumPlayArgs& args) {
   const auto [host, port] = split_server(args.server);
   if (port <= 0 || port > 65535)
     return fail(fmt::format("--server '{}': expected ws://HOST:PORT/ws or http://HOST:PORT/", args.server));
-  auto link = Link::open(host, static_cast<std::uint16_t>(port));
-  if (!link) return fail(link.error().message);
-  auto welcome = (*link)->hello(args.bot);
-  if (!welcome) return fail(welcome.error().message);
-  std::printf("uh museum play: the %s bot joined %s (seed %llu)\n", args.bot.c_str(), args.server.c_str(),
-              static_cast<unsigned long long>(welcome->value("seed", std::uint64_t{0})));
+  std::printf("uh museum play: the %s bot joins %s\n", args.bot.c_str(), args.server.c_str());
   std::fflush(stdout);
   std::vector<BlindVerdict> verdicts;
   std::mutex verdicts_mutex;
-  const Status played = args.bot == "vive" ? play_vive(**link, *welcome)
-                                           : play_phantom(**link, *welcome, args.seed, verdicts, verdicts_mutex);
-  (*link)->close();
+  const Status played = play_bot(args.bot, host, static_cast<std::uint16_t>(port), args.seed, verdicts, verdicts_mutex, true);
   if (!played) return fail(played.error().message);
   for (const BlindVerdict& v : verdicts)
     std::printf("uh museum play: judged the %s (item %d): %s\n", v.kind.c_str(), v.item,
@@ -463,15 +496,7 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   std::mutex failure_mutex;
   std::string failure;  // the first bot's error
   const auto run_bot = [&](const std::string& role) {
-    Status played = [&]() -> Status {
-      auto link = Link::open("127.0.0.1", port);
-      if (!link) return link.error();
-      auto w = (*link)->hello(role);
-      if (!w) return w.error();
-      Status s = role == "vive" ? play_vive(**link, *w) : play_phantom(**link, *w, args.seed, verdicts, verdicts_mutex);
-      (*link)->close();
-      return s;
-    }();
+    const Status played = play_bot(role, "127.0.0.1", port, args.seed, verdicts, verdicts_mutex, !args.json);
     if (!played) {
       {
         const std::lock_guard lock(failure_mutex);

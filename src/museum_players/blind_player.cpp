@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <numeric>
 
@@ -276,12 +277,23 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
 namespace {
 
 constexpr double kSurfaceFloorM = 0.0003;    // a surface difference under 0.3 mm is not told apart
-constexpr double kStiffnessFloor = 0.15;     // nor stiffness under 15 % (the least a hand tells apart)
+// nor stiffness under 25 % (a hand's Weber fraction for stiffness is about 23 %, Jones and Hunter 1990;
+// a pad press also reads the packing's grain under it)
+constexpr double kStiffnessFloor = 0.25;
 constexpr double kFrictionFloor = 0.10;      // nor friction under 10 % (half of what a hand tells apart)
 constexpr double kNoiseMargin = 2.0;         // a difference must exceed twice the reference's own spread
 constexpr double kShiftSearchM = 0.003;      // strokes: the piece may sit up to 3 mm off the reference
 constexpr std::size_t kStrokeSmoothing = 4;  // samples (1 mm) averaged before the largest difference
 constexpr std::size_t kAroundSmoothing = 3;  // samples (1.5 degrees) around
+// A contour holds only the level part of the force: where the side leans back by more than about
+// 37 degrees (a shelf, a foot, a flaring cup) the hand slides up and down it as it circles and the
+// trace tells where the hand went, not the piece. A side contour is compared only where the side's
+// profile (the reference's stroke up) turns in or out by less than kContourSteepest per unit of
+// height across kSteepWindowM either side of its height, and a side stroke only where it rises
+// more steeply than 45 degrees.
+constexpr double kContourSteepest = 0.75;
+constexpr double kStrokeSteepest = 1.0;
+constexpr double kSteepWindowM = 0.002;
 
 // a - b across b's slope (where the surface is steep, a little shift along the way is a large
 // difference of height but a small one across), minus its least-squares line (a piece standing a
@@ -331,7 +343,7 @@ double mean_square(const std::vector<double>& v) {
 // shifted along their axis by up to kShiftSearchM, contours around turned by any angle (the piece
 // may stand turned), each minus what a piece standing off-centre adds (a line; around: the mean
 // and the first harmonic). Negative when they do not overlap enough to compare.
-double surface_difference(const SurfaceTrack& a, const SurfaceTrack& b) {
+double surface_difference(const SurfaceTrack& a, const SurfaceTrack& b, bool wall_only = false) {
   if (a.around != b.around || a.height.empty() || b.height.empty()) return -1.0;
   if (a.around) {
     const std::size_t n = a.height.size();
@@ -376,8 +388,19 @@ double surface_difference(const SurfaceTrack& a, const SurfaceTrack& b) {
     const std::ptrdiff_t from = std::max(trim, trim - k), to = std::min(na - trim, nb - trim - k);
     if (to - from < need) continue;
     const auto n = static_cast<std::size_t>(to - from);
-    const std::vector<double> d =
-        detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step);
+    std::vector<double> d = detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step);
+    if (wall_only) {
+      // only where b's surface rises more steeply than it turns in or out (a wall, not a shelf)
+      const auto& h = b.height;
+      const auto w = static_cast<std::ptrdiff_t>(0.001 / b.step);
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::ptrdiff_t j = from + k + static_cast<std::ptrdiff_t>(i);
+        const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(0, j - w), hi = std::min(nb - 1, j + w);
+        if (hi > lo && std::fabs(h[static_cast<std::size_t>(hi)] - h[static_cast<std::size_t>(lo)]) >
+                           kStrokeSteepest * static_cast<double>(hi - lo) * b.step)
+          d[i] = 0.0;
+      }
+    }
     const double ms = mean_square(d);
     if (ms < best) {
       best = ms;
@@ -393,6 +416,34 @@ const SurfaceTrack* find_track(const PieceSurvey& survey, const std::string& nam
   return nullptr;
 }
 
+// The side's profile as the hand traced it going up (distance from the centre line by height), or null
+const SurfaceTrack* side_profile(const PieceSurvey& survey) {
+  for (const SurfaceTrack& t : survey.tracks)
+    if (t.name.rfind("side", 0) == 0 && t.name.ends_with("stroke up")) return &t;
+  return nullptr;
+}
+
+// Whether the profile turns in or out by more than kContourSteepest per unit of height across
+// kSteepWindowM either side of `z` (end to end: a trace's grain is not a shelf); true where the
+// profile does not reach
+bool shelf_near(const SurfaceTrack& profile, double z) {
+  const auto n = static_cast<std::ptrdiff_t>(profile.height.size());
+  const auto at = [&](double zz) {
+    return static_cast<std::ptrdiff_t>(std::lround((zz - profile.start) / profile.step));
+  };
+  const std::ptrdiff_t lo = at(z - kSteepWindowM), hi = at(z + kSteepWindowM);
+  if (lo < 0 || hi >= n || hi <= lo) return true;
+  return std::fabs(profile.height[static_cast<std::size_t>(hi)] - profile.height[static_cast<std::size_t>(lo)]) >
+         kContourSteepest * static_cast<double>(hi - lo) * profile.step;
+}
+
+// the height a side contour was planned at, from its name ("side 25 mm around"), or nothing
+std::optional<double> contour_height(const SurfaceTrack& t) {
+  double mm = 0.0;
+  if (!t.around || std::sscanf(t.name.c_str(), "side %lf mm", &mm) != 1) return std::nullopt;
+  return mm * 1e-3;
+}
+
 // |a / b - 1|, or nothing when either is missing or b is not positive
 std::optional<double> relative_difference(const std::optional<double>& a, const std::optional<double>& b) {
   if (!a || !b || !(*b > 0.0)) return std::nullopt;
@@ -406,14 +457,19 @@ Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
   Judgement j;
   // the surface: per track, against the reference's same track
   std::vector<FeatureDifference> surface;
+  const SurfaceTrack* profile = side_profile(reference);
   for (const SurfaceTrack& r : reference.tracks) {
     const SurfaceTrack* p = find_track(piece, r.name);
     const SurfaceTrack* again = find_track(reference_again, r.name);
     if (p == nullptr || again == nullptr) continue;
+    // a contour round a shelf of the side tells where the hand was, not the piece
+    if (const auto z = contour_height(r); z && profile != nullptr && shelf_near(*profile, *z)) continue;
+    const bool side_stroke = !r.around && r.name.rfind("side", 0) == 0;
     // the piece differs only as much as it differs from the closer of the two explorations of the
     // reference (which differ from each other by the noise)
-    const double to_first = surface_difference(*p, r), to_second = surface_difference(*p, *again);
-    const double noise = surface_difference(*again, r);
+    const double to_first = surface_difference(*p, r, side_stroke),
+                 to_second = surface_difference(*p, *again, side_stroke);
+    const double noise = surface_difference(*again, r, side_stroke);
     if (to_first < 0.0 || to_second < 0.0 || noise < 0.0) continue;
     const double difference = std::min(to_first, to_second);
     surface.push_back({.feature = "surface",
@@ -451,8 +507,19 @@ Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
     std::nth_element(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(k.size() / 2), k.end());
     return k[k.size() / 2];
   };
+  // and no difference counts that the piece's own presses disagree by (one press on a ridge, one
+  // beside it)
+  const auto press_spread = [](const PieceSurvey& survey) {
+    double lo = 1e300, hi = 0.0;
+    for (const auto& [site, value] : survey.site_stiffness)
+      if (site.rfind("top press", 0) == 0) {
+        lo = std::min(lo, value);
+        hi = std::max(hi, value);
+      }
+    return hi > lo && lo > 0.0 ? hi / lo - 1.0 : 0.0;
+  };
   material("stiffness", top_stiffness(piece), top_stiffness(reference), top_stiffness(reference_again),
-           kStiffnessFloor);
+           std::max(kStiffnessFloor, press_spread(piece)));
   material("dynamic friction", piece.material.friction_dynamic, reference.material.friction_dynamic,
            reference_again.material.friction_dynamic, kFrictionFloor);
   const bool differs = std::any_of(j.evidence.begin(), j.evidence.end(),

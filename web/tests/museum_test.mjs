@@ -1,7 +1,8 @@
 // Vive's browser client in Debian's Chromium (headless, driven by playwright-core; never a
 // downloaded browser): `uh museum serve` on a free loopback port with a seed and a short round,
-// the page joined as Vive and driven with the keyboard, Phantom played by a scripted client (a
-// second page's WebSocket that judges whatever lands on the table). Checks that the page draws
+// the page joined as Vive and driven with the keyboard, Phantom played by the automated blind
+// player (`uh museum play --bot phantom`: it studies the targets' genuine pieces, then judges each
+// piece in its hands by touch on a simulated device). Checks that the page draws
 // the museum (the canvas is not blank), Falcon's pictures are rendered, snapshots arrive and the
 // timer runs, Vive moves when keys are held (the prediction and the server agree where she is),
 // the guards are drawn between snapshots (interpolated, on the path the snapshots trace), the keys
@@ -9,6 +10,7 @@
 // screenshots: the museum view and Falcon's panel.
 //
 //   node museum_test.mjs UH_BINARY OUT_DIR
+import { spawn } from 'node:child_process';
 import path from 'node:path';
 import { check, runBrowserTest, startServer } from './browser_harness.mjs';
 
@@ -17,7 +19,10 @@ if (!uhBinary || !outDir) {
   console.error('usage: node museum_test.mjs UH_BINARY OUT_DIR');
   process.exit(2);
 }
-const kRoundMinutes = 0.75;  // 45 s of play: enough to walk, watch the guards, a heist and the end
+const kRoundMinutes = 1;  // 60 s of play: enough to walk, watch the guards, a heist, a verdict by touch and the end
+// the blind bot studies the targets before it sits down (the round waits) and judges a piece by touch:
+// seconds of CPU each, more on a busy machine
+const kPhantomPatience = 150000;
 
 const server = await startServer(uhBinary, ['museum', 'serve', '--port', '0', '--seed', '2', '--minutes', String(kRoundMinutes)],
                                  /Vive plays in a browser at (http:\/\/127\.0\.0\.1:\d+\/)/);
@@ -53,26 +58,17 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
   const waiting = await page.evaluate(() => window.uhMuseum.snapshot.phase);
   check(waiting === 'waiting', `the page joins as Vive and the round waits for Phantom (${waiting})`);
 
-  // Phantom: a scripted client in a page of its own; it judges every piece that reaches the table
-  const phantom = await browser.newPage();
-  await phantom.goto(`${url}artifacts/none`).catch(() => {});
-  await phantom.evaluate(() => {
-    const judged = new Set();
-    window.phantomJoin = () => {
-      const ws = new WebSocket(`ws://${location.host}/ws`);
-      window.phantom = ws;
-      ws.onopen = () => ws.send(JSON.stringify({ type: 'hello', protocol: 1, role: 'phantom' }));
-      ws.onmessage = (event) => {
-        const m = JSON.parse(event.data);
-        if (m.type === 'snapshot' && m.table.length > 0 && !judged.has(m.table[0].item)) {
-          judged.add(m.table[0].item);
-          ws.send(JSON.stringify({ type: 'verdict', item: m.table[0].item, verdict: 'genuine' }));
-        }
-      };
-    };
-    window.phantomJoin();
-  });
-  await page.waitForFunction(() => window.uhMuseum.snapshot.phase === 'playing', null, { timeout: 10000 });
+  // Phantom: the automated blind player, a process of its own joining the server
+  const phantomBot = () => {
+    const bot = spawn(uhBinary, ['museum', 'play', '--bot', 'phantom', '--server', url, '--seed', '2'],
+                      { stdio: ['ignore', 'pipe', 'inherit'] });
+    bot.output = '';
+    bot.stdout.on('data', (chunk) => { bot.output += chunk; });
+    bot.exited = new Promise((resolve) => bot.on('exit', (code, signal) => resolve({ code, signal })));
+    return bot;
+  };
+  let phantom = phantomBot();
+  await page.waitForFunction(() => window.uhMuseum.snapshot.phase === 'playing', null, { timeout: kPhantomPatience });
   check(true, 'the round plays once Phantom joins');
 
   const round = await page.evaluate(() => ({
@@ -149,7 +145,7 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
   await waitFor('the server to have her at the table', () => Math.hypot(window.uhMuseum.snapshot.vive.pos[0] - 4.7, window.uhMuseum.snapshot.vive.pos[1] - 3) < 0.2, null, 5000);
   const deliverPrompt = await page.evaluate(() => document.getElementById('prompt').textContent);
   await page.keyboard.press('e');
-  await waitFor("Phantom's verdict", () => window.uhMuseum.events.some((e) => e.event === 'verdict'), null, 5000);
+  await waitFor('the delivery', () => window.uhMuseum.events.some((e) => e.event === 'items_delivered'), null, 5000);
   const home = await page.evaluate(() => ({
     events: window.uhMuseum.events.map((e) => e.event),
     caught: window.uhMuseum.snapshot.vive.times_caught,
@@ -197,13 +193,16 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
         `the timer runs (${start.timeLeft.toFixed(1)} s -> ${after.timeLeft.toFixed(1)} s, shown ${start.timer} -> ${after.timer})`);
 
   // Phantom drops out: the round pauses (the page says so, the timer stands); a new hello resumes it
-  await phantom.evaluate(() => window.phantom.close());
+  phantom.kill('SIGTERM');
+  await phantom.exited;
   await waitFor('the pause', () => window.uhMuseum.snapshot.phase === 'paused', null, 5000);
   const paused = await page.evaluate(() => ({ status: document.getElementById('status').textContent, left: window.uhMuseum.snapshot.time_left_s, at: [...window.uhMuseum.predicted] }));
   await page.waitForTimeout(500);
   const pausedLater = await page.evaluate(() => ({ left: window.uhMuseum.snapshot.time_left_s, at: [...window.uhMuseum.predicted] }));
-  await phantom.evaluate(() => window.phantomJoin());
-  await waitFor('the round to resume', () => window.uhMuseum.snapshot.phase === 'playing', null, 5000);
+  phantom = phantomBot();
+  await waitFor('the round to resume', () => window.uhMuseum.snapshot.phase === 'playing', null, kPhantomPatience);
+  // the new Phantom is handed the piece on the table and judges it by touch
+  await waitFor("Phantom's verdict", () => window.uhMuseum.events.some((e) => e.event === 'verdict'), null, kPhantomPatience);
   check(paused.status === 'paused: Phantom dropped out' && pausedLater.left === paused.left && dist(pausedLater.at, paused.at) < 1e-9,
         `Phantom dropping out pauses the round ("${paused.status}", the timer stands at ${paused.left.toFixed(1)} s) and a new hello resumes it`);
 
@@ -290,8 +289,15 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
     points: document.getElementById('summary-points').textContent,
     ended: window.uhMuseum.events.some((e) => e.event === 'round_ended'),
   }));
-  const kept = summary.summary.targets.find((t) => t.kind === heist.piece.kind);
-  check(kept && (kept.genuine === 'kept' || kept.forgery === 'kept'), `the summary has the delivered ${heist.piece.kind} kept (Phantom said genuine)`);
+  const verdict = await page.evaluate(() => window.uhMuseum.events.find((e) => e.event === 'verdict'));
+  const outcome = summary.summary.targets.find((t) => t.kind === heist.piece.kind);
+  const place = verdict.verdict === 'genuine' ? 'kept' : 'rejected';
+  const judged = outcome && (outcome.genuine === place || outcome.forgery === place);
+  const right = outcome && (verdict.verdict === 'genuine' ? outcome.genuine === 'kept' : outcome.forgery === 'rejected');
+  check(verdict.item === heist.piece.item && judged,
+        `the summary has the delivered ${heist.piece.kind} ${place} as the blind bot judged it by touch (${verdict.verdict}: ${right ? 'right' : 'wrong'})`);
+  const botEnded = await phantom.exited;
+  check(botEnded.code === 0, `the blind bot leaves when the round ends (exit ${botEnded.code}; ${phantom.output.trim().split('\n').pop()})`);
   check(summary.shown && summary.ended && Number.isInteger(summary.summary.score.points) &&
         summary.points === `${summary.summary.score.points} points` && summary.summary.targets.length === round.targets.length,
         `the round ends and the summary is shown (${summary.points}, ${summary.summary.seconds_played.toFixed(0)} s played)`);
