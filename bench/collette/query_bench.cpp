@@ -16,9 +16,10 @@
 // which goes first), so both see the same machine load, and the query's reference path
 // (`reference_kernel`: the scalar path before the SIMD kernels) on the same pose; each pose 10 times.
 // Counters: median, p90 and max of both over all poses and repetitions, and the ratio of the medians.
-// Each iteration also runs the query with the baseline kernels (`sse2_median_us`: `use_avx2` off;
-// `avx2` says which the default took) and with its worker thread (`two_threads_*`, and how many of
-// the frontier's chunks the worker ran per query); the five run in a rotating order.
+// Each iteration also runs the query with the AVX2 kernels (`avx2_median_us`: `use_avx512` off),
+// with the baseline kernels (`sse2_median_us`: `use_avx2` off; `kernel_lanes` says which width the
+// default took: 16 with AVX-512) and with its worker thread (`two_threads_*`, and how many of the
+// frontier's chunks the worker ran per query); the six run in a rotating order.
 
 #include <benchmark/benchmark.h>
 
@@ -447,12 +448,14 @@ void BM_DeepRandomPoses(benchmark::State& state) {
   VolumeQuery query;
   VolumeQuery reference({.reference_kernel = true});
   VolumeQuery baseline({.use_avx2 = false});
+  VolumeQuery avx2_only({.use_avx512 = false});
   VolumeQuery shared({.worker_thread = true});
   fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
   fcl::CollisionObjectd b(s.fcl_model, fcl::Transform3d::Identity());
   const fcl::CollisionRequestd request(1000000, true);
-  std::vector<double> ours, reference_times, fcl_times, baseline_times, shared_times;
+  std::vector<double> ours, reference_times, fcl_times, baseline_times, avx2_times, shared_times;
   ours.reserve(1 << 14);
+  avx2_times.reserve(1 << 14);
   baseline_times.reserve(1 << 14);
   shared_times.reserve(1 << 14);
   double worker_chunks = 0.0;
@@ -495,16 +498,19 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       fcl_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       contacts += static_cast<double>(result.numContacts());
     };
-    // all five on the same pose, in an order that rotates, so that each sees the same load and
+    // all six on the same pose, in an order that rotates, so that each sees the same load and
     // the same share of caches warmed by the one before
-    const std::function<void()> runs[5] = {run_ours, run_reference, run_fcl,
+    const std::function<void()> runs[6] = {run_ours,
+                                           run_reference,
+                                           run_fcl,
                                            [&] { run_other(baseline, baseline_times); },
+                                           [&] { run_other(avx2_only, avx2_times); },
                                            [&] { run_other(shared, shared_times); }};
-    for (std::size_t i = 0; i < 5; ++i) runs[(k + i) % 5]();
+    for (std::size_t i = 0; i < 6; ++i) runs[(k + i) % 6]();
     worker_chunks += shared.worker_chunks();
     // the fast path (each kernel width, one or two threads) must give exactly the reference path's
     // totals and pairs
-    for (const VolumeQuery* q : {&query, &baseline, &shared})
+    for (const VolumeQuery* q : {&query, &baseline, &avx2_only, &shared})
       if (q->result().total_volume != reference.result().total_volume ||
           q->result().pair_count != reference.result().pair_count)
         ++mismatches;
@@ -516,13 +522,15 @@ void BM_DeepRandomPoses(benchmark::State& state) {
   std::sort(fcl_times.begin(), fcl_times.end());
   std::sort(reference_times.begin(), reference_times.end());
   std::sort(baseline_times.begin(), baseline_times.end());
+  std::sort(avx2_times.begin(), avx2_times.end());
   std::sort(shared_times.begin(), shared_times.end());
   state.counters["reference_median_us"] = quantile(reference_times, 0.5) * 1e6;
   state.counters["sse2_median_us"] = quantile(baseline_times, 0.5) * 1e6;
+  state.counters["avx2_median_us"] = quantile(avx2_times, 0.5) * 1e6;
   state.counters["two_threads_median_us"] = quantile(shared_times, 0.5) * 1e6;
   state.counters["two_threads_p90_us"] = quantile(shared_times, 0.9) * 1e6;
   state.counters["two_threads_worker_chunks"] = worker_chunks / n;
-  state.counters["avx2"] = query.uses_avx2() ? 1.0 : 0.0;
+  state.counters["kernel_lanes"] = query.kernel_lanes();
   state.counters["reference_p90_us"] = quantile(reference_times, 0.9) * 1e6;
   state.counters["mismatches"] = static_cast<double>(mismatches);
   state.counters["median_us"] = quantile(ours, 0.5) * 1e6;

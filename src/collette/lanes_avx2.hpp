@@ -18,6 +18,14 @@ struct F8 {
   [[gnu::always_inline]] static F8 load(const float* p) { return {_mm256_loadu_ps(p)}; }
   [[gnu::always_inline]] static F8 set1(float x) { return {_mm256_set1_ps(x)}; }
   [[gnu::always_inline]] static F8 zero() { return {_mm256_setzero_ps()}; }
+  /// the four floats at p in lanes 0..3 and again in lanes 4..7
+  [[gnu::always_inline]] static F8 load_twice(const float* p) {
+    return {_mm256_broadcast_ps(reinterpret_cast<const __m128*>(p))};
+  }
+  /// lo in lanes 0..3, hi in lanes 4..7
+  [[gnu::always_inline]] static F8 set2(float lo, float hi) {
+    return {_mm256_insertf128_ps(_mm256_set1_ps(lo), _mm_set1_ps(hi), 1)};
+  }
 };
 
 [[gnu::always_inline]] inline void store(float* p, F8 a) { _mm256_storeu_ps(p, a.v); }

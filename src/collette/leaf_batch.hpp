@@ -16,13 +16,14 @@
 
 namespace uh::collette::detail {
 
-/// Leaf pairs waiting for evaluation. Lanes past `count` up to the next multiple of 8 are zero
-/// spheres at the origin (apart: never overlap), so a group may read them.
+/// Leaf pairs waiting for evaluation. Lanes past `count` up to the next multiple of 16 (the widest
+/// group) are zero spheres at the origin (apart: never overlap), so a group may read them.
 struct LeafBatch {
   static constexpr int kCapacity = 256;
-  static constexpr int kPad = 8;
-  alignas(32) float ax[kCapacity + kPad], ay[kCapacity + kPad], az[kCapacity + kPad], ar[kCapacity + kPad];
-  alignas(32) float bx[kCapacity + kPad], by[kCapacity + kPad], bz[kCapacity + kPad], br[kCapacity + kPad];
+  static constexpr int kPad = 16;
+  // each array is a whole number of cache lines, so all start on one
+  alignas(64) float ax[kCapacity + kPad], ay[kCapacity + kPad], az[kCapacity + kPad], ar[kCapacity + kPad];
+  alignas(64) float bx[kCapacity + kPad], by[kCapacity + kPad], bz[kCapacity + kPad], br[kCapacity + kPad];
   std::int32_t leaf_a[kCapacity], leaf_b[kCapacity];
   int count = 0;
 
@@ -41,7 +42,7 @@ struct LeafBatch {
     leaf_b[i] = lb;
   }
 
-  /// Zero spheres from `count` up to the next multiple of 8.
+  /// Zero spheres from `count` up to the next multiple of kPad.
   void pad() {
     for (int i = count; i < ((count + kPad - 1) / kPad) * kPad; ++i) ax[i] = ay[i] = az[i] = ar[i] = bx[i] = by[i] = bz[i] = br[i] = 0.f;
   }
@@ -50,7 +51,7 @@ struct LeafBatch {
 /// What lens_lanes() computes per lane, in A's frame: lens volume (0 unless the spheres overlap),
 /// intersection disk area, unit normal from A's centre to B's, lens centroid.
 struct LensLanes {
-  alignas(32) float volume[8], area[8], nx[8], ny[8], nz[8], cx[8], cy[8], cz[8];
+  alignas(32) float volume[16], area[16], nx[16], ny[16], nz[16], cx[16], cy[16], cz[16];
 };
 
 inline constexpr float kPiF = static_cast<float>(3.14159265358979323846264338327950288L);

@@ -3,16 +3,15 @@
 //
 // Included inside `namespace uh::collette::detail::<isa>` after `using V = <lane type>;` (F4 in
 // volume_query.cpp for the baseline ISA, F8 in volume_query_avx2.cpp inside a region compiled for
-// AVX2), so that each ISA gets its own copy of these functions under its own names. It includes
-// nothing itself: the including file includes volume_traversal.hpp and the lane headers first.
+// AVX2, F16 in volume_query_avx512.cpp inside a region compiled for AVX-512) and
+// `template <int W> using BlockLanes = <lanes for a block of W children>;` (V, or narrower lanes
+// when a block is narrower than V), so that each ISA gets its own copy of these functions under its
+// own names. It includes nothing itself: the including file includes volume_traversal.hpp and the
+// lane headers first.
 //
 // Every lane operation is the scalar kernel's operation in the scalar kernel's order, so each pair
 // is bit for bit what the reference path computes, at any width; pairs are found, stored and summed
 // in the reference path's order, so the totals are identical too.
-
-// the lanes for a block of W children: one group of V, or F4 when a block is narrower than V
-template <int W>
-using BlockLanes = std::conditional_t<(W < V::kWidth), F4, V>;
 
 // bit j set when lane j of the (x, y, z, r) lanes overlaps the sphere (px, py, pz, pr)
 template <int W>
@@ -37,6 +36,21 @@ template <int WA, int WB>
   return static_cast<std::uint64_t>(overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, tb[j], tb[WB + j],
                                                      tb[2 * WB + j], tb[3 * WB + j] + sm))
          << (8 * j);
+}
+
+// rows j and j + 1 of a visit's child-pair mask in one group of lanes, when a group is two rows
+// wide (16 lanes and A's blocks 8 wide, or 8 lanes and 4 wide): A's children twice, child j of B against the first half
+// of the lanes, child j + 1 against the second; the operations of row_mask, so the bits are the same
+template <int WA, int WB, typename L = V>  // L: V, named so that only widths with set2() compile it
+[[gnu::always_inline]] inline std::uint64_t row_pair_mask(const float* ab, const float* tb, int j, float sm) {
+  static_assert(2 * WA == L::kWidth);
+  const L dx = L::set2(tb[j], tb[j + 1]) - L::load_twice(ab);
+  const L dy = L::set2(tb[WB + j], tb[WB + j + 1]) - L::load_twice(ab + WA);
+  const L dz = L::set2(tb[2 * WB + j], tb[2 * WB + j + 1]) - L::load_twice(ab + 2 * WA);
+  const L rs = L::set2(tb[3 * WB + j] + sm, tb[3 * WB + j + 1] + sm) + L::load_twice(ab + 3 * WA);
+  const std::uint64_t m = bits((dx * dx + dy * dy) + dz * dz < rs * rs);
+  // row j + 1 from bit WA to bit 8 (nothing moves when WA is 8)
+  return ((m & ((1u << WA) - 1u)) | ((m >> WA) << 8)) << (8 * j);
 }
 
 // B's children of block kb moved into A's frame: t[0..W) x, t[W..2W) y, t[2W..3W) z, t[3W..4W) r
@@ -70,11 +84,11 @@ template <int W>
   const V dx = bx - ax, dy = by - ay, dz = bz - az;
   const V d = sqrt((dx * dx + dy * dy) + dz * dz);
   const V sum = ar + br;
-  const V touching = d < sum;
+  const auto touching = d < sum;  // masks: V, or M16 with sixteen lanes
   const V delta = ar - br;
   const V rmin = min(br, ar);  // std::min(ar, br): br < ar ? br : ar
   const V contained = ((V::set1(kFourThirdsPiF) * rmin) * rmin) * rmin;
-  const V containment = (d <= abs(delta)) | (d < V::set1(std::numeric_limits<float>::min()));
+  const auto containment = (d <= abs(delta)) | (d < V::set1(std::numeric_limits<float>::min()));
   // the lens (garbage in lanes that are apart or contained; blended away below)
   const V s = sum - d;
   const V half_inv_d = V::set1(0.5f) / d;
@@ -101,7 +115,7 @@ template <int W>
   store(out.cx, ax + nx * offset);
   store(out.cy, ay + ny * offset);
   store(out.cz, az + nz * offset);
-  const V overlap = volume > zero;
+  const auto overlap = volume > zero;
   near = margin > 0.f ? bits(andnot(overlap, d < sum + V::set1(margin))) : 0u;
   return bits(overlap);
 }
@@ -204,14 +218,17 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
     t.leaf_tests += kBitCount[leaf_a] * kBitCount[leaf_b];
     // only B's children that reach A's node sphere can reach a leaf below A: the rows of the others
-    // (a third to a half) are dropped. When a row is one group of lanes, every row is tested in a
-    // loop of fixed length (no branch to mispredict) and the mask drops rows afterwards; narrower
-    // lanes test only the rows kept.
+    // (a third to a half) are dropped. When a row is one group of lanes (or two rows are, with
+    // sixteen lanes), every row is tested in a loop of fixed length (no branch to mispredict) and
+    // the mask drops rows afterwards; narrower lanes test only the rows kept.
     const std::uint32_t rows =
         overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, e.ax, e.ay, e.az, e.ar + sm) &
         ((1u << b.count[e.b]) - 1u);
     std::uint64_t hits = 0;
-    if constexpr (WA <= V::kWidth) {
+    if constexpr (2 * WA == V::kWidth && WB % 2 == 0) {
+      for (int j = 0; j < WB; j += 2) hits |= row_pair_mask<WA, WB>(ab, tb, j, sm);
+      hits &= kByteMask[rows];
+    } else if constexpr (WA <= V::kWidth) {
       for (int j = 0; j < WB; ++j) hits |= row_mask<WA, WB>(ab, tb, j, sm);
       hits &= kByteMask[rows];
     } else {

@@ -18,6 +18,8 @@ namespace uh::collette {
 
 namespace detail::sse2 {
 using V = F4;
+template <int W>
+using BlockLanes = F4;
 #include "volume_fast_path.inl"
 }  // namespace detail::sse2
 
@@ -45,7 +47,7 @@ struct QueryWorker {
   Traversal traversal{};
   std::vector<VolumeQuery::StackEntry> frontier;  // in the order the one-thread traversal takes them
   int chunk_begin[kMaxChunks + 1] = {};           // chunk c: frontier[chunk_begin[c], chunk_begin[c + 1])
-  bool avx2 = false;
+  int lanes = 4;                                  // the kernel width (VolumeQuery::kernel_lanes())
   // the worker's scratch and results
   std::vector<VolumeQuery::StackEntry> stack;
   std::unique_ptr<LeafBatch> batch = std::make_unique<LeafBatch>();
@@ -98,7 +100,7 @@ struct QueryWorker {
   void run_chunk(Traversal& t, int c) const {
     for (int i = chunk_begin[c + 1] - 1; i >= chunk_begin[c]; --i)
       (*t.stack)[t.top++] = frontier[static_cast<std::size_t>(i)];
-    avx2 ? avx2::run_fast(t) : sse2::run_fast(t);
+    run_fast(lanes, t);
   }
 
   void loop() {
@@ -133,7 +135,10 @@ struct QueryWorker {
 VolumeQuery::VolumeQuery(const VolumeQueryOptions& options)
     : options_(options),
       batch_(std::make_unique<detail::LeafBatch>()),
-      uses_avx2_(options.use_avx2 && detail::avx2::supported()) {
+      kernel_lanes_(!options.use_avx2                                   ? 4
+                    : options.use_avx512 && detail::avx512::supported() ? 16
+                    : detail::avx2::supported()                         ? 8
+                                                                        : 4) {
   if (options_.worker_thread) worker_ = std::make_unique<detail::QueryWorker>(options_.pair_capacity);
   options_.pair_capacity = std::max(0, options_.pair_capacity);
   // the traversal keeps its own top: the vector is storage, sized to its capacity
@@ -153,12 +158,12 @@ VolumeQuery& VolumeQuery::operator=(VolumeQuery&&) noexcept = default;
 namespace {
 
 // The fast path shared with the worker thread (QueryWorker): returns the chunks the worker ran.
-int run_shared(detail::QueryWorker& w, Traversal& t, bool avx2, const SphereTree& a, const SphereTree& b,
+int run_shared(detail::QueryWorker& w, Traversal& t, int lanes, const SphereTree& a, const SphereTree& b,
                const Pose& b_in_a, const VolumeQueryOptions& options) {
   using detail::QueryWorker;
-  avx2 ? detail::avx2::expand(t, QueryWorker::kFrontier) : detail::sse2::expand(t, QueryWorker::kFrontier);
+  detail::expand(lanes, t, QueryWorker::kFrontier);
   if (t.top < 2) {
-    avx2 ? detail::avx2::run_fast(t) : detail::sse2::run_fast(t);
+    detail::run_fast(lanes, t);
     return 0;
   }
   // the frontier in the order one thread would take it (top of the stack first), cut into chunks
@@ -191,7 +196,7 @@ int run_shared(detail::QueryWorker& w, Traversal& t, bool avx2, const SphereTree
       detail::make_traversal(a, b, b_in_a, options, &w.stack, w.pairs.data(), nullptr, w.batch.get());
   w.traversal.capacity = static_cast<std::int32_t>(w.pairs.size());
   w.traversal.search_margin = t.search_margin;
-  w.avx2 = avx2;
+  w.lanes = lanes;
   w.finished.store(0, std::memory_order_relaxed);
   w.claim.store(static_cast<std::uint32_t>(chunks) << 16, std::memory_order_release);
   w.posted.fetch_add(1, std::memory_order_release);
@@ -295,11 +300,9 @@ void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose&
     if (!wide_a) wide_b ? t.run<4, 8, false>() : t.run<4, 4, false>();
     else wide_b ? t.run<8, 8, false>() : t.run<8, 4, false>();
   } else if (worker_) {
-    worker_chunks_ = run_shared(*worker_, t, uses_avx2_, a, b, b_in_a, options_);
-  } else if (uses_avx2_) {
-    detail::avx2::run_fast(t);
+    worker_chunks_ = run_shared(*worker_, t, kernel_lanes_, a, b, b_in_a, options_);
   } else {
-    detail::sse2::run_fast(t);
+    detail::run_fast(kernel_lanes_, t);
   }
   finish(t, options_.collect_pairs, result_);
   if (!keep_candidates) return;

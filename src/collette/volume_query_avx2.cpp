@@ -46,6 +46,9 @@ bool supported() {
 
 namespace uh::collette::detail::avx2 {
 using V = F8;
+// a block of 4 children: one group of four lanes
+template <int W>
+using BlockLanes = std::conditional_t<(W < 8), F4, F8>;
 #include "volume_fast_path.inl"
 }  // namespace uh::collette::detail::avx2
 

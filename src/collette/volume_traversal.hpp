@@ -4,8 +4,9 @@
 // VolumeQuery runs one of three traversals over the same state: the reference path (Traversal::run,
 // one pair at a time with the scalar lens kernel, also the coherence path that keeps candidates),
 // and the fast path (volume_fast_path.inl: hit masks per visit, batched SIMD lens kernel), which is
-// compiled twice, for the baseline ISA (sse2::run_fast) and for AVX2 (avx2::run_fast, chosen at
-// run time when the CPU has it). All give the same pairs in the same order, bit for bit.
+// compiled three times, for the baseline ISA (sse2::run_fast), for AVX2 (avx2::run_fast) and for
+// AVX-512 (avx512::run_fast), the widest the CPU has chosen at run time. All give the same pairs in
+// the same order, bit for bit.
 
 #include <algorithm>
 #include <array>
@@ -345,7 +346,8 @@ inline Traversal make_traversal(const SphereTree& a, const SphereTree& b, const 
                    Totals{}};
 }
 
-// The fast path for the baseline ISA (volume_query.cpp) and for AVX2 (volume_query_avx2.cpp):
+// The fast path for the baseline ISA (volume_query.cpp), for AVX2 (volume_query_avx2.cpp) and for
+// AVX-512 (volume_query_avx512.cpp):
 // run_fast() traverses until the stack is empty; expand() traverses (in the same order) only until
 // the stack holds `entries` node pairs, the frontier that a two-thread query shares out. Both
 // evaluate the leaf pairs found so far before they return.
@@ -360,5 +362,20 @@ bool supported();
 void run_fast(Traversal& t);
 void expand(Traversal& t, std::size_t entries);
 }  // namespace avx2
+namespace avx512 {
+/// True when this build has the AVX-512 path and the CPU running it supports AVX-512 F, VL, DQ, BW.
+bool supported();
+/// Only when supported().
+void run_fast(Traversal& t);
+void expand(Traversal& t, std::size_t entries);
+}  // namespace avx512
+
+/// The fast path at a kernel width (16, 8 or 4 lanes: VolumeQuery::kernel_lanes()).
+inline void run_fast(int lanes, Traversal& t) {
+  lanes == 16 ? avx512::run_fast(t) : lanes == 8 ? avx2::run_fast(t) : sse2::run_fast(t);
+}
+inline void expand(int lanes, Traversal& t, std::size_t entries) {
+  lanes == 16 ? avx512::expand(t, entries) : lanes == 8 ? avx2::expand(t, entries) : sse2::expand(t, entries);
+}
 
 }  // namespace uh::collette::detail

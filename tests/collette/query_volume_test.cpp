@@ -184,8 +184,9 @@ TEST(VolumeQuery, DeepPosesMatchBruteForce) {
     ASSERT_TRUE(ta && tb);
     const std::vector<Pose> poses =
         testing::deep_poses(*ta, *tb, 3, 300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
-    for (const bool avx2 : {true, false}) {
-      VolumeQuery query({.use_avx2 = avx2});
+    for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
+      SCOPED_TRACE(kernels.name);
+      VolumeQuery query({.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
       for (std::size_t k = 0; k < poses.size(); ++k) {
         expect_pose_matches_brute_force(query, *ta, *tb, la, lb, poses[k], static_cast<int>(k));
         EXPECT_GT(query.result().stats.overlapping_pairs, 300) << "not deep: the test would prove little";
@@ -194,17 +195,24 @@ TEST(VolumeQuery, DeepPosesMatchBruteForce) {
   }
 }
 
-// The kernels the fast path may take on this machine: AVX2 where the CPU has it (not on Windows
-// builds), and always the baseline (SSE2).
-TEST(VolumeQuery, TakesTheAvx2KernelsWhereTheCpuHasThem) {
+// The kernels the fast path may take on this machine: AVX-512 where the CPU has it, else AVX2 where
+// it has that (neither on Windows builds), and always the baseline (SSE2); the options force the
+// narrower ones.
+TEST(VolumeQuery, TakesTheWidestKernelsTheCpuHas) {
 #if defined(__x86_64__) && !defined(_WIN32)
   __builtin_cpu_init();
   const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
+  const bool cpu_has_avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                              __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
 #else
-  const bool cpu_has_avx2 = false;
+  const bool cpu_has_avx2 = false, cpu_has_avx512 = false;
 #endif
-  EXPECT_EQ(VolumeQuery().uses_avx2(), cpu_has_avx2);
-  EXPECT_FALSE(VolumeQuery({.use_avx2 = false}).uses_avx2());
+  EXPECT_EQ(VolumeQuery().kernel_lanes(), cpu_has_avx512 ? 16 : cpu_has_avx2 ? 8 : 4);
+  EXPECT_EQ(VolumeQuery().uses_avx512(), cpu_has_avx512);
+  EXPECT_EQ(VolumeQuery().uses_avx2(), cpu_has_avx2 && !cpu_has_avx512);
+  EXPECT_EQ(VolumeQuery({.use_avx512 = false}).kernel_lanes(), cpu_has_avx2 ? 8 : 4);
+  EXPECT_EQ(VolumeQuery({.use_avx2 = false}).kernel_lanes(), 4);
+  EXPECT_EQ(VolumeQuery({.use_avx2 = false, .use_avx512 = true}).kernel_lanes(), 4);
   EXPECT_FALSE(VolumeQuery({.reference_kernel = true, .use_avx2 = false}).uses_avx2());
 }
 
@@ -245,8 +253,8 @@ TEST(VolumeQuery, FastKernelsEqualTheScalarLensAtItsBranchPoints) {
     const auto ta = build_sphere_tree(la, {.arity = arity});
     const auto tb = build_sphere_tree(lb, {.arity = arity});
     ASSERT_TRUE(ta && tb);
-    for (const bool avx2 : {true, false}) {
-      VolumeQuery q({.use_avx2 = avx2});
+    for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
+      VolumeQuery q({.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
       q.run(*ta, *tb, Pose{});
       std::set<std::pair<int, int>> got;
       for (const PairOverlap& p : q.pairs()) {
@@ -269,7 +277,7 @@ TEST(VolumeQuery, FastKernelsEqualTheScalarLensAtItsBranchPoints) {
                                  p.normal[2], p.centroid[0], p.centroid[1], p.centroid[2]};
         EXPECT_EQ(std::memcmp(expected, actual, sizeof expected), 0)
             << "pair (" << p.leaf_a << ", " << p.leaf_b << ") at d " << d << ": volume " << p.volume
-            << " against " << o.volume << (avx2 ? " (AVX2 kernels)" : " (baseline kernels)");
+            << " against " << o.volume << " (" << kernels.name << ")";
       }
       // every overlapping pair found (the scalar kernel decides, pair by pair)
       int overlapping = 0;
@@ -300,8 +308,10 @@ void expect_fast_equals_reference(float margin) {
     const auto tb = build_sphere_tree(lb, {.arity = arity_b});
     ASSERT_TRUE(ta && tb);
     // the fast path with the AVX2 kernels (where the CPU has them) and with the baseline kernels
-    for (const bool avx2 : {true, false}) {
-      VolumeQuery fast({.contact_margin = margin, .use_avx2 = avx2});
+    for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
+      SCOPED_TRACE(kernels.name);
+      VolumeQuery fast(
+          {.contact_margin = margin, .use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
       VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
       for (const Pose& pose :
            testing::deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {

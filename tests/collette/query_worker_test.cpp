@@ -43,11 +43,16 @@ TEST(VolumeQueryWorker, SameResultsAsOneThreadOnDeepPoses) {
     const auto poses =
         testing::deep_poses(*ta, *tb, 4, 500u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
     for (const float margin : {0.f, 0.02f}) {
-      for (const bool avx2 : {true, false}) {
+      for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
+        SCOPED_TRACE(kernels.name);
+        const bool avx2 = kernels.use_avx2, avx512 = kernels.use_avx512;
         // the worker claims first, so that its part (and the merge) runs in every run
-        VolumeQuery shared(
-            {.contact_margin = margin, .use_avx2 = avx2, .worker_thread = true, .worker_claims_first = true});
-        VolumeQuery single({.contact_margin = margin, .use_avx2 = avx2});
+        VolumeQuery shared({.contact_margin = margin,
+                            .use_avx2 = avx2,
+                            .use_avx512 = avx512,
+                            .worker_thread = true,
+                            .worker_claims_first = true});
+        VolumeQuery single({.contact_margin = margin, .use_avx2 = avx2, .use_avx512 = avx512});
         int worker_chunks = 0;
         for (const Pose& pose : poses) {
           expect_same_as_one_thread(shared, single, *ta, *tb, pose);
@@ -57,7 +62,8 @@ TEST(VolumeQueryWorker, SameResultsAsOneThreadOnDeepPoses) {
             << "the worker ran no chunk: the test would prove little";
         EXPECT_GT(single.result().pair_count, 150);
         // and a run where the caller may take every chunk (whatever the worker manages)
-        VolumeQuery racing({.contact_margin = margin, .use_avx2 = avx2, .worker_thread = true});
+        VolumeQuery racing(
+            {.contact_margin = margin, .use_avx2 = avx2, .use_avx512 = avx512, .worker_thread = true});
         for (int repeat = 0; repeat < 3; ++repeat)
           for (const Pose& pose : poses) expect_same_as_one_thread(racing, single, *ta, *tb, pose);
       }

@@ -74,11 +74,16 @@ struct VolumeQueryOptions {
   /// the reference that tests and benchmarks compare the fast path with. Same results (the same
   /// pairs, bit for bit, and the same totals), slower.
   bool reference_kernel = false;
-  /// Run the fast path's node tests and lens kernel eight lanes wide (AVX2) when the CPU has AVX2,
-  /// checked once at construction (VolumeQuery::uses_avx2()); false keeps the baseline kernels
+  /// Run the fast path's node tests and lens kernel eight lanes wide (AVX2) when the CPU has AVX2
+  /// (sixteen with use_avx512), checked once at construction (VolumeQuery::kernel_lanes()); false
+  /// keeps the baseline kernels
   /// (SSE2, four lanes), which every x86-64 runs. Both give the same results, bit for bit. Builds
   /// for Windows have the baseline kernels only.
   bool use_avx2 = true;
+  /// With use_avx2: run them sixteen lanes wide (AVX-512) when the CPU has AVX-512 F, VL, DQ and
+  /// BW (VolumeQuery::uses_avx512()); false stops at AVX2. Same results, bit for bit. Builds for
+  /// Windows leave it out, as the AVX2 kernels.
+  bool use_avx512 = true;
   /// Share each traversal with a second thread that the query owns (started at construction,
   /// joined by the destructor; it sleeps between runs): the calling thread runs the first node
   /// pairs, then both take chunks of the remaining frontier, the caller from the front and the
@@ -159,8 +164,13 @@ class VolumeQuery {
   /// The overlapping pairs stored by the last run (empty unless collect_pairs), A frame.
   std::span<const PairOverlap> pairs() const { return {pairs_.data(), static_cast<std::size_t>(result_.pair_count)}; }
   const VolumeQueryOptions& options() const { return options_; }
-  /// True when runs take the AVX2 kernels (options().use_avx2 and the CPU has AVX2).
-  bool uses_avx2() const { return uses_avx2_; }
+  /// The fast path's kernel width, chosen at construction: 16 (AVX-512: options().use_avx2,
+  /// use_avx512 and the CPU has it), 8 (AVX2: use_avx2 and the CPU has it) or 4 (the baseline).
+  int kernel_lanes() const { return kernel_lanes_; }
+  /// True when runs take the AVX2 kernels (eight lanes).
+  bool uses_avx2() const { return kernel_lanes_ == 8; }
+  /// True when runs take the AVX-512 kernels (sixteen lanes).
+  bool uses_avx512() const { return kernel_lanes_ == 16; }
   /// Node-pair chunks that the worker thread ran in the last run (worker_thread only; 0 when the
   /// calling thread ran them all).
   int worker_chunks() const { return worker_chunks_; }
@@ -191,7 +201,7 @@ class VolumeQuery {
   std::vector<StackEntry> stack_;
   std::vector<PairOverlap> pairs_;
   VolumeQueryResult result_;
-  bool uses_avx2_ = false;
+  int kernel_lanes_ = 4;
   int worker_chunks_ = 0;
   std::unique_ptr<detail::QueryWorker> worker_;  // the second thread and its buffers (worker_thread only)
   // coherence: the kept pairs, B's leaves among them (by index) and where they are this run, and
