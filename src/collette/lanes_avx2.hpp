@@ -22,9 +22,9 @@ struct F8 {
   [[gnu::always_inline]] static F8 load_twice(const float* p) {
     return {_mm256_broadcast_ps(reinterpret_cast<const __m128*>(p))};
   }
-  /// lo in lanes 0..3, hi in lanes 4..7
-  [[gnu::always_inline]] static F8 set2(float lo, float hi) {
-    return {_mm256_insertf128_ps(_mm256_set1_ps(lo), _mm_set1_ps(hi), 1)};
+  /// lane j of v in lanes 0..3, lane j + 1 in lanes 4..7
+  [[gnu::always_inline]] static F8 spread_pair(F8 v, int j) {
+    return {_mm256_permutevar8x32_ps(v.v, _mm256_setr_epi32(j, j, j, j, j + 1, j + 1, j + 1, j + 1))};
   }
 };
 

@@ -11,6 +11,8 @@
 #include <immintrin.h>
 #include <cstdint>
 
+#include "lanes_avx2.hpp"
+
 namespace uh::collette::detail {
 
 /// A mask of sixteen lanes, one bit per lane.
@@ -29,9 +31,10 @@ struct F16 {
   [[gnu::always_inline]] static F16 load_twice(const float* p) {
     return {_mm512_broadcast_f32x8(_mm256_loadu_ps(p))};
   }
-  /// lo in lanes 0..7, hi in lanes 8..15
-  [[gnu::always_inline]] static F16 set2(float lo, float hi) {
-    return {_mm512_mask_mov_ps(_mm512_set1_ps(lo), 0xff00, _mm512_set1_ps(hi))};
+  /// lane j of the eight lanes v in lanes 0..7, lane j + 1 in lanes 8..15 (one permute)
+  [[gnu::always_inline]] static F16 spread_pair(F8 v, int j) {
+    const __m512i index = _mm512_mask_mov_epi32(_mm512_set1_epi32(j), 0xff00, _mm512_set1_epi32(j + 1));
+    return {_mm512_permutexvar_ps(index, _mm512_castps256_ps512(v.v))};
   }
 };
 

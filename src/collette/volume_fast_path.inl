@@ -39,15 +39,18 @@ template <int WA, int WB>
 }
 
 // rows j and j + 1 of a visit's child-pair mask in one group of lanes, when a group is two rows
-// wide (16 lanes and A's blocks 8 wide, or 8 lanes and 4 wide): A's children twice, child j of B against the first half
-// of the lanes, child j + 1 against the second; the operations of row_mask, so the bits are the same
-template <int WA, int WB, typename L = V>  // L: V, named so that only widths with set2() compile it
-[[gnu::always_inline]] inline std::uint64_t row_pair_mask(const float* ab, const float* tb, int j, float sm) {
+// wide (16 lanes and A's blocks 8 wide, or 8 lanes and 4 wide) and B's block is 8 wide: A's
+// children twice, child j of B against the first half of the lanes, child j + 1 against the second.
+// bx .. br: B's moved children (eight lanes, radius plus the search margin), spread by one permute
+// each. The operations of row_mask, so the bits are the same.
+template <int WA, typename L = V>  // L: V, named so that only widths with spread_pair() compile it
+[[gnu::always_inline]] inline std::uint64_t row_pair_mask(const float* ab, BlockLanes<8> bx, BlockLanes<8> by,
+                                                          BlockLanes<8> bz, BlockLanes<8> br, int j) {
   static_assert(2 * WA == L::kWidth);
-  const L dx = L::set2(tb[j], tb[j + 1]) - L::load_twice(ab);
-  const L dy = L::set2(tb[WB + j], tb[WB + j + 1]) - L::load_twice(ab + WA);
-  const L dz = L::set2(tb[2 * WB + j], tb[2 * WB + j + 1]) - L::load_twice(ab + 2 * WA);
-  const L rs = L::set2(tb[3 * WB + j] + sm, tb[3 * WB + j + 1] + sm) + L::load_twice(ab + 3 * WA);
+  const L dx = L::spread_pair(bx, j) - L::load_twice(ab);
+  const L dy = L::spread_pair(by, j) - L::load_twice(ab + WA);
+  const L dz = L::spread_pair(bz, j) - L::load_twice(ab + 2 * WA);
+  const L rs = L::spread_pair(br, j) + L::load_twice(ab + 3 * WA);
   const std::uint64_t m = bits((dx * dx + dy * dy) + dz * dz < rs * rs);
   // row j + 1 from bit WA to bit 8 (nothing moves when WA is 8)
   return ((m & ((1u << WA) - 1u)) | ((m >> WA) << 8)) << (8 * j);
@@ -225,8 +228,11 @@ void run_fast(Traversal& t, std::size_t stop_at) {
         overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, e.ax, e.ay, e.az, e.ar + sm) &
         ((1u << b.count[e.b]) - 1u);
     std::uint64_t hits = 0;
-    if constexpr (2 * WA == V::kWidth && WB % 2 == 0) {
-      for (int j = 0; j < WB; j += 2) hits |= row_pair_mask<WA, WB>(ab, tb, j, sm);
+    if constexpr (2 * WA == V::kWidth && WB == 8) {
+      using B8 = BlockLanes<8>;
+      const B8 bx = B8::load(tb), by = B8::load(tb + 8), bz = B8::load(tb + 16);
+      const B8 br = B8::load(tb + 24) + B8::set1(sm);
+      for (int j = 0; j < WB; j += 2) hits |= row_pair_mask<WA>(ab, bx, by, bz, br, j);
       hits &= kByteMask[rows];
     } else if constexpr (WA <= V::kWidth) {
       for (int j = 0; j < WB; ++j) hits |= row_mask<WA, WB>(ab, tb, j, sm);
