@@ -1,4 +1,5 @@
 // uh museum serve [--host 127.0.0.1] [--port 7780] [--token T] [--seed N] [--minutes M] [--level easy|hard]
+//                  [--speed S]
 // uh museum judge [--level easy|hard] [--seed N] [--kinds K,...] [--json]
 // uh museum play: cmd_museum_play.cpp
 #include <cstdio>
@@ -25,6 +26,7 @@ struct MuseumServeArgs {
   std::uint64_t seed = 1;
   double minutes = 0.0;  // 0: the level's own round time
   std::string level = "easy";
+  double speed = 1.0;  // game seconds per second of the clock
 };
 
 int museum_serve(const MuseumServeArgs& args) {
@@ -38,14 +40,17 @@ int museum_serve(const MuseumServeArgs& args) {
                                                    .token = args.token,
                                                    .level = std::move(level),
                                                    .seed = args.seed,
+                                                   .speed = args.speed,
                                                    .files = client.files});
   if (!server) {
     const std::string& m = server.error().message;
     return fail(m.find("token is required") != std::string::npos ? m + " (give --token)" : m);
   }
   const std::string url = (*server)->url();
-  std::printf("uh museum serve: %s level, seed %llu; players connect to ws%sws; Ctrl-C stops\n",
-              args.level.c_str(), static_cast<unsigned long long>(args.seed), url.substr(4).c_str());
+  std::printf("uh museum serve: %s level, seed %llu%s; players connect to ws%sws; Ctrl-C stops\n",
+              args.level.c_str(), static_cast<unsigned long long>(args.seed),
+              args.speed != 1.0 ? fmt::format(", at {:g} times the clock", args.speed).c_str() : "",
+              url.substr(4).c_str());
   if (client.has_page) std::printf("uh museum serve: Vive plays in a browser at %s\n", url.c_str());
   std::fflush(stdout);
   wait_for_stop_signal(stop_signals);
@@ -159,6 +164,9 @@ void add_museum_commands(CLI::App& app, CommandRunner& runner) {
   s->add_option("--level", args.level, "easy or hard")
       ->default_val("easy")
       ->check(CLI::IsMember({"easy", "hard"}));
+  s->add_option("--speed", args.speed, "game seconds per second of the clock (tests, demonstrations)")
+      ->default_val(1.0)
+      ->check(CLI::Range(0.1, 20.0));
   s->callback([&runner] { runner = [] { return museum_serve(args); }; });
 
   static MuseumJudgeArgs judge;

@@ -1,4 +1,4 @@
-// uh museum station [--server URL] [--device DRIVER[:SELECTOR]] [--token T] [--no-sound]
+// uh museum station [--server URL] [--device DRIVER[:SELECTOR]] [--token T] [--no-sound] [--trace FILE]
 // Phantom's station: the artifact in Phantom's hands on a haptic device, the round through sound
 // and speech, keys on the terminal (docs/museum.md, "Playing Phantom").
 #include <fcntl.h>
@@ -17,8 +17,6 @@
 
 #include "commands.hpp"
 #include "progress_bar.hpp"
-#include "uh/devices/device_probe.hpp"
-#include "uh/devices/hardware_drivers.hpp"
 #include "uh/museum_station/game_link.hpp"
 #include "uh/museum_station/station.hpp"
 
@@ -31,6 +29,7 @@ struct StationArgs {
   std::string server = "ws://127.0.0.1:7780/ws";
   std::string device;
   std::string token;
+  std::string trace;
   bool no_sound = false;
 };
 
@@ -80,11 +79,11 @@ constexpr const char* kKeysHelp =
     "      q  quit\n";
 
 int museum_station_run(const StationArgs& args) {
-  // a bad device is said before anything connects
-  if (!args.device.empty()) {
-    auto choice = devices::parse_device_choice(args.device, devices::all_drivers());
-    if (!choice) return fail(choice.error().message);
-  }
+  // a bad address or device is said before anything connects (the device is opened once and
+  // closed: a selector naming no device fails now, not when the first piece comes)
+  if (auto address = museum_station::parse_server_url(args.server); !address)
+    return fail("--" + address.error().message);
+  if (Status device = museum_station::check_device(args.device); !device) return fail(device.error().message);
   auto link = museum_station::GameLink::connect({.url = args.server, .token = args.token});
   if (!link) return fail(link.error().message);
   std::optional<museum_station::StationSound> sound;
@@ -101,6 +100,7 @@ int museum_station_run(const StationArgs& args) {
   std::string bar_label;
   museum_station::StationOptions options;
   options.device = args.device;
+  options.trace = args.trace;
   options.on_caption = [](const std::string& caption) {
     std::printf("  %s\n", caption.c_str());
     std::fflush(stdout);
@@ -204,6 +204,8 @@ void add_museum_station_command(CLI::App& museum, CommandRunner& runner) {
                 "the haptic device, DRIVER[:SELECTOR] as for uh run (default: a simulated hand)");
   s->add_option("--token", args.token, "the server's token, when it has one");
   s->add_flag("--no-sound", args.no_sound, "captions only, no sound output");
+  s->add_option("--trace", args.trace,
+                "write the haptic trace (CSV) of the piece in hand to this file, anew for each piece");
   s->callback([&runner] { runner = [] { return museum_station_run(args); }; });
 }
 

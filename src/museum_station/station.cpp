@@ -38,6 +38,20 @@ std::string list_words(const std::vector<std::string>& names) {
 
 }  // namespace
 
+Status check_device(const std::string& device) {
+  if (device.empty()) return Ok{};  // the simulated hand
+  const haptico::DeviceRegistry registry = devices::all_drivers();
+  auto choice = devices::parse_device_choice(device, registry);
+  if (!choice) return choice.error();
+  auto made = registry.create(choice->driver, choice->selection);
+  if (!made) return Error{fmt::format("--device {}: {}", device, made.error().message)};
+  if (Status opened = (*made)->open(); !opened)
+    return Error{fmt::format("--device {}: the device does not open: {}", device, opened.error().message)};
+  if (Status closed = (*made)->close(); !closed)
+    return Error{fmt::format("--device {}: the device does not close: {}", device, closed.error().message)};
+  return Ok{};
+}
+
 Vec3 HomeGuide::force_at(Vec3 position) {
   const Vec3 away = position - home_;
   const double d = norm(away);
@@ -283,9 +297,19 @@ Status Station::load_piece(const InHand& h) {
   guide_->set_home({0.0, 0.0, top + kHomeAboveTopM});
   guide_connection_ = (*session)->force_on_haptic_tick().connect<&HomeGuide::on_force>(*guide_);
   if (held_) (*session)->halt();
-  if (Status started = (*session)->start(); !started) {
+  if (!options_.trace.empty()) {
+    trace_ = std::make_unique<std::ofstream>(options_.trace, std::ios::binary | std::ios::trunc);
+    if (!*trace_) {
+      trace_.reset();
+      guide_connection_.disconnect();
+      guide_.reset();
+      return Error{fmt::format("cannot write the trace '{}'", options_.trace.string())};
+    }
+  }
+  if (Status started = (*session)->start(trace_.get()); !started) {
     guide_connection_.disconnect();
     guide_.reset();
+    trace_.reset();
     return started;
   }
   session_ = std::move(*session);
@@ -302,6 +326,7 @@ void Station::end_session() {
   guide_connection_.disconnect();
   session_.reset();
   guide_.reset();
+  trace_.reset();  // after stop(): its last row is the zero the device was sent
   if (sound_) sound_->set_contact(false, 0.0);
 }
 

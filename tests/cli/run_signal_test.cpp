@@ -22,6 +22,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include "child_process.hpp"
 #include "haply_standin.hpp"
 #include "test_paths.hpp"
 
@@ -31,12 +32,9 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test_support::Finished;
+using test_support::read_text;
+using test_support::wait_for_exit;
 
 // The stylus bounces into the bunny and out for a minute: in contact most of the time.
 std::string long_scene_json(const fs::path& assets) {
@@ -90,26 +88,6 @@ bool has_thread(pid_t pid, const std::string& name) {
     if (comm == name) return true;
   }
   return false;
-}
-
-struct Finished {
-  bool exited = false;
-  int code = -1;
-};
-
-// Waits for `pid` to end, at most `limit` (then kills it: a hang is a failure, not a wait).
-Finished wait_for_exit(pid_t pid, std::chrono::seconds limit) {
-  const auto deadline = std::chrono::steady_clock::now() + limit;
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      return {};
-    }
-    std::this_thread::sleep_for(5ms);
-  }
-  return {WIFEXITED(status), WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
 struct Interrupt {

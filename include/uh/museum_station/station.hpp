@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -82,7 +83,15 @@ struct StationOptions {
   std::function<void(const std::string&)> on_caption{};
   /// Progress while a piece is packed on first use.
   std::function<void(const std::string& what, double fraction)> build_progress{};
+  /// When set, the haptic trace (CSV, as `uh run --trace`) of the piece in Phantom's hands: the
+  /// file is written anew for each piece; its last row is the zero sent when that piece's session
+  /// stopped.
+  std::filesystem::path trace{};
 };
+
+/// Checks a device as StationOptions::device takes it before the round: the driver and its
+/// settings, and that the device opens (it is closed again at once). Errors name `device`.
+Status check_device(const std::string& device);
 
 /// Which device button gives which verdict (bit i: button i; the first button is the one under
 /// the index finger on a stylus).
@@ -159,6 +168,7 @@ class Station {
   InHand in_hand_{};
   std::unique_ptr<HomeGuide> guide_;
   std::unique_ptr<controllers::HapticSession> session_;
+  std::unique_ptr<std::ofstream> trace_;  // outlives the session's stop(), which writes its last row
   ScopedConnection guide_connection_;  // the home spring on the session's force delegate
   Vec3 last_tool_pos_{};
   bool have_tool_pos_ = false;
