@@ -22,6 +22,7 @@ struct IstBuildArgs {
   std::string out;
   std::int64_t spheres = 10000;
   double voxel = 0.0;
+  double max_radius = 0.0;
   double meters_per_unit = 1.0;
   std::string preview;
   bool json = false;
@@ -97,6 +98,7 @@ int run_build(const IstBuildArgs& args) {
   ProgressBar bar("packing");
   collette::IstBuildOptions options{.sphere_count = args.spheres,
                                     .voxel_size = args.voxel,
+                                    .max_radius = args.max_radius,
                                     .meters_per_unit = args.meters_per_unit,
                                     .progress = [&bar](double f) { bar.update(f); }};
   auto built = collette::build_ist_asset(*mesh, *hash, options);
@@ -231,6 +233,12 @@ void add_ist_commands(CLI::App& app, CommandRunner& runner) {
       ->default_val(10000)
       ->check(CLI::Range(1, 10000000));
   b->add_option("--voxel", build.voxel, "distance-field voxel size in mesh units (0 = automatic)")
+      ->default_val(0.0)
+      ->check(CLI::NonNegativeNumber);
+  b->add_option(
+       "--max-radius", build.max_radius,
+       "largest sphere radius in mesh units (0 = unbounded; bounded, a thick object is as full under "
+       "its faces as on average)")
       ->default_val(0.0)
       ->check(CLI::NonNegativeNumber);
   b->add_option("--meters-per-unit", build.meters_per_unit, "length of one mesh unit in metres")

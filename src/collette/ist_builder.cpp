@@ -67,6 +67,7 @@ Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t s
   PackingOptions packing_options;
   packing_options.target_sphere_count = options.sphere_count;
   packing_options.voxel_size = options.voxel_size;
+  packing_options.max_radius = options.max_radius;
   packing_options.progress = options.progress;
   auto packing = pack_spheres(mesh, packing_options);
   if (!packing) return Error{fmt::format("{}: {}", name, packing.error().message)};

@@ -195,6 +195,10 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   if (options.target_sphere_count < 0 || options.voxel_size < 0.0 || !std::isfinite(options.voxel_size)) {
     return Error{fmt::format("{}: invalid packing options (negative sphere count or voxel size)", name)};
   }
+  if (!(options.max_radius >= 0.0 && std::isfinite(options.max_radius))) {
+    return Error{fmt::format("{}: invalid packing options (the largest sphere radius must be >= 0, got {})",
+                             name, options.max_radius)};
+  }
   const std::int64_t target = options.target_sphere_count;
   double h = options.voxel_size;
   if (h == 0.0) {
@@ -354,18 +358,25 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   std::vector<char> exact(static_cast<std::size_t>(n_interior), 0);
   std::vector<char> removed(static_cast<std::size_t>(n_interior), 0);
   BucketQueue queue(kBucketsPerVoxel / h);
-  for (std::int64_t q = 0; q < n_interior; ++q) queue.push(dsurf[static_cast<std::size_t>(q)], static_cast<std::int32_t>(q));
-
   const double min_radius = kMinRadiusInVoxels * h;
   const double margin = options.safety_margin * h;
+  // The largest radius a sphere centred `d` from the surface may have. Monotone in d, so an upper
+  // bound of d still gives an upper bound of the radius (the queue's invariant).
+  const double max_radius =
+      options.max_radius > 0.0 ? options.max_radius : std::numeric_limits<double>::infinity();
+  auto radius_bound = [&](double d) { return std::min(d, max_radius); };
+  auto radius_bound_f = [&](float d) { return static_cast<float>(radius_bound(static_cast<double>(d))); };
+  for (std::int64_t q = 0; q < n_interior; ++q)
+    queue.push(radius_bound_f(dsurf[static_cast<std::size_t>(q)]), static_cast<std::int32_t>(q));
   detail::SphereGrid sgrid(box.min, box.max, 2.0 * h);
   std::vector<Sphere> spheres;
   std::int64_t removed_count = 0;
 
   // free radius at p: exact distance to the surface and to the placed spheres within `reach`
+  // (never more than the largest radius allowed)
   auto free_at = [&](const Vec3& p, double reach, Vec3* away) {
     Vec3 qs{};
-    const double ds = std::sqrt(bvh.closest(p, &qs, reach * reach));
+    const double ds = radius_bound(std::sqrt(bvh.closest(p, &qs, reach * reach)));
     std::int32_t nid = -1;
     const double dsp = sgrid.free_radius(p, std::min(ds, reach), &nid);
     if (away != nullptr) {
@@ -385,7 +396,7 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
     const auto key = static_cast<float>(queue.upper_bound(bucket));
     const auto uid = static_cast<std::size_t>(id);
     if (removed[uid] != 0) continue;
-    const float current = std::min(dsurf[uid], fsph[uid]);
+    const float current = std::min(radius_bound_f(dsurf[uid]), fsph[uid]);
     if (static_cast<double>(current) <= min_radius) {
       removed[uid] = 1;
       ++removed_count;
@@ -402,8 +413,9 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
       const auto d = static_cast<float>(std::sqrt(bvh.closest(v)));
       if (d < dsurf[uid]) {
         dsurf[uid] = d;
-        if (queue.bucket_of(std::min(d, fsph[uid])) < bucket) {
-          queue.push(std::min(d, fsph[uid]), id);
+        const float bound = std::min(radius_bound_f(d), fsph[uid]);
+        if (queue.bucket_of(bound) < bucket) {
+          queue.push(bound, id);
           continue;
         }
       }

@@ -115,10 +115,10 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   std::vector<collette::ObjectId> object_ids;
   std::vector<double> object_coverages;
   // objects of one shape share its tree (a room repeats a few meshes): loaded once
-  std::map<std::tuple<std::string, std::string, std::int64_t, double>, ShapeTree> loaded;
+  std::map<std::tuple<std::string, std::string, std::int64_t, double, double>, ShapeTree> loaded;
   const auto load_shared = [&](const SceneShape& shape) -> Result<ShapeTree> {
-    const auto key =
-        std::make_tuple(shape.mesh.string(), shape.ist.string(), shape.spheres, shape.meters_per_unit);
+    const auto key = std::make_tuple(shape.mesh.string(), shape.ist.string(), shape.spheres,
+                                     shape.meters_per_unit, shape.max_sphere_radius);
     if (const auto it = loaded.find(key); it != loaded.end() && !shape.tree) return it->second;
     auto tree = load_shape_tree(shape, cache, options.build_progress);
     if (tree && !shape.tree) loaded.emplace(key, *tree);

@@ -167,6 +167,12 @@ Status read_shape(const FieldReader& r, const json& j, const std::string& path, 
   }
   UH_CHECK(r.integer(j, path, "spheres", shape.spheres, 1, 2'000'000));
   UH_CHECK(r.number(j, path, "meters_per_unit", shape.meters_per_unit, 1e-9, 1e6));
+  if (j.contains("max_sphere_radius")) {
+    if (!ist.empty())
+      return r.error(FieldReader::join(path, "max_sphere_radius"),
+                     "applies only when packing a 'mesh' (a .ist file is packed already)");
+    UH_CHECK(r.number(j, path, "max_sphere_radius", shape.max_sphere_radius, 1e-9, 1e6));
+  }
   return Ok{};
 }
 
@@ -426,9 +432,9 @@ Status check_material_law(const FieldReader& r, const SceneTool& tool, const std
 Status read_tool(const FieldReader& r, const json& j, const std::string& path,
                  const std::filesystem::path& base_dir, const MaterialTable& materials, SceneTool& tool) {
   UH_CHECK(r.require_object(j, path));
-  UH_CHECK(r.check_keys(
-      j, path,
-      {"name", "mesh", "ist", "spheres", "meters_per_unit", "force", "device", "workspace", "material"}));
+  UH_CHECK(r.check_keys(j, path,
+                        {"name", "mesh", "ist", "spheres", "max_sphere_radius", "meters_per_unit", "force",
+                         "device", "workspace", "material"}));
   UH_CHECK(r.string(j, path, "name", tool.name, false));
   UH_CHECK(read_shape(r, j, path, base_dir, tool.shape));
   if (const auto it = j.find("force"); it != j.end())
@@ -535,8 +541,9 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
     const json& o = (*objects)[i];
     const std::string path = fmt::format("objects[{}]", i);
     UH_CHECK(r.require_object(o, path));
-    UH_CHECK(
-        r.check_keys(o, path, {"name", "mesh", "ist", "spheres", "meters_per_unit", "pose", "material"}));
+    UH_CHECK(r.check_keys(
+        o, path,
+        {"name", "mesh", "ist", "spheres", "max_sphere_radius", "meters_per_unit", "pose", "material"}));
     SceneObject object;
     UH_CHECK(r.string(o, path, "name", object.name, true));
     for (const auto& existing : scene.objects)
@@ -651,15 +658,20 @@ Result<ShapeTree> load_shape_tree(
     std::error_code ec;
     std::filesystem::create_directories(cache_dir, ec);
     if (ec) return Error{fmt::format("{}: cannot create the cache folder: {}", cache_dir.string(), ec.message())};
+    // keyed by everything the packing depends on (the radius bound in mesh units, shortest exact form)
+    const double max_radius = shape.max_sphere_radius / shape.meters_per_unit;
+    const std::string bound = max_radius > 0.0 ? fmt::format("-r{}", max_radius) : std::string();
     const std::filesystem::path cached =
-        cache_dir / fmt::format("{}-{:016x}-{}.ist", shape.mesh.stem().string(), *hash, shape.spheres);
+        cache_dir /
+        fmt::format("{}-{:016x}-{}{}.ist", shape.mesh.stem().string(), *hash, shape.spheres, bound);
     auto loaded = collette::load_ist(cached);
     if (loaded && loaded->meta.source_mesh_hash == *hash) {
       asset = std::move(loaded).value();
     } else {
       // absent, unreadable or stale: build it again (only the cache file is replaced)
       const std::string what = fmt::format("packing {} ({} spheres)", shape.mesh.filename().string(), shape.spheres);
-      collette::IstBuildOptions options{.sphere_count = shape.spheres, .meters_per_unit = shape.meters_per_unit};
+      collette::IstBuildOptions options{
+          .sphere_count = shape.spheres, .max_radius = max_radius, .meters_per_unit = shape.meters_per_unit};
       if (progress) options.progress = [&](double f) { progress(what, f); };
       auto built = collette::build_ist_asset(shape.mesh, options);
       if (!built) return built.error();

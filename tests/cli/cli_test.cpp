@@ -842,6 +842,27 @@ TEST_F(CliTest, ExploreRecoversEveryMaterialOnAFlatPackedSlab) {
   }
 }
 
+// A 2 cm block packed with spheres of bounded radius (unbounded, its face reads 9-33 % soft).
+TEST_F(CliTest, ExploreRecoversTheStiffnessOfAThickPackedBlock) {
+  const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_block.json";
+  std::ifstream in(path);
+  const nlohmann::json scene = nlohmann::json::parse(in);
+  const double tool_radius = scene["tool"]["meters_per_unit"].get<double>();  // ball.obj has radius 1
+  for (const auto& object : scene["objects"]) {
+    ASSERT_TRUE(object.contains("max_sphere_radius")) << object;
+    const double k = object.contains("material") ? object["material"]["stiffness"].get<double>()
+                                                 : scene["tool"]["force"]["stiffness"].get<double>();
+    const std::string name = object["name"].get<std::string>();
+    const CommandRun r = uh(fmt::format("explore '{}' --object {} --json --seed 1", path.string(), name),
+                            fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json e = json_of(r)["objects"][0];
+    const double reference = 2.0 * kPi * tool_radius * k * 1e-3;  // N/mm
+    EXPECT_NEAR(e["stiffness_n_per_mm"].get<double>(), reference, 0.05 * reference) << name;
+    EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << name << ": passive";
+  }
+}
+
 TEST_F(CliTest, MuseumJudgeReportsItsVerdictsAndTheirEvidence) {
   // the artifacts' packings are kept in the build tree (built once, like the test command's other caches)
   const std::string cache = fmt::format("UH_CACHE_DIR='{}' ", UH_TEST_CACHE_DIR);

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
 
 #include "mesh_test_support.hpp"
 #include "test_paths.hpp"
@@ -168,6 +169,23 @@ TEST(SpherePacking, FillsTheOverlapOfInterpenetratingShells) {
   EXPECT_GT(in_overlap, 10);
 }
 
+TEST(SpherePacking, BoundedRadiusIsKeptEverywhere) {
+  const TriangleMesh cube = validated(test::unit_cube());
+  const auto free = pack_spheres(cube, {.target_sphere_count = 3000});
+  const auto bounded = pack_spheres(cube, {.target_sphere_count = 3000, .max_radius = 0.08});
+  ASSERT_TRUE(free && bounded) << (free ? bounded.error().message : free.error().message);
+  expect_valid_packing(cube, *bounded);
+  EXPECT_EQ(bounded->spheres.size(), 3000u);
+  for (const Sphere& s : bounded->spheres) ASSERT_LE(s.radius, 0.08f);
+  // the bound is reached (the first spheres are as large as allowed, less the safety margin)
+  EXPECT_NEAR(static_cast<double>(bounded->spheres.front().radius), 0.08, 1e-3 * 0.08);
+  EXPECT_LE(bounded->report.max_radius, 0.08);
+  EXPECT_GT(free->report.max_radius, 0.4);
+  // many equal spheres fill a cube less than one large one and its gaps, but not much less
+  EXPECT_GT(bounded->report.coverage, 0.6);
+  EXPECT_LT(bounded->report.coverage, free->report.coverage);
+}
+
 TEST(SpherePacking, RejectsBadInput) {
   TriangleMesh empty;
   empty.source_name = "nothing";
@@ -181,6 +199,8 @@ TEST(SpherePacking, RejectsBadInput) {
   const TriangleMesh cube = validated(test::unit_cube());
   EXPECT_FALSE(pack_spheres(cube, {.voxel_size = 1e-5}));  // 10^15 voxels
   EXPECT_FALSE(pack_spheres(cube, {.voxel_size = -1.0}));
+  EXPECT_FALSE(pack_spheres(cube, {.max_radius = -0.1}));
+  EXPECT_FALSE(pack_spheres(cube, {.max_radius = std::numeric_limits<double>::quiet_NaN()}));
 }
 
 TEST(SpherePacking, MaxGapMatchesBruteForceAtVertices) {

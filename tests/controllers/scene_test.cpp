@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 
@@ -78,6 +79,13 @@ TEST(Scene, ReportsFileFieldAndExpectation) {
   with_base(replaced(good, R"("haptic_hz": 1000)", R"("haptic_hz": 50000)"), "field 'rates.haptic_hz': expected a number in [1, 10000]");
   with_base(replaced(good, R"("spheres": 600)", R"("sphers": 600)"), "field 'objects[0].sphers': unknown field");
   with_base(replaced(good, R"("spheres": 600)", R"("spheres": 2.5)"), "field 'objects[0].spheres': expected a whole number");
+  with_base(replaced(good, R"("spheres": 600)", R"("spheres": 600, "max_sphere_radius": -0.001)"),
+            "field 'objects[0].max_sphere_radius': expected a number in [1e-09, 1000000], got -0.001");
+  with_base(replaced(good, R"("spheres": 600)", R"("spheres": 600, "max_sphere_radius": "small")"),
+            "field 'objects[0].max_sphere_radius': expected a number, got string");
+  with_base(replaced(good, R"("mesh": "meshes/stylus.obj",)",
+                     R"("ist": "meshes/stylus.obj", "max_sphere_radius": 0.001,)"),
+            "field 'tool.max_sphere_radius': applies only when packing a 'mesh'");
   with_base(replaced(good, R"("name": "bunny",)", ""), "field 'objects[0].name': missing");
   with_base(replaced(good, R"("rotation": [0.70710678, 0.70710678, 0, 0])", R"("rotation": [0, 0, 0, 0])"),
             "field 'objects[0].pose.rotation': expected a non-zero quaternion");
@@ -208,7 +216,7 @@ TEST(Scene, NamesTheBadFieldOfSeveralTools) {
                                        R"("devices": { "driver": "sim-line",
                 "config": { "start": [0.15)")),
             "hands.json: field 'tools[1].devices': unknown field (known here: name, mesh, ist, spheres, "
-            "meters_per_unit, force, device, workspace, material)");
+            "max_sphere_radius, meters_per_unit, force, device, workspace, material)");
 }
 
 TEST(Scene, LoadSceneNamesAMissingFile) {
@@ -286,6 +294,24 @@ TEST(Scene, ShapeTreesAreBuiltOnceThenLoadedFromTheCacheInMetres) {
   const auto third = load_shape_tree(shape, cache, [&](const std::string&, double) { ++progress_calls; });
   ASSERT_TRUE(third.has_value()) << third.error().message;
   EXPECT_GT(progress_calls, 0);
+
+  // a bound on the radius is part of the cache key: a packing of its own, every sphere within it
+  shape.max_sphere_radius = 0.002;  // [m]: 0.2 mesh units
+  progress_calls = 0;
+  const auto bounded = load_shape_tree(shape, cache, [&](const std::string&, double) { ++progress_calls; });
+  ASSERT_TRUE(bounded.has_value()) << bounded.error().message;
+  EXPECT_GT(progress_calls, 0) << "not the unbounded packing from the cache";
+  files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(cache))
+    files += entry.path().extension() == ".ist";
+  EXPECT_EQ(files, 2);
+  float largest = 0.f;
+  for (const Sphere& s : bounded->tree->leaves()) largest = std::max(largest, s.radius);
+  EXPECT_LE(largest, 0.002f * (1.f + 1e-6f));
+  EXPECT_GT(largest, 0.0019f);
+  float unbounded_largest = 0.f;
+  for (const Sphere& s : first->tree->leaves()) unbounded_largest = std::max(unbounded_largest, s.radius);
+  EXPECT_GT(unbounded_largest, 0.003f) << "the stylus is 4 mm thick: unbounded, its spheres are larger";
   std::filesystem::remove_all(cache);
 }
 

@@ -21,6 +21,7 @@ namespace uh::collette {
 struct IstBuildOptions {
   std::int64_t sphere_count = 10000;                ///< target number of leaf spheres
   double voxel_size = 0.0;                          ///< distance-field voxel [mesh units]; 0 = automatic
+  double max_radius = 0.0;                          ///< largest sphere radius [mesh units]; 0 = unbounded
   double meters_per_unit = 1.0;                     ///< stored in the asset: length of one mesh unit [m]
   MeshLoadOptions mesh{};                           ///< import and validation settings
   SphereTreeBuildOptions tree{};                    ///< hierarchy settings

@@ -24,6 +24,11 @@ struct PackingOptions {
   double safety_margin = 1e-3;
   /// Move each chosen centre continuously to grow its radius beyond what the grid allows.
   bool refine_centres = true;
+  /// Largest sphere radius [length unit of the mesh]; 0 = unbounded. Bounded, the packing is as
+  /// full under its faces as it is on average, so a pressed face feels the stiffness the law
+  /// is calibrated for (docs/collette-packing.md, "Bounded radius"); unbounded, a thick object
+  /// gets a few large spheres inside and a thinner fill under its faces.
+  double max_radius = 0.0;
   /// Surface points sampled per triangle (besides the vertices) to measure max_gap; 0 = only vertices.
   int gap_samples_per_triangle = 1;
   /// Called from the calling thread with a fraction in [0, 1] that never decreases and ends at 1.

@@ -33,6 +33,8 @@ struct SceneShape {
   /// gradient force law; 1 when unknown. Meshes and .ist files bring their own.
   double coverage = 1.0;
   std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
+  /// Largest sphere radius when packing the mesh [m]; 0 = unbounded (collette::PackingOptions::max_radius).
+  double max_sphere_radius = 0.0;
   double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
 };
 
