@@ -22,99 +22,61 @@
 #include <thread>
 #include <vector>
 
-#include <boost/asio/connect.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/websocket.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "uh/core/log.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/core/log.hpp"
+#include "uh/museum/cues.hpp"
 #include "uh/museum/level.hpp"
 #include "uh/museum/rules.hpp"
 #include "uh/museum/sighted_bot.hpp"
 #include "uh/museum_artifacts/artifact.hpp"
+#include "uh/museum_client/game_link.hpp"
 #include "uh/museum_players/blind_player.hpp"
 #include "uh/museum_service/game_server.hpp"
 
 namespace uh::cli {
 namespace {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
+using museum_client::GameEvent;
+using museum_client::GameLink;
+using museum_client::InHand;
+using museum_client::LinkNote;
+using museum_client::Snapshot;
+using museum_client::Summary;
+using museum_client::Welcome;
 using nlohmann::json;
 
-// A player's connection to the game server: blocking reads and writes on its own thread.
-class Link {
- public:
-  static Result<std::unique_ptr<Link>> open(const std::string& host, std::uint16_t port) {
-    auto link = std::unique_ptr<Link>(new Link());
-    beast::error_code ec;
-    tcp::resolver resolver(link->io_);
-    const auto endpoints = resolver.resolve(host, std::to_string(port), ec);
-    if (!ec) asio::connect(link->ws_.next_layer(), endpoints, ec);
-    if (!ec) link->ws_.handshake(host, "/ws", ec);
-    if (ec) return Error{fmt::format("cannot reach the game server at {}:{}: {}", host, port, ec.message())};
-    link->ws_.read_message_max(64u << 20);
-    return link;
-  }
-  bool send(const json& message) {
-    beast::error_code ec;
-    ws_.text(true);
-    ws_.write(asio::buffer(message.dump()), ec);
-    return !ec;
-  }
-  // the next message; nothing when the connection ended
-  std::optional<json> read() {
-    beast::flat_buffer buffer;
-    beast::error_code ec;
-    ws_.read(buffer, ec);
-    if (ec) return std::nullopt;
-    json m = json::parse(beast::buffers_to_string(buffer.data()), nullptr, false);
-    if (m.is_discarded() || !m.is_object()) return json::object();
-    return m;
-  }
-  // the welcome, or the server's error
-  Result<json> hello(const std::string& role) {
-    if (!send({{"type", "hello"}, {"protocol", museum_service::kGameProtocolVersion}, {"role", role}}))
-      return Error{"the game server closed the connection"};
-    for (;;) {
-      const auto m = read();
-      if (!m) return Error{"the game server closed the connection before welcoming " + role};
-      if ((*m)["type"] == "welcome") return *m;
-      if ((*m)["type"] == "error")
-        return Error{fmt::format("the game server refused {}: {}", role, (*m).value("message", ""))};
-    }
-  }
-  void close() {
-    beast::error_code ec;
-    ws_.close(websocket::close_code::normal, ec);
-  }
+// A bot's connection to the game server: it does not come back after a drop (the round is over
+// for it when the server goes).
+Result<std::unique_ptr<GameLink>> join(const std::string& url, const std::string& role) {
+  return GameLink::connect({.url = url, .role = role, .reconnect = false});
+}
 
- private:
-  Link() = default;
-  asio::io_context io_;
-  websocket::stream<tcp::socket> ws_{io_};
-};
-
-museum::Vec2 vec2(const json& v) { return {v.at(0).get<double>(), v.at(1).get<double>()}; }
+// The next message from the server; nothing once the connection ended. A frame that does not
+// parse was logged by the link and is passed over.
+std::optional<LinkNote> next_message(GameLink& link) {
+  LinkNote note;
+  for (;;) {
+    if (!link.wait(note, 1.0)) continue;
+    if (note.kind == LinkNote::Kind::dropped) return std::nullopt;
+    if (note.kind == LinkNote::Kind::message) return note;
+  }
+}
 
 // The shipped level the welcome describes (the bots know the museum and its guards' rounds, as a
 // player who has watched them does); the round's time as the server says.
-Result<museum::Level> level_of(const json& welcome) {
-  const json& l = welcome.at("level");
-  museum::Level level = museum::make_level(l.value("difficulty", "") == "hard" ? museum::Difficulty::hard
-                                                                              : museum::Difficulty::easy);
-  if (l.at("cases").size() != level.cases.size() || l.at("rooms").size() != level.rooms.size() ||
-      l.value("name", "") != level.name)
-    return Error{fmt::format("the server plays level '{}', which is not a shipped one; the bots know only "
-                             "the shipped museum",
-                             l.value("name", ""))};
-  level.rules.round_s = l.at("rules").at("round_s").get<double>();
+Result<museum::Level> level_of(const Welcome& welcome) {
+  museum::Level level = museum::make_level(welcome.level.difficulty);
+  if (welcome.level.cases.size() != level.cases.size() || welcome.level.rooms.size() != level.rooms.size() ||
+      welcome.level.name != level.name)
+    return Error{
+        fmt::format("the server plays level '{}', which is not a shipped one; the bots know only "
+                    "the shipped museum",
+                    welcome.level.name)};
+  level.rules.round_s = welcome.level.rules.round_s;
   return level;
 }
 
@@ -133,72 +95,68 @@ class ViveView {
  public:
   explicit ViveView(const museum::Level& level) : level_(level) {}
 
-  void heard(const json& event) {
-    const int g = event.at("guard").get<int>();
-    if (g >= 0 && g < museum::kMaxGuards) noise_[static_cast<std::size_t>(g)] = vec2(event.at("pos"));
+  void heard(const museum::Event& event) {
+    if (event.guard >= 0 && event.guard < museum::kMaxGuards)
+      noise_[static_cast<std::size_t>(event.guard)] = event.pos;
   }
 
-  const museum::GameState& update(const json& snapshot, const json& targets) {
+  const museum::GameState& update(const Snapshot& snapshot, const std::vector<std::string>& targets) {
     museum::GameState& s = state_;
-    s.tick = snapshot.at("tick").get<std::int64_t>();
-    s.time_left_s = snapshot.at("time_left_s").get<double>();
-    s.phase = snapshot.at("phase") == "ended" ? museum::Phase::ended : museum::Phase::playing;
-    s.paused = snapshot.at("phase") != "playing";
-    s.target_count = static_cast<int>(targets.size());
+    s.tick = snapshot.tick;
+    s.time_left_s = snapshot.time_left_s;
+    s.phase = snapshot.phase == "ended" ? museum::Phase::ended : museum::Phase::playing;
+    s.paused = snapshot.phase != "playing";
+    s.target_count = static_cast<int>(std::min<std::size_t>(targets.size(), museum::kMaxTargets));
     for (int t = 0; t < s.target_count; ++t)
-      s.target_kinds[static_cast<std::size_t>(t)] = kind_index(level_, targets.at(static_cast<std::size_t>(t)));
+      s.target_kinds[static_cast<std::size_t>(t)] = kind_index(level_, targets[static_cast<std::size_t>(t)]);
     s.item_count = 2 * s.target_count;
     for (int i = 0; i < s.item_count; ++i) {
       museum::ItemState& item = s.items[static_cast<std::size_t>(i)];
       item.kind = s.target_kinds[static_cast<std::size_t>(i / 2)];
       item.place = museum::ItemPlace::kept;  // judged, unless seen below
     }
-    const auto see = [&](const json& it, museum::ItemPlace place) {
-      const int i = it.at("item").get<int>();
-      if (i < 0 || i >= s.item_count) return -1;
-      s.items[static_cast<std::size_t>(i)].place = place;
-      return i;
+    const auto see = [&](const museum_client::ItemView& it, museum::ItemPlace place) {
+      if (it.item < 0 || it.item >= s.item_count) return -1;
+      s.items[static_cast<std::size_t>(it.item)].place = place;
+      return it.item;
     };
-    const json& cases = snapshot.at("cases");
-    s.case_count = static_cast<int>(std::min<std::size_t>(cases.size(), museum::kMaxCases));
+    s.case_count = static_cast<int>(std::min<std::size_t>(snapshot.cases.size(), museum::kMaxCases));
     for (int c = 0; c < s.case_count; ++c) {
-      const json& cj = cases.at(static_cast<std::size_t>(c));
-      s.case_broken[static_cast<std::size_t>(c)] = cj.at("broken").get<bool>();
+      const museum_client::CaseView& seen = snapshot.cases[static_cast<std::size_t>(c)];
+      s.case_broken[static_cast<std::size_t>(c)] = seen.broken;
       s.case_item[static_cast<std::size_t>(c)] = -1;
-      if (cj.at("item").is_null()) continue;
-      const int i = see(cj.at("item"), museum::ItemPlace::in_case);
+      const int i = see(seen.item, museum::ItemPlace::in_case);
       if (i < 0) continue;
       s.case_item[static_cast<std::size_t>(c)] = i;
       s.items[static_cast<std::size_t>(i)].case_index = c;  // where it goes back when she is caught
     }
-    const json& vive = snapshot.at("vive");
-    s.vive.pos = vec2(vive.at("pos"));
-    s.vive.facing = vec2(vive.at("facing"));
-    s.vive.running = vive.at("running").get<bool>();
-    s.vive.times_caught = vive.at("times_caught").get<int>();
+    s.vive.pos = snapshot.vive_pos;
+    s.vive.facing = snapshot.vive_facing;
+    s.vive.running = snapshot.vive_running;
+    s.vive.times_caught = snapshot.times_caught;
     s.vive.carried_count = 0;
-    for (const json& it : vive.at("carried")) {
+    for (const museum_client::ItemView& it : snapshot.carried) {
       const int i = see(it, museum::ItemPlace::carried);
       if (i >= 0 && s.vive.carried_count < museum::kMaxCarried)
         s.vive.carried[static_cast<std::size_t>(s.vive.carried_count++)] = i;
     }
     s.table_count = 0;
-    for (const json& it : snapshot.at("table")) {
+    for (const museum_client::ItemView& it : snapshot.table) {
       const int i = see(it, museum::ItemPlace::on_table);
-      if (i >= 0) s.table[static_cast<std::size_t>(s.table_count++)] = i;
+      if (i >= 0 && s.table_count < museum::kMaxItems) s.table[static_cast<std::size_t>(s.table_count++)] = i;
     }
-    const json& guards = snapshot.at("guards");
-    s.guard_count = static_cast<int>(std::min({guards.size(), level_.routes.size(),
-                                               static_cast<std::size_t>(museum::kMaxGuards)}));
-    for (int g = 0; g < s.guard_count; ++g) infer_guard(g, guards.at(static_cast<std::size_t>(g)));
+    s.guard_count = static_cast<int>(std::min(
+        {snapshot.guards.size(), level_.routes.size(), static_cast<std::size_t>(museum::kMaxGuards)}));
+    for (int g = 0; g < s.guard_count; ++g) infer_guard(g, snapshot.guards[static_cast<std::size_t>(g)]);
     return s;
   }
+  const museum::GameState& state() const { return state_; }
 
  private:
-  void infer_guard(int g, const json& gj) {
+  void infer_guard(int g, const museum_client::GuardView& seen) {
     museum::GuardState& guard = state_.guards[static_cast<std::size_t>(g)];
-    guard.pos = vec2(gj.at("pos"));
-    guard.facing = vec2(gj.at("facing"));
+    guard.pos = seen.pos;
+    guard.facing = seen.facing;
     const std::vector<museum::Vec2>& w = level_.routes[static_cast<std::size_t>(g)].waypoints;
     const int n = static_cast<int>(w.size());
     // the leg of its round nearest to where it stands
@@ -215,7 +173,7 @@ class ViveView {
         leg = i;
       }
     }
-    const std::string mode = gj.at("mode").get<std::string>();
+    const std::string& mode = seen.mode;
     const museum::GuardMode was = guard.mode;
     if (mode == "investigate") {
       guard.mode = museum::GuardMode::investigate;
@@ -242,29 +200,30 @@ class ViveView {
 };
 
 // Plays Vive with the sighted bot until the round ends or the connection does.
-Status play_vive(Link& link, const json& welcome) {
+Status play_vive(GameLink& link, const Welcome& welcome) {
   auto level = level_of(welcome);
   if (!level) return level.error();
   museum::SightedBot bot(*level);
   ViveView view(*level);
   museum::ViveInput sent{};
   for (;;) {
-    const auto m = link.read();
-    if (!m) return Ok{};
-    const std::string type = m->value("type", "");
-    if (type == "summary") return Ok{};
-    if (type == "event" && m->value("event", "") == "guard_heard") view.heard(*m);
-    if (type != "snapshot") continue;
-    const museum::GameState& s = view.update(*m, welcome.at("targets"));
+    const auto note = next_message(link);
+    if (!note || std::holds_alternative<Summary>(note->message)) return Ok{};
+    if (const auto* e = std::get_if<GameEvent>(&note->message);
+        e && e->event.type == museum::EventType::guard_heard)
+      view.heard(e->event);
+    const auto* snapshot = std::get_if<Snapshot>(&note->message);
+    if (snapshot == nullptr) continue;
+    const museum::GameState& s = view.update(*snapshot, welcome.targets);
     if (s.phase == museum::Phase::ended) continue;
     if (s.paused) continue;
     const museum::ViveInput in = bot.decide(s);
     if (museum::distance(in.move, sent.move) > 1e-3 || in.run != sent.run) {
-      link.send({{"type", "move"}, {"move", {in.move.x, in.move.y}}, {"run", in.run}});
+      link.send(museum_client::move_text(in.move, in.run));
       sent = in;
     }
     for (const auto& [wanted, name] : {std::pair{in.break_case, "break"}, {in.take, "take"}, {in.deliver, "deliver"}})
-      if (wanted) link.send({{"type", "action"}, {"action", name}});
+      if (wanted) link.send(museum_client::action_text(name));
   }
 }
 
@@ -279,22 +238,17 @@ struct BlindVerdict {
 // Plays Phantom with the blind bot: first it explores the genuine reference of each target twice;
 // then each piece that comes into its hands (in_hands) is put under a simulated device, explored
 // and judged against the reference of its kind; only the device's trace decides.
-Status play_phantom(const std::string& host, std::uint16_t port, std::uint64_t seed,
-                    std::vector<BlindVerdict>& verdicts, std::mutex& verdicts_mutex, bool announce) {
+Status play_phantom(const std::string& url, std::uint64_t seed, std::vector<BlindVerdict>& verdicts,
+                    std::mutex& verdicts_mutex, bool announce) {
   // first a look at the round as a watcher: which targets to study
-  json welcome;
+  Welcome welcome;
   {
-    auto watcher = Link::open(host, port);
+    auto watcher = join(url, "watcher");
     if (!watcher) return watcher.error();
-    auto w = (*watcher)->hello("watcher");
-    if (!w) return w.error();
-    welcome = std::move(*w);
-    (*watcher)->close();
+    welcome = (*watcher)->welcome();
   }
   using museum_artifacts::Piece;
-  const museum::Difficulty difficulty = welcome.at("level").value("difficulty", "") == "hard"
-                                            ? museum::Difficulty::hard
-                                            : museum::Difficulty::easy;
+  const museum::Difficulty difficulty = welcome.level.difficulty;
   const std::filesystem::path cache = controllers::default_cache_dir();
   std::uint64_t deal = seed * 0x9E3779B97F4A7C15ull + 17;
   const auto uniform = [&deal] {
@@ -328,54 +282,50 @@ Status play_phantom(const std::string& host, std::uint16_t port, std::uint64_t s
   };
   // Phantom studies the genuine pieces of Falcon's targets before taking its seat: the round
   // starts when it says hello as Phantom (the game clock does not run meanwhile)
-  for (const json& target : welcome.at("targets"))
-    if (const auto kind = museum_artifacts::artifact_kind(target.get<std::string>()))
+  for (const std::string& target : welcome.targets)
+    if (const auto kind = museum_artifacts::artifact_kind(target))
       if (const Status studied = study(*kind); !studied) return studied;
-  auto opened = Link::open(host, port);
-  if (!opened) return opened.error();
-  Link& link = **opened;
-  if (auto w = link.hello("phantom"); !w) return w.error();
+  auto joined = join(url, "phantom");
+  if (!joined) return joined.error();
+  GameLink& link = **joined;
   if (announce) {
     std::printf("uh museum play: Phantom is at the table\n");
     std::fflush(stdout);
   }
   for (;;) {
-    const auto m = link.read();
-    if (!m) return Ok{};
-    const std::string type = m->value("type", "");
-    if (type == "summary") return Ok{};
-    if (type != "in_hands") continue;
-    const int item = m->at("item").get<int>();
-    const std::string kind_name = m->at("kind").get<std::string>();
+    const auto note = next_message(link);
+    if (!note || std::holds_alternative<Summary>(note->message)) return Ok{};
+    const auto* in_hands = std::get_if<InHand>(&note->message);
+    if (in_hands == nullptr || in_hands->item < 0) continue;
+    const int item = in_hands->item;
+    const std::string& kind_name = in_hands->kind;
     const auto kind = museum_artifacts::artifact_kind(kind_name);
     if (!kind) return Error{fmt::format("the server handed Phantom a '{}', which is no artifact kind", kind_name)};
     if (const Status studied = study(*kind); !studied) return studied;
     // the piece under the device: the server says which (as the station loads it); the bot's
     // verdict reads only the trace of exploring it
-    auto survey = explore(*kind, m->value("piece", "") == "genuine" ? Piece::genuine : Piece::forgery, true);
+    auto survey = explore(*kind, in_hands->piece, true);
     if (!survey) return survey.error();
     const auto& [reference, again] = references.at(kind_name);
     BlindVerdict v{.item = item,
                    .kind = kind_name,
                    .judgement = museum_players::judge_piece(*survey, reference, again),
                    .simulated_s = survey->simulated_s};
-    link.send({{"type", "verdict"}, {"item", item}, {"verdict", museum_players::to_string(v.judgement.verdict)}});
+    link.send(museum_client::verdict_text(item, v.judgement.verdict == museum_players::Verdict::genuine
+                                                    ? museum::Verdict::genuine
+                                                    : museum::Verdict::forgery));
     const std::lock_guard lock(verdicts_mutex);
     verdicts.push_back(std::move(v));
   }
 }
 
-// One bot's round on the server at host:port.
-Status play_bot(const std::string& role, const std::string& host, std::uint16_t port, std::uint64_t seed,
+// One bot's round on the server at `url`.
+Status play_bot(const std::string& role, const std::string& url, std::uint64_t seed,
                 std::vector<BlindVerdict>& verdicts, std::mutex& verdicts_mutex, bool announce) {
-  if (role == "phantom") return play_phantom(host, port, seed, verdicts, verdicts_mutex, announce);
-  auto link = Link::open(host, port);
+  if (role == "phantom") return play_phantom(url, seed, verdicts, verdicts_mutex, announce);
+  auto link = join(url, role);
   if (!link) return link.error();
-  auto welcome = (*link)->hello(role);
-  if (!welcome) return welcome.error();
-  Status played = play_vive(**link, *welcome);
-  (*link)->close();
-  return played;
+  return play_vive(**link, (*link)->welcome());
 }
 
 struct MuseumPlayArgs {
@@ -394,56 +344,15 @@ std::string clock_of(double seconds_left) {
   return fmt::format("{}:{:02}", s / 60, s % 60);
 }
 
-// A line for an event, as the watcher reads it.
-std::string describe_event(const json& e, const json& welcome) {
-  const std::string what = e.value("event", "");
-  const auto kind_of = [&](int item) {
-    const json& targets = welcome.at("targets");
-    return item >= 0 && static_cast<std::size_t>(item / 2) < targets.size()
-               ? targets.at(static_cast<std::size_t>(item / 2)).get<std::string>()
-               : std::string("artifact");
-  };
-  if (what == "case_broken")
-    return fmt::format("Vive broke case {} (heard within {:.0f} m)", e.value("case", -1), e.value("radius", 0.0));
-  if (what == "case_empty") return fmt::format("case {} was empty", e.value("case", -1));
-  if (what == "item_taken")
-    return fmt::format("Vive took the {} (item {})", kind_of(e.value("item", -1)), e.value("item", -1));
-  if (what == "items_delivered") return fmt::format("Vive delivered {} to Phantom's table", e.value("count", 0));
-  if (what == "guard_heard") return fmt::format("guard {} heard a noise", e.value("guard", -1));
-  if (what == "vive_caught")
-    return fmt::format("guard {} caught Vive ({} carried lost)", e.value("guard", -1), e.value("items_lost", 0));
-  if (what == "verdict")
-    return fmt::format("Phantom judged the {} (item {}): {}", kind_of(e.value("item", -1)), e.value("item", -1),
-                       e.value("verdict", ""));
-  if (what == "time_warning") return fmt::format("{} s left", e.value("seconds_left", 0));
-  if (what == "round_ended") return "the round ended";
-  return what;
-}
-
-std::pair<std::string, int> split_server(const std::string& url) {
-  std::string rest = url;
-  for (const char* scheme : {"ws://", "http://"})
-    if (rest.rfind(scheme, 0) == 0) rest = rest.substr(std::string(scheme).size());
-  rest = rest.substr(0, rest.find('/'));
-  const auto colon = rest.rfind(':');
-  if (colon == std::string::npos) return {rest, 7780};
-  try {
-    return {rest.substr(0, colon), std::stoi(rest.substr(colon + 1))};
-  } catch (const std::exception&) {
-    return {rest, -1};
-  }
-}
-
 // One bot joining a running server (e.g. Phantom against Vive in a browser).
 int museum_play_one(const MuseumPlayArgs& args) {
-  const auto [host, port] = split_server(args.server);
-  if (port <= 0 || port > 65535)
-    return fail(fmt::format("--server '{}': expected ws://HOST:PORT/ws or http://HOST:PORT/", args.server));
+  if (auto address = museum_client::parse_server_url(args.server); !address)
+    return fail("--" + address.error().message);
   std::printf("uh museum play: the %s bot joins %s\n", args.bot.c_str(), args.server.c_str());
   std::fflush(stdout);
   std::vector<BlindVerdict> verdicts;
   std::mutex verdicts_mutex;
-  const Status played = play_bot(args.bot, host, static_cast<std::uint16_t>(port), args.seed, verdicts, verdicts_mutex, true);
+  const Status played = play_bot(args.bot, args.server, args.seed, verdicts, verdicts_mutex, true);
   if (!played) return fail(played.error().message);
   for (const BlindVerdict& v : verdicts)
     std::printf("uh museum play: judged the %s (item %d): %s\n", v.kind.c_str(), v.item,
@@ -486,17 +395,17 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   std::fflush(stdout);
 
   // the watcher: what is printed
-  auto watcher = Link::open("127.0.0.1", port);
+  const std::string url = fmt::format("ws://127.0.0.1:{}/ws", port);
+  auto watcher = join(url, "watcher");
   if (!watcher) return fail(watcher.error().message);
-  auto welcome = (*watcher)->hello("watcher");
-  if (!welcome) return fail(welcome.error().message);
+  const Welcome& welcome = (*watcher)->welcome();
 
   std::vector<BlindVerdict> verdicts;
   std::mutex verdicts_mutex;
   std::mutex failure_mutex;
   std::string failure;  // the first bot's error
   const auto run_bot = [&](const std::string& role) {
-    const Status played = play_bot(role, "127.0.0.1", port, args.seed, verdicts, verdicts_mutex, !args.json);
+    const Status played = play_bot(role, url, args.seed, verdicts, verdicts_mutex, !args.json);
     if (!played) {
       {
         const std::lock_guard lock(failure_mutex);
@@ -508,45 +417,57 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   std::thread vive([&] { run_bot("vive"); });
   std::thread phantom([&] { run_bot("phantom"); });
 
-  json summary;
+  std::optional<Summary> summary;
+  std::string summary_text;  // the summary as the server wrote it, for --json
   json event_counts = json::object();
   double time_left = level.rules.round_s;
+  ViveView seen(level);  // the round as the watcher sees it: names the pieces in the lines
   for (;;) {
-    const auto m = (*watcher)->read();
-    if (!m) break;
-    const std::string type = m->value("type", "");
-    if (type == "snapshot") time_left = m->value("time_left_s", time_left);
-    if (type == "event") event_counts[m->value("event", "")] = event_counts.value(m->value("event", ""), 0) + 1;
-    if (type == "event" && !args.json)
-      std::printf("[%s left] %s\n", clock_of(time_left).c_str(), describe_event(*m, *welcome).c_str());
-    if (type == "summary") {
-      summary = *m;
+    auto note = next_message(**watcher);
+    if (!note) break;
+    if (const auto* s = std::get_if<Snapshot>(&note->message)) {
+      time_left = s->time_left_s;
+      seen.update(*s, welcome.targets);
+    }
+    if (const auto* e = std::get_if<GameEvent>(&note->message)) {
+      const std::string name = museum::to_string(e->event.type);
+      event_counts[name] = event_counts.value(name, 0) + 1;
+      if (e->event.type == museum::EventType::guard_heard) seen.heard(e->event);
+      if (!args.json)
+        std::printf("[%s left] %s\n", clock_of(time_left).c_str(),
+                    museum::describe(e->event, level, seen.state()).caption.c_str());
+    }
+    if (const auto* s = std::get_if<Summary>(&note->message)) {
+      summary = *s;
+      summary_text = std::move(note->text);
       break;
     }
     std::fflush(stdout);
   }
   vive.join();
   phantom.join();
-  (*watcher)->close();
+  (*watcher)->stop();
   (*server)->stop();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!failure.empty()) return fail(failure);
-  if (summary.is_null()) return fail("the round did not end: the server closed the connection first");
+  if (!summary) return fail("the round did not end: the server closed the connection first");
 
-  const json& score = summary.at("score");
   if (args.json) {
-    json out{{"level", args.level}, {"seed", args.seed}, {"speed", args.speed}, {"wall_s", wall_s},
-             {"summary", summary},  {"events", event_counts}, {"verdicts", json::array()}};
+    json out{{"level", args.level},
+             {"seed", args.seed},
+             {"speed", args.speed},
+             {"wall_s", wall_s},
+             {"summary", json::parse(summary_text, nullptr, false)},  // the link parsed it already
+             {"events", event_counts},
+             {"verdicts", json::array()}};
     for (const BlindVerdict& v : verdicts) out["verdicts"].push_back(verdict_json(v));
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }
   std::printf("uh museum play: the round ended%s after %.0f s of game time (%.0f s on the clock)\n",
-              summary.value("ended_early", false) ? " early, every target settled," : "",
-              summary.value("seconds_played", 0.0), wall_s);
-  for (const json& t : summary.at("targets"))
-    std::printf("  %-8s genuine: %-8s forgery: %s\n", t.value("kind", "").c_str(), t.value("genuine", "").c_str(),
-                t.value("forgery", "").c_str());
+              summary->ended_early ? " early, every target settled," : "", summary->seconds_played, wall_s);
+  for (const museum_client::TargetView& t : summary->targets)
+    std::printf("  %-8s genuine: %-8s forgery: %s\n", t.kind.c_str(), t.genuine.c_str(), t.forgery.c_str());
   for (const BlindVerdict& v : verdicts) {
     const auto& e = v.judgement.evidence;
     std::printf("  Phantom on the %s (item %d): %s, from %.0f s of touch%s\n", v.kind.c_str(), v.item,
@@ -556,11 +477,11 @@ int museum_play_bots(const MuseumPlayArgs& args) {
                                         e.front().difference, e.front().unit, e.front().threshold)
                                 .c_str());
   }
-  std::printf("score %d: %d genuine kept, %d forgeries kept, %d genuine put aside, %d forgeries put aside, "
-              "time bonus %d; caught %d times\n",
-              score.value("points", 0), score.value("genuine_kept", 0), score.value("forgeries_kept", 0),
-              score.value("genuine_rejected", 0), score.value("forgeries_rejected", 0), score.value("time_bonus", 0),
-              summary.value("times_caught", 0));
+  std::printf(
+      "score %d: %d genuine kept, %d forgeries kept, %d genuine put aside, %d forgeries put aside, "
+      "time bonus %d; caught %d times\n",
+      summary->points, summary->genuine_kept, summary->forgeries_kept, summary->genuine_rejected,
+      summary->forgeries_rejected, summary->time_bonus, summary->times_caught);
   return 0;
 }
 

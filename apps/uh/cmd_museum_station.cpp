@@ -17,7 +17,7 @@
 
 #include "commands.hpp"
 #include "progress_bar.hpp"
-#include "uh/museum_station/game_link.hpp"
+#include "uh/museum_client/game_link.hpp"
 #include "uh/museum_station/station.hpp"
 
 namespace uh::cli {
@@ -81,7 +81,7 @@ constexpr const char* kKeysHelp =
 int museum_station_run(const StationArgs& args) {
   // a bad address or device is said before anything connects (the device is opened once and
   // closed: a selector naming no device fails now, not when the first piece comes)
-  if (auto address = museum_station::parse_server_url(args.server); !address)
+  if (auto address = museum_client::parse_server_url(args.server); !address)
     return fail("--" + address.error().message);
   if (Status device = museum_station::check_device(args.device); !device) return fail(device.error().message);
   auto link = museum_station::GameLink::connect({.url = args.server, .token = args.token});

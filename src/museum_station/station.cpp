@@ -12,6 +12,11 @@
 #include "uh/museum_artifacts/artifact.hpp"
 
 namespace uh::museum_station {
+
+using museum_client::GuardView;
+using museum_client::ServerError;
+using museum_client::verdict_text;
+
 namespace {
 
 constexpr double kStylusRadiusM = 0.004;  // the stylus: a 4 mm ball, as the automated player's
@@ -180,7 +185,7 @@ void Station::on_snapshot(const Snapshot& s) {
   const bool was_playing = have_snapshot_ && last_snapshot_.phase == "playing";
   last_snapshot_ = s;
   have_snapshot_ = true;
-  remember_items(s.cases);
+  for (const museum_client::CaseView& c : s.cases) remember_items({c.item});
   remember_items(s.carried);
   remember_items(s.table);
   view_.table_count = 0;

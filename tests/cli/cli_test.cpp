@@ -943,7 +943,13 @@ TEST_F(CliTest, MuseumPlayBotsPlaysARoundToItsSummary) {
   EXPECT_NE(alone.err.find("give --bots, or --bot vive|phantom with --server URL"), std::string::npos) << alone.err;
   const CommandRun nobody = uh("museum play --bot phantom --server ws://127.0.0.1:1/ws");
   EXPECT_NE(nobody.exit_code, 0);
-  EXPECT_NE(nobody.err.find("cannot reach the game server at 127.0.0.1:1"), std::string::npos) << nobody.err;
+  EXPECT_NE(nobody.err.find("museum server at ws://127.0.0.1:1/ws: cannot reach the server"),
+            std::string::npos)
+      << nobody.err;
+  const CommandRun nowhere = uh("museum play --bot vive --server ftp://127.0.0.1:7780/");
+  EXPECT_NE(nowhere.exit_code, 0);
+  EXPECT_NE(nowhere.err.find("--server 'ftp://127.0.0.1:7780/': the address must be"), std::string::npos)
+      << nowhere.err;
 }
 
 TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {

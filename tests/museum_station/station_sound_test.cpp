@@ -147,7 +147,7 @@ TEST(StationCues, EveryEventTypeHasAnEarconASpokenTextAndACaption) {
   sound.set_volume(audio::Channel::speech, 0.0);
   Snapshot s;
   s.phase = "playing";
-  s.cases = {{0, "bowl"}, {1, "bowl"}};
+  s.cases = {{.item = {0, "bowl"}}, {.item = {1, "bowl"}}};
   s.carried = {{0, "bowl"}};
   (*station)->handle({.message = s});
   std::set<std::string> lines;

@@ -24,10 +24,21 @@
 #include "uh/core/result.hpp"
 #include "uh/museum/cues.hpp"
 #include "uh/museum/game_state.hpp"
-#include "uh/museum_station/game_link.hpp"
+#include "uh/museum_client/game_link.hpp"
 #include "uh/museum_station/station_sound.hpp"
 
 namespace uh::museum_station {
+
+// the server's messages and the connection, as every client of the game server has them
+using museum_client::GameEvent;
+using museum_client::GameLink;
+using museum_client::InHand;
+using museum_client::ItemView;
+using museum_client::LinkNote;
+using museum_client::ServerMessage;
+using museum_client::Snapshot;
+using museum_client::Summary;
+using museum_client::Welcome;
 
 /// The home spring: beyond `free_radius_m` from home the stylus is pulled back with a soft spring
 /// whose force never exceeds `max_force_n` (and then passes the session's limit chain like every

@@ -1,4 +1,4 @@
-#include "uh/museum_station/server_messages.hpp"
+#include "uh/museum_client/server_messages.hpp"
 
 #include <cmath>
 #include <limits>
@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-namespace uh::museum_station {
+namespace uh::museum_client {
 namespace {
 
 using nlohmann::json;
@@ -38,6 +38,12 @@ class Reader {
       return fail(path + name, "must be an integer"), 0;
     return static_cast<int>(f->get<std::int64_t>());
   }
+  bool boolean(const json& j, const char* name, const std::string& path = "") {
+    const json* f = field(j, name, path);
+    if (f == nullptr) return false;
+    if (!f->is_boolean()) return fail(path + name, "must be true or false"), false;
+    return f->get<bool>();
+  }
   std::string text(const json& j, const char* name, const std::string& path = "") {
     const json* f = field(j, name, path);
     if (f == nullptr) return {};
@@ -66,11 +72,12 @@ class Reader {
     if (j.is_null()) return {};
     return {integer(j, "item", path + "."), text(j, "kind", path + ".")};
   }
-  std::vector<ItemView> items(const json& j, const char* name) {
+  std::vector<ItemView> items(const json& j, const char* name, const std::string& path = "") {
     std::vector<ItemView> out;
-    const json* a = array(j, name);
+    const json* a = array(j, name, path);
     if (a == nullptr) return out;
-    for (std::size_t i = 0; i < a->size(); ++i) out.push_back(item((*a)[i], fmt::format("{}[{}]", name, i)));
+    for (std::size_t i = 0; i < a->size(); ++i)
+      out.push_back(item((*a)[i], fmt::format("{}{}[{}]", path, name, i)));
     return out;
   }
 
@@ -143,7 +150,9 @@ Result<ServerMessage> parse_snapshot(const json& m, Reader& r) {
   if (const json* vive = r.field(m, "vive", "")) {
     s.vive_pos = r.xy(*vive, "pos", "vive.");
     s.vive_facing = r.xy(*vive, "facing", "vive.");
-    if (r.error.empty()) s.carried = r.items(*vive, "carried");
+    s.vive_running = r.boolean(*vive, "running", "vive.");
+    s.times_caught = r.integer(*vive, "times_caught", "vive.");
+    if (r.error.empty()) s.carried = r.items(*vive, "carried", "vive.");
   }
   if (const json* guards = r.array(m, "guards")) {
     for (std::size_t i = 0; i < guards->size(); ++i) {
@@ -154,8 +163,10 @@ Result<ServerMessage> parse_snapshot(const json& m, Reader& r) {
   }
   if (const json* cases = r.array(m, "cases")) {
     for (std::size_t i = 0; i < cases->size(); ++i) {
-      const json* held = r.field((*cases)[i], "item", fmt::format("cases[{}].", i));
-      s.cases.push_back(held != nullptr ? r.item(*held, fmt::format("cases[{}].item", i)) : ItemView{});
+      const std::string path = fmt::format("cases[{}].", i);
+      CaseView c{.broken = r.boolean((*cases)[i], "broken", path)};
+      if (const json* held = r.field((*cases)[i], "item", path)) c.item = r.item(*held, path + "item");
+      s.cases.push_back(c);
     }
   }
   s.table = r.items(m, "table");
@@ -169,7 +180,7 @@ Result<ServerMessage> parse_event(const json& m, Reader& r) {
   if (!r.error.empty()) return Error{r.error};
   bool known = false;
   museum::Event e{.type = event_type(name, known)};
-  if (!known) return Error{fmt::format("'event' is '{}', which this station does not know", name)};
+  if (!known) return Error{fmt::format("'event' is '{}', which this client does not know", name)};
   using museum::EventType;
   switch (e.type) {
     case EventType::case_broken:
@@ -240,6 +251,16 @@ Result<ServerMessage> parse_summary(const json& m, Reader& r) {
     s.forgeries_rejected = r.integer(*score, "forgeries_rejected", "score.");
     s.time_bonus = r.integer(*score, "time_bonus", "score.");
   }
+  if (const json* targets = r.array(m, "targets")) {
+    for (std::size_t i = 0; i < targets->size(); ++i) {
+      const std::string path = fmt::format("targets[{}].", i);
+      const json& t = (*targets)[i];
+      s.targets.push_back({r.text(t, "kind", path), r.text(t, "genuine", path), r.text(t, "forgery", path)});
+    }
+  }
+  s.times_caught = r.integer(m, "times_caught");
+  s.seconds_played = r.number(m, "seconds_played");
+  s.ended_early = r.boolean(m, "ended_early");
   if (!r.error.empty()) return Error{r.error};
   return ServerMessage{s};
 }
@@ -267,11 +288,11 @@ Result<ServerMessage> parse_server_message(std::string_view text) {
     return ServerMessage{e};
   }
   if (type == "pong") return ServerMessage{Ignored{type}};
-  return Error{fmt::format("'type' is '{}', which this station does not know", type)};
+  return Error{fmt::format("'type' is '{}', which this client does not know", type)};
 }
 
-std::string hello_text(std::string_view token) {
-  json hello = {{"type", "hello"}, {"protocol", 1}, {"role", "phantom"}};
+std::string hello_text(std::string_view role, std::string_view token) {
+  json hello = {{"type", "hello"}, {"protocol", 1}, {"role", std::string(role)}};
   if (!token.empty()) hello["token"] = std::string(token);
   return hello.dump();
 }
@@ -280,4 +301,12 @@ std::string verdict_text(int item, museum::Verdict verdict) {
   return json{{"type", "verdict"}, {"item", item}, {"verdict", museum::to_string(verdict)}}.dump();
 }
 
-}  // namespace uh::museum_station
+std::string move_text(museum::Vec2 move, bool run) {
+  return json{{"type", "move"}, {"move", {move.x, move.y}}, {"run", run}}.dump();
+}
+
+std::string action_text(std::string_view action) {
+  return json{{"type", "action"}, {"action", std::string(action)}}.dump();
+}
+
+}  // namespace uh::museum_client

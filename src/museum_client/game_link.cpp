@@ -1,4 +1,4 @@
-#include "uh/museum_station/game_link.hpp"
+#include "uh/museum_client/game_link.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -15,7 +15,7 @@
 #include "uh/core/log.hpp"
 #include "uh/core/spsc_queue.hpp"
 
-namespace uh::museum_station {
+namespace uh::museum_client {
 namespace {
 
 namespace asio = boost::asio;
@@ -62,6 +62,7 @@ struct GameLink::Impl {
   asio::steady_timer retry_timer;
   beast::flat_buffer buffer;
   std::deque<std::string> writing;  // the network thread's: frames being written, in order
+  std::deque<LinkNote> backlog;     // the network thread's: notes the owner had no room for yet
   bool write_busy = false;
   bool ever_connected = false;
   bool told_dropped = false;
@@ -72,9 +73,16 @@ struct GameLink::Impl {
   std::atomic<bool> up{false};
   std::thread thread;
 
+  // Hands a note to the owner. When the owner lags a snapshot is dropped (the next one is newer);
+  // every other note waits in the backlog, in order.
   void note(LinkNote n) {
-    if (!inbox.try_push(std::move(n)))
-      log::warn("museum station: the station is not reading; a note was dropped");
+    flush_backlog();
+    if (backlog.empty() && inbox.try_push(std::move(n))) return;
+    if (n.kind == LinkNote::Kind::message && std::holds_alternative<Snapshot>(n.message)) return;
+    backlog.push_back(std::move(n));
+  }
+  void flush_backlog() {
+    while (!backlog.empty() && inbox.try_push(std::move(backlog.front()))) backlog.pop_front();
   }
 
   void open() {
@@ -106,20 +114,20 @@ struct GameLink::Impl {
     writing.clear();
     write_busy = false;
     ws->text(true);
-    write(hello_text(options.token));
+    write(hello_text(options.role, options.token));
     read();
   }
 
   void read() {
     ws->async_read(buffer, [this](beast::error_code ec, std::size_t) {
       if (ec) return lost(ec, "the connection to the server ended");
-      const std::string text = beast::buffers_to_string(buffer.data());
+      std::string text = beast::buffers_to_string(buffer.data());
       buffer.consume(buffer.size());
       auto parsed = parse_server_message(text);
       if (parsed) {
-        note({.kind = LinkNote::Kind::message, .message = std::move(*parsed)});
+        note({.kind = LinkNote::Kind::message, .message = std::move(*parsed), .text = std::move(text)});
       } else {
-        log::warn("museum station: ignored a message from the server: {}", parsed.error().message);
+        log::warn("museum {}: ignored a message from the server: {}", options.role, parsed.error().message);
         note({.kind = LinkNote::Kind::bad_message, .text = parsed.error().message});
       }
       read();
@@ -154,6 +162,7 @@ struct GameLink::Impl {
       beast::error_code ignored;
       beast::get_lowest_layer(*ws).socket().close(ignored);
     }
+    if (!options.reconnect) return;
     retry_timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(options.retry_s)));
     retry_timer.async_wait([this](beast::error_code e) {
@@ -174,6 +183,7 @@ struct GameLink::Impl {
         io.stop();
         return;
       }
+      flush_backlog();
       std::string text;
       while (outbox.try_pop(text))
         if (up.load()) write(std::move(text));  // a verdict while away is dropped: the station gives it again
@@ -214,7 +224,8 @@ Result<std::unique_ptr<GameLink>> GameLink::connect(const LinkOptions& options) 
     if (n.kind != LinkNote::Kind::message) continue;
     if (const auto* e = std::get_if<ServerError>(&n.message)) {
       if (e->request == "hello" || e->request.empty())
-        return Error{fmt::format("museum server at {} refused this station: {}{}", options.url, e->message,
+        return Error{fmt::format("museum server at {} refused {}: {}{}", options.url, options.role,
+                                 e->message,
                                  e->message.find("token") != std::string::npos ? " (give --token)" : "")};
       continue;
     }
@@ -229,6 +240,17 @@ Result<std::unique_ptr<GameLink>> GameLink::connect(const LinkOptions& options) 
 
 bool GameLink::poll(LinkNote& out) { return impl_->inbox.try_pop(out); }
 
+bool GameLink::wait(LinkNote& out, double limit_s) {
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(limit_s));
+  for (;;) {
+    if (impl_->inbox.try_pop(out)) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+}
+
 bool GameLink::send(std::string text) { return impl_->outbox.try_push(std::move(text)); }
 
 bool GameLink::connected() const { return impl_->up.load(); }
@@ -239,4 +261,4 @@ void GameLink::stop() {
   impl_->thread.join();
 }
 
-}  // namespace uh::museum_station
+}  // namespace uh::museum_client

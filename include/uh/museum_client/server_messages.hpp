@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// What the museum server tells Phantom's station (the messages of docs/museum.md, protocol 1),
-/// parsed into plain data. A message that does not parse is an error naming the field; the station
-/// logs it and carries on.
+/// What the museum server tells its clients (the messages of docs/museum.md, protocol 1), parsed
+/// into plain data, and what they say to it. A message that does not parse is an error naming the
+/// field (never an exception); GameLink logs it and carries on.
 
 #include <cstdint>
 #include <string>
@@ -15,7 +15,7 @@
 #include "uh/museum/rules.hpp"
 #include "uh/museum_artifacts/artifact.hpp"
 
-namespace uh::museum_station {
+namespace uh::museum_client {
 
 /// An artifact as clients see it: its index in the round and its kind's name.
 struct ItemView {
@@ -36,16 +36,25 @@ struct GuardView {
   std::string mode{};
 };
 
-/// `snapshot`: what the station needs of it.
+/// A display case as clients see it.
+struct CaseView {
+  bool broken = false;
+  ItemView item{};  ///< what it holds (item -1: nothing)
+};
+
+/// `snapshot`: what Vive sees (the players' connections and the targets are left out: the welcome
+/// has the targets).
 struct Snapshot {
   std::int64_t tick = 0;
   double time_left_s = 0.0;
   std::string phase{};  ///< waiting, playing, paused or ended
   museum::Vec2 vive_pos{};
   museum::Vec2 vive_facing{1.0, 0.0};
+  bool vive_running = false;
+  int times_caught = 0;
   std::vector<ItemView> carried{};
   std::vector<GuardView> guards{};
-  std::vector<ItemView> cases{};  ///< per case: what it holds (item -1: nothing)
+  std::vector<CaseView> cases{};
   std::vector<ItemView> table{};  ///< in the order Phantom judges them
   int judged = 0;
 };
@@ -63,6 +72,14 @@ struct InHand {
   museum_artifacts::Piece piece = museum_artifacts::Piece::genuine;
 };
 
+/// Where a target's two pieces ended (`kept`, `rejected`, `in_case`, ... as museum::to_string
+/// names a museum::ItemPlace).
+struct TargetView {
+  std::string kind{};
+  std::string genuine{};
+  std::string forgery{};
+};
+
 /// `summary`: the end of the round.
 struct Summary {
   int points = 0;
@@ -71,6 +88,10 @@ struct Summary {
   int genuine_rejected = 0;
   int forgeries_rejected = 0;
   int time_bonus = 0;
+  std::vector<TargetView> targets{};
+  int times_caught = 0;
+  double seconds_played = 0.0;
+  bool ended_early = false;  ///< every target settled before the time ran out
 };
 
 /// `error`: a request the server refused.
@@ -79,7 +100,7 @@ struct ServerError {
   std::string message{};
 };
 
-/// `pong` and anything else the station does not act on.
+/// `pong` and anything else a client does not act on.
 struct Ignored {
   std::string type{};
 };
@@ -89,8 +110,11 @@ using ServerMessage = std::variant<Welcome, Snapshot, GameEvent, InHand, Summary
 /// Parses one text frame. Errors name the field and what is wrong (the frame is then ignored).
 Result<ServerMessage> parse_server_message(std::string_view text);
 
-/// The JSON text of Phantom's hello and of a verdict.
-std::string hello_text(std::string_view token);
+/// The JSON text of a hello in `role` (vive, phantom or watcher), of Phantom's verdict and of
+/// Vive's move (`move`: the direction, at most unit length) and actions (break, take, deliver).
+std::string hello_text(std::string_view role, std::string_view token);
 std::string verdict_text(int item, museum::Verdict verdict);
+std::string move_text(museum::Vec2 move, bool run);
+std::string action_text(std::string_view action);
 
-}  // namespace uh::museum_station
+}  // namespace uh::museum_client
