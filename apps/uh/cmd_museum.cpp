@@ -71,8 +71,11 @@ museum::Difficulty difficulty_named(const std::string& level) {
 }
 
 nlohmann::json evidence_json(const museum_players::FeatureDifference& f) {
-  return {{"feature", f.feature},     {"where", f.where}, {"difference", f.difference}, {"noise", f.noise},
-          {"threshold", f.threshold}, {"unit", f.unit},   {"differs", f.differs()}};
+  nlohmann::json j = {{"feature", f.feature},  {"where", f.where},         {"difference", f.difference},
+                      {"noise", f.noise},      {"threshold", f.threshold}, {"unit", f.unit},
+                      {"differs", f.differs()}};
+  if (f.p_value) j["p_value"] = *f.p_value;
+  return j;
 }
 
 int museum_judge(const MuseumJudgeArgs& args) {
@@ -129,9 +132,10 @@ int museum_judge(const MuseumJudgeArgs& args) {
       std::string evidence;
       for (const auto& f : p.judgement.evidence) {
         if (!evidence.empty()) evidence += "; ";
-        evidence += fmt::format("{}{} {:.2f}{} (threshold {:.2f}{}){}", f.feature,
+        evidence += fmt::format("{}{} {:.2f}{} (threshold {:.2f}{}{}){}", f.feature,
                                 f.where.empty() ? "" : " (" + f.where + ")", f.difference, f.unit,
-                                f.threshold, f.unit, f.differs() ? " DIFFERS" : "");
+                                f.threshold, f.unit, f.p_value ? fmt::format(", p {:.2g}", *f.p_value) : "",
+                                f.differs() ? " DIFFERS" : "");
       }
       std::printf("  %-8s %-8s -> %-8s %s  %s\n", museum_artifacts::to_string(pair.kind),
                   museum_artifacts::to_string(p.truth), museum_players::to_string(p.judgement.verdict),

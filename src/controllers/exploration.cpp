@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/statistics.hpp"
 #include "uh/haptico/device_registry.hpp"
 #include "uh/haptico/simulated_device.hpp"
 
@@ -482,13 +483,6 @@ double touch_slope(const std::vector<double>& s, const std::vector<double>& f) {
   return slope > 0.0 ? slope : fit_line(s, f).slope;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // The samples of one sliding stretch with, for each, the distance travelled, the motion
 // direction (over about a millimetre of path) and the force split into normal and tangential parts
 struct Slide {
@@ -811,7 +805,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
       if (depth.size() >= 10) e.stiffness_per_press_n_per_mm.push_back(touch_slope(depth, force) * 1e-3);
     }
     if (!e.stiffness_per_press_n_per_mm.empty())
-      e.stiffness_n_per_mm = median(e.stiffness_per_press_n_per_mm);
+      e.stiffness_n_per_mm = core::median(e.stiffness_per_press_n_per_mm);
   }
 
   // friction: per stroke, the largest ratio before a third of the stroke (breakaway) and the
@@ -836,11 +830,11 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
         peak = std::max(peak, s.friction_ratio[j] * s.normal_n[j]);
         across.push_back(s.normal_n[j]);
       }
-    if (!across.empty()) peak /= median(across);
+    if (!across.empty()) peak /= core::median(across);
     for (std::size_t j = 0; j < s.travel.size(); ++j)
       if (s.travel[j] > 0.5 * length && s.travel[j] < 0.95 * length) slid.push_back(s.friction_ratio[j]);
     if (peak > -1e300) breakaway.push_back(peak);
-    if (!slid.empty()) sliding.push_back(median(slid));
+    if (!slid.empty()) sliding.push_back(core::median(slid));
   }
   Slide contour;
   {
@@ -853,7 +847,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     const double circle = 2.0 * kPi * o.contour_radius_m;
     for (std::size_t j = 0; j < c.travel.size(); ++j)
       if (c.travel[j] > 0.25 * circle) slid.push_back(c.friction_ratio[j]);
-    if (!slid.empty()) sliding.push_back(median(slid));
+    if (!slid.empty()) sliding.push_back(core::median(slid));
   }
   const auto mean = [](const std::vector<double>& v) {
     return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
@@ -901,7 +895,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
       if (spectrum.power[k] < spectrum.power[k - 1] || spectrum.power[k] < spectrum.power[k + 1]) continue;
       if (peak == 0 || spectrum.power[k] > spectrum.power[peak]) peak = k;
     }
-    const double background = median(spectrum.power);
+    const double background = core::median(spectrum.power);
     // a texture stands out of the packing's own grain by an order of magnitude and more
     if (!(spectrum.power[peak] > 30.0 * background) || peak == 0 || peak + 1 >= spectrum.power.size())
       continue;

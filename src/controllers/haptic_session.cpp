@@ -12,17 +12,11 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "uh/core/statistics.hpp"
 #include "uh/devices/force_dimension_device.hpp"
 
 namespace uh::controllers {
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -616,7 +610,7 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     if (rates.empty())
       for (const auto& s : r.collision_rates) rates.push_back(s.rate_hz);
     r.collision_rate_min_hz = rates.empty() ? 0.0 : *std::min_element(rates.begin(), rates.end());
-    r.collision_rate_median_hz = median_of(rates);
+    r.collision_rate_median_hz = core::median(rates);
     r.collision_rate_mean_hz = ws.rate_hz;
   }
 }

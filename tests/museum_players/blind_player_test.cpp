@@ -46,7 +46,7 @@ PieceSurvey survey(SurfaceTrack top, SurfaceTrack side, double friction, double 
   PieceSurvey s;
   s.tracks = {std::move(top), std::move(side)};
   s.material.friction_dynamic = friction;
-  for (int k = 1; k <= 4; ++k)
+  for (int k = 1; k <= 8; ++k)
     s.site_stiffness.emplace_back("top press " + std::to_string(k), stiffness * (1.0 + 0.01 * k));
   return s;
 }
@@ -117,26 +117,47 @@ TEST(MuseumBlindPlayer, MaterialsOffByMoreThanTheFloorDiffer) {
   EXPECT_NEAR(friction->difference, 20.0, 1e-9);
   EXPECT_TRUE(friction->differs());
   // the thresholds: the floors (10 % friction, 25 % stiffness), twice the reference's own spread
-  // (2 % here) and the piece's own presses' spread (3 %) being less
+  // (2 % here) being less
   EXPECT_NEAR(friction->threshold, 10.0, 1e-9);
   const Judgement soft = judged(0.3, 2.1);  // 30 % softer
   EXPECT_EQ(soft.verdict, Verdict::forgery);
   const FeatureDifference* stiffness = feature(soft, "stiffness");
   ASSERT_NE(stiffness, nullptr);
-  EXPECT_NEAR(stiffness->difference, 30.0, 1e-9);
+  // against the median of the reference's two sets of presses together (3.0 and 3.06 times
+  // 1.01-1.08: the middle two are 3.06 * 1.03 and 3.0 * 1.06)
+  EXPECT_NEAR(stiffness->difference, 100.0 * (1.0 - 2.1 * 1.045 / (0.5 * (3.06 * 1.03 + 3.0 * 1.06))), 1e-9);
   EXPECT_NEAR(stiffness->threshold, 25.0, 1e-9);
+  ASSERT_TRUE(stiffness->p_value.has_value());
+  EXPECT_LT(*stiffness->p_value, 1e-5);  // all 8 below all 16: 2 of C(24, 8) deals
   // under the floors: the same
   EXPECT_EQ(judged(0.28, 2.4).verdict, Verdict::genuine);
-  // presses that disagree (three beside a ridge, one on it): their median is half the reference's,
-  // but the piece's own spread (100 %) says the reading tells nothing
-  PieceSurvey uneven = survey(stroke(0.0, 0.0, 0.0, 0.0), around(24, 1.0), 0.3, 1.5);
-  uneven.site_stiffness.back().second = 3.0;
-  const Judgement j = judge_piece(uneven, reference, again);
+}
+
+TEST(MuseumBlindPlayer, PressesThatInterleaveTellNothingWhateverTheirMedians) {
+  // the packing's grain: presses on one top spread by 30 % either side
+  const std::vector<double> grain{2.2, 2.6, 3.0, 3.4, 3.8, 4.2, 2.4, 3.6};
+  const auto with_presses = [](const std::vector<double>& k) {
+    PieceSurvey s = survey(stroke(0.0, 0.0, 0.0, 0.0), around(24, 0.0), 0.3, 1.0);
+    for (std::size_t i = 0; i < k.size(); ++i) s.site_stiffness[i].second = k[i];
+    return s;
+  };
+  std::vector<double> again = grain;
+  for (double& k : again) k *= 1.02;
+  // six presses on the soft side of the grain, two on the stiff: the median is a third under the
+  // reference's, but the presses interleave with the reference's
+  const Judgement j = judge_piece(with_presses({1.8, 1.9, 2.0, 2.1, 2.2, 2.3, 4.0, 4.4}), with_presses(grain),
+                                  with_presses(again));
   const FeatureDifference* k = feature(j, "stiffness");
   ASSERT_NE(k, nullptr);
-  EXPECT_GT(k->difference, 45.0);
-  EXPECT_GT(k->threshold, 90.0);
+  EXPECT_GT(k->difference, k->threshold);
+  ASSERT_TRUE(k->p_value.has_value());
+  EXPECT_GT(*k->p_value, kRankTestLevel);
+  EXPECT_FALSE(k->differs());
   EXPECT_EQ(j.verdict, Verdict::genuine);
+  // the same medians with every press below the reference's: a forgery
+  const Judgement all_below = judge_piece(with_presses({1.8, 1.9, 2.0, 2.1, 2.2, 2.1, 2.0, 1.9}),
+                                          with_presses(grain), with_presses(again));
+  EXPECT_EQ(all_below.verdict, Verdict::forgery);
 }
 
 // a side: a stroke up that meets a shelf at 10-14 mm (the radius steps in by 8 mm: 2 per unit of height) and walls

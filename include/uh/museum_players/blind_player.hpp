@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,8 +41,8 @@ struct SurfaceTrack {
 /// What the blind player read off one piece.
 struct PieceSurvey {
   controllers::MaterialEstimate material;  ///< from the press, strokes and contour on the top
-  /// Each site's press: the force gained over the depth gone in between a tenth and nine tenths of
-  /// the press force [N/mm], by site
+  /// Each pad press on the top: the force 0.8 mm past first contact over that depth [N/mm], by site
+  /// ("top press 1" ..)
   std::vector<std::pair<std::string, double>> site_stiffness;
   std::vector<SurfaceTrack> tracks;
   double simulated_s = 0.0;  ///< device time the exploration took [s]
@@ -60,7 +61,8 @@ struct SurveyOptions {
 };
 
 /// Explores `piece` (a scene object standing on its base, any turn about the vertical) with the
-/// stylus. Sites: the top (press, four strokes, a circle, taps: the material); a raster of long
+/// stylus. Sites: the top (press, four strokes, a circle, taps: the material); 24 presses with
+/// a finger's pad on two rings round the top's middle (the stiffness); a raster of long
 /// strokes over the top of a flat piece; on a piece with a round footprint, contours once around
 /// it at heights every `ring_spacing_m` and strokes up and down its side.
 Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const SurveyOptions& options,
@@ -75,8 +77,16 @@ struct FeatureDifference {
   double noise = 0.0;       ///< the same between the two explorations of the reference
   double threshold = 0.0;
   std::string unit;  ///< "mm" or "%": how to read the three numbers
-  bool differs() const { return difference > threshold; }
+  /// stiffness: the chance that presses on two like pieces part at least this clearly (the rank
+  /// test, core::rank_test_p_value); a difference counts only under kRankTestLevel. Empty elsewhere.
+  std::optional<double> p_value;
+  bool differs() const;
 };
+
+/// A stiffness difference counts only when the rank test puts the chance of one as clear between
+/// like pieces under this (the judge compares about a dozen pieces per level: one in a hundred
+/// levels would call a genuine piece a forgery on its presses' grain alone).
+inline constexpr double kRankTestLevel = 0.001;
 
 enum class Verdict : std::uint8_t { genuine, forgery };
 const char* to_string(Verdict verdict);
@@ -88,7 +98,9 @@ struct Judgement {
 
 /// Compares a piece with the genuine reference (explored twice, at two turns and seeds) and decides:
 /// forgery when any feature differs by more than its threshold: the larger of a floor (a felt
-/// difference: 0.3 mm of surface, 15 % of stiffness, 10 % of friction) and twice the noise.
+/// difference: 0.3 mm of surface, 10 % of friction) and twice the noise. Stiffness: the piece's
+/// presses against the reference's two sets together, a difference of their medians over 25 %
+/// that the rank test finds under kRankTestLevel.
 Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
                       const PieceSurvey& reference_again);
 
