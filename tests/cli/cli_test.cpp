@@ -682,10 +682,14 @@ TEST_F(CliTest, RunsTwoDevicesOfDifferentDriversInOneSession) {
 struct MaterialsScene {
   nlohmann::json scene;
   nlohmann::json material(const std::string& object) const {
-    for (const auto& o : scene["objects"])
-      if (o["name"] == object)
-        return o["material"].is_string() ? scene["materials"][o["material"].get<std::string>()]
-                                         : o["material"];
+    // (operator[] on a const json with a missing key is undefined: an object without a material reads
+    // as an empty one)
+    for (const auto& o : scene.at("objects"))
+      if (o.at("name") == object) {
+        if (!o.contains("material")) return nlohmann::json::object();
+        const nlohmann::json& m = o.at("material");
+        return m.is_string() ? scene.at("materials").at(m.get<std::string>()) : m;
+      }
     ADD_FAILURE() << "no object " << object;
     return {};
   }
