@@ -162,10 +162,16 @@ class Relay {
           close(in);
         }
       }
-      // what one side says goes to the other; a side that ends ends the pair
+      // what one side says goes to the other; a side that ends ends the pair. A pair accepted
+      // above was not in this poll (it has no entries in fds): it is only kept.
+      const std::size_t polled = (fds.size() - 2) / 2;
       std::vector<std::pair<int, int>> kept;
       for (std::size_t p = 0; p < pairs_.size(); ++p) {
         const auto [a, b] = pairs_[p];
+        if (p >= polled) {
+          kept.emplace_back(a, b);
+          continue;
+        }
         bool open = true;
         for (const auto& [from, to, revents] :
              {std::tuple{a, b, fds[2 + 2 * p].revents}, std::tuple{b, a, fds[3 + 2 * p].revents}}) {
