@@ -70,13 +70,6 @@ museum::Difficulty difficulty_named(const std::string& level) {
   return level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy;
 }
 
-nlohmann::json evidence_json(const museum_players::FeatureDifference& f) {
-  nlohmann::json j = {{"feature", f.feature},  {"where", f.where},         {"difference", f.difference},
-                      {"noise", f.noise},      {"threshold", f.threshold}, {"unit", f.unit},
-                      {"differs", f.differs()}};
-  if (f.p_value) j["p_value"] = *f.p_value;
-  return j;
-}
 
 int museum_judge(const MuseumJudgeArgs& args) {
   museum_players::JudgeOptions options;
@@ -147,6 +140,14 @@ int museum_judge(const MuseumJudgeArgs& args) {
 }
 
 }  // namespace
+
+nlohmann::json evidence_json(const museum_players::FeatureDifference& f) {
+  nlohmann::json j = {{"feature", f.feature},  {"where", f.where},         {"difference", f.difference},
+                      {"noise", f.noise},      {"threshold", f.threshold}, {"unit", f.unit},
+                      {"differs", f.differs()}};
+  if (f.p_value) j["p_value"] = *f.p_value;
+  return j;
+}
 
 void add_museum_play_command(CLI::App& museum, CommandRunner& runner);  // cmd_museum_play.cpp
 

@@ -363,13 +363,7 @@ int museum_play_one(const MuseumPlayArgs& args) {
 
 json verdict_json(const BlindVerdict& v) {
   json evidence = json::array();
-  for (const auto& f : v.judgement.evidence)
-    evidence.push_back({{"feature", f.feature},
-                        {"where", f.where},
-                        {"difference", f.difference},
-                        {"threshold", f.threshold},
-                        {"unit", f.unit},
-                        {"differs", f.differs()}});
+  for (const auto& f : v.judgement.evidence) evidence.push_back(evidence_json(f));
   return {{"item", v.item},
           {"kind", v.kind},
           {"verdict", museum_players::to_string(v.judgement.verdict)},

@@ -4,9 +4,14 @@
 /// of its run: 0 success, 1 a user-facing error (already printed to stderr), 2 bad usage.
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <csignal>
 #include <functional>
+
+namespace uh::museum_players {
+struct FeatureDifference;
+}
 
 namespace uh::cli {
 
@@ -22,6 +27,8 @@ void add_serve_command(CLI::App& app, CommandRunner& runner);
 void add_museum_commands(CLI::App& app, CommandRunner& runner);
 /// `uh museum station` (Phantom's station), on `museum`, when the build has sound.
 void add_museum_station_command(CLI::App& museum, CommandRunner& runner);
+/// One piece of the blind player's evidence as `uh museum judge --json` and `uh museum play` print it.
+nlohmann::json evidence_json(const museum_players::FeatureDifference& f);
 
 /// Blocks SIGINT and SIGTERM in the calling thread, before a server's threads start (they inherit
 /// the mask, so no thread is interrupted by them); wait_for_stop_signal() then takes them.

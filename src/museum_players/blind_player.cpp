@@ -196,7 +196,7 @@ std::vector<SurveySite> plan_survey(const Bounds& b, const SurveyOptions& o) {
   base.stroke_turn_rad = 0.0;
   base.stroke_stops_at_edge_rad = 0.6;  // about 35 degrees: the rim of a top
   base.presses = 1;                     // the survey presses at sites of its own (below)
-  base.press_depth_m.reset();           // presses to a force, read by their secant (above)
+  base.press_depth_m.reset();           // the top's press goes to a force (the pad presses: to a depth)
   base.press_force_n = 3.0;
   base.strokes_through_site = false;  // each site's strokes start at the site
   // the top, as `uh explore` does it: the material
