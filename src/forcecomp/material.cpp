@@ -2,27 +2,18 @@
 
 #include <cmath>
 
+#include "uh/core/split_mix.hpp"
+
 namespace uh::forcecomp {
 namespace {
 
-// splitmix64: a small generator whose output is the same on every platform and standard library
-// (std::normal_distribution is not), so a seed names one surface everywhere
-struct SplitMix64 {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  // uniform in (0, 1): never 0, so the logarithm below is finite
-  double uniform() { return (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53; }
-  // standard normal (Box-Muller)
-  double normal() {
-    const double r = std::sqrt(-2.0 * std::log(uniform()));
-    return r * std::cos(2.0 * kPi * uniform());
-  }
-};
+// a standard normal draw (Box-Muller) from the seeded generator (std::normal_distribution differs
+// between standard libraries, so a seed would not name one surface everywhere); the open uniform
+// is never 0, so the logarithm is finite
+double standard_normal(core::SplitMix64& random) {
+  const double r = std::sqrt(-2.0 * std::log(random.uniform_open()));
+  return r * std::cos(2.0 * kPi * random.uniform_open());
+}
 
 double combined_in_series(double a, double b) { return a + b > 0.0 ? a * b / (a + b) : 0.0; }
 
@@ -70,11 +61,12 @@ Texture make_random_texture(double roughness_m, double correlation_length_m, std
   t.roughness_m = roughness_m;
   t.correlation_length_m = correlation_length_m;
   t.seed = seed;
-  SplitMix64 rng{seed};
+  core::SplitMix64 random{seed};
   for (Texture::Wave& w : t.waves) {
     // k ~ N(0, I / l^2): the mean of cos(k . r) is then exp(-|r|^2 / (2 l^2))
-    w.wave_vector = Vec3{rng.normal(), rng.normal(), rng.normal()} / correlation_length_m;
-    w.phase = 2.0 * kPi * rng.uniform();
+    w.wave_vector =
+        Vec3{standard_normal(random), standard_normal(random), standard_normal(random)} / correlation_length_m;
+    w.phase = 2.0 * kPi * random.uniform_open();
   }
   return t;
 }

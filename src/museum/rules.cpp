@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "uh/core/split_mix.hpp"
+
 namespace uh::museum {
 
 const char* to_string(ItemPlace place) {
@@ -83,22 +85,10 @@ const char* to_string(EventType type) {
 
 namespace {
 
-// SplitMix64 (Steele, Lea, Flood 2014): the same numbers on every platform and standard library,
-// unlike the std:: distributions
-struct SeedSequence {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
-  int below(int n) { return static_cast<int>(next() % static_cast<std::uint64_t>(n)); }
-  // Fisher-Yates over the first `count` entries
-  void shuffle(int* first, int count) {
-    for (int i = count - 1; i > 0; --i) std::swap(first[i], first[below(i + 1)]);
-  }
-};
+// Fisher-Yates over the first `count` entries, dealt by the seed's generator
+void shuffle(core::SplitMix64& random, int* first, int count) {
+  for (int i = count - 1; i > 0; --i) std::swap(first[i], first[random.below(i + 1)]);
+}
 
 template <typename T, std::size_t N>
 T& at(std::array<T, N>& a, int i) {
@@ -319,7 +309,7 @@ void end_round(GameState& state, Events& events) {
 GameState new_game(const Level& level, std::uint64_t seed) {
   assert(validate(level).has_value() && "uh::museum::new_game(): the level does not validate");
   GameState state;
-  SeedSequence rng{seed};
+  core::SplitMix64 rng{seed};
   state.seed = seed;
   state.time_left_s = level.rules.round_s;
   state.vive.pos = level.entrance;
@@ -327,7 +317,7 @@ GameState new_game(const Level& level, std::uint64_t seed) {
   std::array<int, kMaxArtifactKinds> kinds{};
   const int kind_count = static_cast<int>(level.artifact_kinds.size());
   for (int k = 0; k < kind_count; ++k) at(kinds, k) = k;
-  rng.shuffle(kinds.data(), kind_count);
+  shuffle(rng, kinds.data(), kind_count);
   state.target_count = level.target_count;
   for (int t = 0; t < state.target_count; ++t) at(state.target_kinds, t) = at(kinds, t);
 
@@ -337,7 +327,7 @@ GameState new_game(const Level& level, std::uint64_t seed) {
     at(cases, c) = c;
     at(state.case_item, c) = -1;
   }
-  rng.shuffle(cases.data(), state.case_count);
+  shuffle(rng, cases.data(), state.case_count);
   state.item_count = 2 * state.target_count;
   for (int t = 0; t < state.target_count; ++t) {
     const bool genuine_first = (rng.next() & 1u) != 0;

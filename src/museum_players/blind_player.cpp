@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/core/split_mix.hpp"
 #include "uh/core/statistics.hpp"
 
 namespace uh::museum_players {
@@ -560,19 +561,6 @@ Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
   return j;
 }
 
-namespace {
-
-// splitmix64: the judge's deal, the same on every platform
-std::uint64_t next_random(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-double uniform(std::uint64_t& state) { return static_cast<double>(next_random(state) >> 11) * 0x1.0p-53; }
-
-}  // namespace
-
 bool turned_on_the_table(museum_artifacts::ArtifactKind kind) {
   using museum_artifacts::ArtifactKind;
   return kind != ArtifactKind::tablet && kind != ArtifactKind::scarab;
@@ -583,7 +571,7 @@ Result<JudgeReport> run_judge(const JudgeOptions& options) {
   JudgeReport report;
   report.difficulty = options.difficulty;
   report.seed = options.seed;
-  std::uint64_t deal = options.seed * 0x2545F4914F6CDD1Dull + 7;
+  core::SplitMix64 deal{options.seed * 0x2545F4914F6CDD1Dull + 7};  // the judge's deal
   const std::filesystem::path cache =
       options.cache_dir.empty() ? controllers::default_cache_dir() : options.cache_dir;
   const std::size_t total = options.kinds.size() * 4;
@@ -606,26 +594,26 @@ Result<JudgeReport> run_judge(const JudgeOptions& options) {
       ++done;
       return result;
     };
-    const auto turn = [&] { return turned_on_the_table(kind) ? 2.0 * kPi * uniform(deal) : 0.0; };
-    const auto off = [&] { return (uniform(deal) - 0.5) * 0.004; };
+    const auto turn = [&] { return turned_on_the_table(kind) ? 2.0 * kPi * deal.uniform() : 0.0; };
+    const auto off = [&] { return (deal.uniform() - 0.5) * 0.004; };
     done = static_cast<std::size_t>(&kind - options.kinds.data()) * 4;
     // the genuine reference, explored twice (two turns, two seeds): how much it differs from itself
-    auto reference = explore(Piece::genuine, 0.0, 0.0, 0.0, next_random(deal));
+    auto reference = explore(Piece::genuine, 0.0, 0.0, 0.0, deal.next());
     if (!reference) return reference.error();
-    auto again = explore(Piece::genuine, turn(), off(), off(), next_random(deal));
+    auto again = explore(Piece::genuine, turn(), off(), off(), deal.next());
     if (!again) return again.error();
     PairResult pair;
     pair.kind = kind;
     pair.tell = museum_artifacts::tell(kind, options.difficulty).description;
     pair.material_tell = museum_artifacts::material_tell(kind, options.difficulty).description;
-    const bool genuine_first = (next_random(deal) & 1u) == 0u;
+    const bool genuine_first = (deal.next() & 1u) == 0u;
     for (const Piece truth :
          {genuine_first ? Piece::genuine : Piece::forgery, genuine_first ? Piece::forgery : Piece::genuine}) {
       PieceResult r;
       r.truth = truth;
       r.turn_rad = turn();
       const double x = off(), y = off();
-      auto survey = explore(truth, r.turn_rad, x, y, next_random(deal));
+      auto survey = explore(truth, r.turn_rad, x, y, deal.next());
       if (!survey) return survey.error();
       r.judgement = judge_piece(*survey, *reference, *again);
       r.simulated_s = survey->simulated_s;
