@@ -1,3 +1,4 @@
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "log_sink.hpp"
@@ -23,11 +24,18 @@ spdlog::level::level_enum to_spdlog(Level level) {
   return spdlog::level::off;
 }
 
+// Messages go to stderr, as the stderr sink's do: spdlog's default logger writes to stdout, where
+// they would mix into what the commands print (`--json` documents, a served port).
+spdlog::logger& logger() {
+  static const std::shared_ptr<spdlog::logger> to_stderr = spdlog::stderr_color_mt("uh");
+  return *to_stderr;
+}
+
 }  // namespace
 
-// the default spdlog logger filters too: let everything through that passes our level
-void sink_set_level(Level level) { spdlog::set_level(to_spdlog(level)); }
+// the logger filters too: let everything through that passes our level
+void sink_set_level(Level level) { logger().set_level(to_spdlog(level)); }
 
-void sink_write(Level level, std::string_view message) { spdlog::log(to_spdlog(level), "{}", message); }
+void sink_write(Level level, std::string_view message) { logger().log(to_spdlog(level), "{}", message); }
 
 }  // namespace uh::log::detail
