@@ -256,4 +256,13 @@ Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path) {
   return parse_obj_or_stl(bytes, name);
 }
 
+std::string obj_text(const TriangleMesh& mesh, std::string_view comment) {
+  std::string obj;
+  if (!comment.empty()) obj = fmt::format("# {}\n", comment);
+  // {} prints the shortest text that reads back to the same double
+  for (const Vec3& v : mesh.vertices) obj += fmt::format("v {} {} {}\n", v.x, v.y, v.z);
+  for (const auto& t : mesh.triangles) obj += fmt::format("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+  return obj;
+}
+
 }  // namespace uh::collette

@@ -82,9 +82,8 @@ Result<collette::MeshReport> SceneDocument::add_inline_object(json object, colle
                                                               const std::filesystem::path& mesh_dir) {
   auto valid = collette::validate_mesh(std::move(mesh));
   if (!valid) return valid.error();
-  std::string obj = "# an inline mesh sent to uh serve (add_object with mesh_binary), welded and checked\n";
-  for (const Vec3& v : valid->vertices) obj += fmt::format("v {} {} {}\n", v.x, v.y, v.z);
-  for (const auto& t : valid->triangles) obj += fmt::format("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+  const std::string obj = collette::obj_text(
+      *valid, "an inline mesh sent to uh serve (add_object with mesh_binary), welded and checked");
   const std::uint64_t hash = collette::ist_hash_bytes(std::as_bytes(std::span<const char>(obj)));
   const auto path = mesh_dir / fmt::format("{:016x}.obj", hash);
   std::error_code ec;

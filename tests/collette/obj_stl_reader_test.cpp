@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -164,6 +166,41 @@ TEST(ObjStlReader, ErrorsNameTheFileAndLine) {
   const auto missing = read_obj_or_stl(dir / "missing.obj");
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("missing.obj: cannot open the mesh file"), std::string::npos);
+}
+
+// The writer's text read back with the C library's own number parser (not fmt, which wrote it):
+// every coordinate exactly, corners 1-based, and the built-in reader takes the text as it is.
+TEST(ObjText, ReadsBackExactly) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0.1, -2.0 / 3.0, 1e-7}, {1.0 / 7.0, 12345.678901234567, -0.0}, {3.0, 0.3, -1e300}};
+  mesh.triangles = {{0, 1, 2}, {2, 1, 0}};
+  const std::string text = obj_text(mesh, "two faces");
+  std::istringstream in(text);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "# two faces");
+  for (const Vec3& v : mesh.vertices) {
+    ASSERT_TRUE(std::getline(in, line));
+    ASSERT_EQ(line.substr(0, 2), "v ");
+    char* end = line.data() + 2;
+    const double x = std::strtod(end, &end), y = std::strtod(end, &end), z = std::strtod(end, &end);
+    EXPECT_EQ(x, v.x);
+    EXPECT_EQ(y, v.y);
+    EXPECT_EQ(z, v.z);
+    EXPECT_EQ(*end, '\0') << line;
+  }
+  for (const auto& t : mesh.triangles) {
+    ASSERT_TRUE(std::getline(in, line));
+    EXPECT_EQ(line, "f " + std::to_string(t[0] + 1) + " " + std::to_string(t[1] + 1) + " " +
+                        std::to_string(t[2] + 1));
+  }
+  EXPECT_FALSE(std::getline(in, line)) << "nothing after the faces";
+  EXPECT_EQ(obj_text(mesh, "").substr(0, 2), "v ") << "no comment line without a comment";
+
+  const auto read = parse_obj_or_stl(text, "written.obj");
+  ASSERT_TRUE(read) << read.error().message;
+  EXPECT_EQ(read->vertices.size(), 3u);
+  EXPECT_EQ(read->triangles, mesh.triangles);
 }
 
 }  // namespace

@@ -56,6 +56,11 @@ Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path);
 /// extension (.obj or .stl) chooses the format.
 Result<TriangleMesh> parse_obj_or_stl(std::string_view bytes, const std::string& name);
 
+/// The mesh as OBJ text (`v` and `f` lines, 1-based corners) after a `# comment` line when the
+/// comment is not empty: the one OBJ writer, for meshes the project generates or receives and
+/// hands on as files. Coordinates are written so they read back exactly.
+std::string obj_text(const TriangleMesh& mesh, std::string_view comment);
+
 /// Welds, repairs, validates and orients an in-memory mesh the same way load_mesh() does (used by
 /// load_mesh() and by code that builds meshes itself). `mesh.source_name` names it in messages.
 /// On success mesh.report holds the counts. Not real-time safe.
