@@ -4,6 +4,8 @@
 // uh museum play: cmd_museum_play.cpp
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <random>
 #include <string>
 
 #include <fmt/format.h>
@@ -23,7 +25,7 @@ struct MuseumServeArgs {
   std::string host = "127.0.0.1";
   int port = 7780;
   std::string token;
-  std::uint64_t seed = 1;
+  std::optional<std::uint64_t> seed;  // none: a fresh one each round (players must not know it)
   double minutes = 0.0;  // 0: the level's own round time
   std::string level = "easy";
   double speed = 1.0;  // game seconds per second of the clock
@@ -34,12 +36,16 @@ int museum_serve(const MuseumServeArgs& args) {
   museum::Level level =
       museum::make_level(args.level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy);
   if (args.minutes > 0.0) level.rules.round_s = args.minutes * 60.0;
+  // the seed deals where the forgeries are: a fixed default would let a player deal the same round
+  // offline and read the answers, so an unseeded round draws one from the system
+  const std::uint64_t seed =
+      args.seed ? *args.seed : (std::uint64_t{std::random_device{}()} << 32) ^ std::random_device{}();
   const MuseumClientFiles client = museum_client_files(level);  // Vive's page, served at `/`
   auto server = museum_service::GameServer::start({.host = args.host,
                                                    .port = static_cast<std::uint16_t>(args.port),
                                                    .token = args.token,
                                                    .level = std::move(level),
-                                                   .seed = args.seed,
+                                                   .seed = seed,
                                                    .speed = args.speed,
                                                    .files = client.files});
   if (!server) {
@@ -47,8 +53,9 @@ int museum_serve(const MuseumServeArgs& args) {
     return fail(m.find("token is required") != std::string::npos ? m + " (give --token)" : m);
   }
   const std::string url = (*server)->url();
-  std::printf("uh museum serve: %s level, seed %llu%s; players connect to ws%sws; Ctrl-C stops\n",
-              args.level.c_str(), static_cast<unsigned long long>(args.seed),
+  std::printf("uh museum serve: %s level, seed %llu%s%s; players connect to ws%sws; Ctrl-C stops\n",
+              args.level.c_str(), static_cast<unsigned long long>(seed),
+              args.seed ? "" : " (drawn; --seed replays the round)",
               args.speed != 1.0 ? fmt::format(", at {:g} times the clock", args.speed).c_str() : "",
               url.substr(4).c_str());
   if (client.has_page) std::printf("uh museum serve: Vive plays in a browser at %s\n", url.c_str());
@@ -162,8 +169,8 @@ void add_museum_commands(CLI::App& app, CommandRunner& runner) {
       ->default_val(7780)
       ->check(CLI::Range(0, 65535));
   s->add_option("--token", args.token, "clients must send this token in their hello");
-  s->add_option("--seed", args.seed, "deals the round: targets, where the forgeries are, the guards' starts")
-      ->default_val(1);
+  s->add_option("--seed", args.seed,
+                "deals the round: targets, where the forgeries are, the guards' starts (default: drawn)");
   s->add_option("--minutes", args.minutes, "the round's time (default: the level's, 6 easy, 5 hard)")
       ->check(CLI::Range(0.1, 600.0));
   s->add_option("--level", args.level, "easy or hard")

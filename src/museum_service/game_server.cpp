@@ -137,12 +137,12 @@ class GameHub final : public service::Endpoint {
     for (int t = 0; t < state_.target_count; ++t)
       targets.push_back(
           level_.artifact_kinds[static_cast<std::size_t>(state_.target_kinds[static_cast<std::size_t>(t)])]);
+    // no seed: a client given it could deal the round itself and know every genuine piece
     c.peer->send(json{
         {"type", "welcome"},
         {"id", req_id},
         {"protocol", kGameProtocolVersion},
         {"role", to_string(h.role)},
-        {"seed", state_.seed},
         {"level", level_json(level_)},
         {"targets",
          targets}}.dump());

@@ -55,6 +55,7 @@ TEST(MuseumServer, WelcomeCarriesTheLevelAndTheTargets) {
   EXPECT_EQ(w["level"]["rooms"].size(), 1u);
   EXPECT_EQ(w["level"]["cases"].size(), 2u);
   ASSERT_EQ(w["targets"].size(), 1u);
+  EXPECT_FALSE(w.contains("seed")) << "the seed deals the round: with it a client knows every genuine piece";
   const json s = *next_snapshot(vive);
   EXPECT_EQ(s["phase"], "waiting") << "the round waits for Phantom";
   EXPECT_EQ(s["tick"], 0);

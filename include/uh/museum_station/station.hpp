@@ -185,7 +185,6 @@ class Station {
   bool have_tool_pos_ = false;
   std::uint32_t last_buttons_ = 0;
   double last_tool_time_s_ = 0.0;
-  int touching_ = 0;  // contact events begun minus ended
   std::vector<std::string> captions_;
   std::string last_speech_;
   std::vector<std::pair<int, museum::Verdict>> verdicts_sent_;
