@@ -12,7 +12,7 @@ namespace UnrealHaptics.Components
         void OnEnable() { hapticManager.MoveOnHapticTick += Move; }
         void OnDisable() { hapticManager.MoveOnHapticTick -= Move; }
 
-        void Move(Vector3 position, Quaternion rotation, Vector3 force)
+        void Move(Vector3 position, Quaternion rotation, uint buttons)
         {
             if (tool != null) tool.SetPositionAndRotation(position, rotation);
         }

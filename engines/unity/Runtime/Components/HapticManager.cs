@@ -16,8 +16,12 @@ namespace UnrealHaptics.Components
         [Tooltip("Objects of the scene file that the Unity scene's ColletteStaticMeshes replace")]
         public string[] sceneObjectsToRemove = { "bunny" };
 
-        /// <summary>Every frame with the newest state: tool position (Unity frame), rotation, force.</summary>
-        public event Action<Vector3, Quaternion, Vector3> MoveOnHapticTick;
+        /// <summary>Every frame with the newest state: tool position (Unity frame), rotation and the
+        /// device's buttons (bit i: button i), as the paper's MoveOnHapticTick.</summary>
+        public event Action<Vector3, Quaternion, uint> MoveOnHapticTick;
+        /// <summary>Every frame with the newest force [N] and torque [N m] sent to the device (Unity
+        /// frame), as the paper's ForceOnHapticTick. They are computed by libuh on its haptic thread.</summary>
+        public event Action<Vector3, Vector3> ForceOnHapticTick;
         public event Action<ContactEvent, string> OnContact;
 
         public State Newest { get; private set; }
@@ -50,7 +54,9 @@ namespace UnrealHaptics.Components
             Newest = session_.Poll();
             if (MoveOnHapticTick != null)
                 MoveOnHapticTick(UnityFrame.Position(Newest.ToolPosition), UnityFrame.Rotation(Newest.ToolOrientation),
-                                 UnityFrame.Direction(Newest.Force));
+                                 Newest.Buttons);
+            if (ForceOnHapticTick != null)
+                ForceOnHapticTick(UnityFrame.Direction(Newest.Force), UnityFrame.Axial(Newest.Torque));
             ContactEvent e;
             while (session_.PollEvent(out e))
                 if (OnContact != null) OnContact(e, session_.ObjectName(e.Object));
@@ -81,6 +87,8 @@ namespace UnrealHaptics.Components
         public static double[] ToUh(Quaternion q) { return new double[] { q.w, -q.x, -q.y, q.z }; }
         public static Vector3 Position(double[] p) { return new Vector3((float)p[0], (float)p[1], (float)-p[2]); }
         public static Vector3 Direction(double[] f) { return new Vector3((float)f[0], (float)f[1], (float)-f[2]); }
+        /// <summary>An axial vector (torque, angular velocity) flips with the mirror: x and y change sign.</summary>
+        public static Vector3 Axial(double[] t) { return new Vector3((float)-t[0], (float)-t[1], (float)t[2]); }
         public static Quaternion Rotation(double[] q) { return new Quaternion((float)-q[1], (float)-q[2], (float)q[3], (float)q[0]); }
     }
 }
