@@ -145,10 +145,10 @@ uh_status uh_tree_get_info(const uh_tree* tree, uh_tree_info* out) {
     out->leaf_count = box->tree->leaf_count();
     out->coverage = box->meta.coverage;
     out->mesh_volume = box->meta.mesh_volume;
-    out->center[0] = root.x;
-    out->center[1] = root.y;
-    out->center[2] = root.z;
-    out->radius = root.radius;
+    out->center[0] = static_cast<double>(root.x);
+    out->center[1] = static_cast<double>(root.y);
+    out->center[2] = static_cast<double>(root.z);
+    out->radius = static_cast<double>(root.radius);
     return UH_OK;
   });
 }

@@ -5,6 +5,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -70,8 +71,13 @@ class ChildProcess {
     for (auto& e : env_storage) envp.push_back(e.data());
     envp.push_back(nullptr);
     const std::string out_path = out.string(), err_path = err.string();
+    const pid_t parent = getpid();
     pid_ = fork();
     if (pid_ == 0) {
+      // a test process that aborts (a failed assertion in a fatal handler, a sanitizer report)
+      // never runs the destructor: the kernel ends the child with it instead of leaving a server
+      // or a bot running. The signal follows the creating thread, which is the test's own.
+      if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(122);
       const int o = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       const int e = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       const int in = open("/dev/null", O_RDONLY);
