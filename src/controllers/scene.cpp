@@ -12,6 +12,7 @@
 #include "embedded_assets.hpp"
 #include "uh/collette/ist_builder.hpp"
 #include "uh/collette/ist_file.hpp"
+#include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/core/atomic_file_writer.hpp"
 
 namespace uh::controllers {
@@ -658,12 +659,13 @@ Result<ShapeTree> load_shape_tree(
     std::error_code ec;
     std::filesystem::create_directories(cache_dir, ec);
     if (ec) return Error{fmt::format("{}: cannot create the cache folder: {}", cache_dir.string(), ec.message())};
-    // keyed by everything the packing depends on (the radius bound in mesh units, shortest exact form)
+    // keyed by everything the packing depends on (the radius bound in mesh units, shortest exact
+    // form) and by the tree builder's version (a cache of an older builder's tree is rebuilt)
     const double max_radius = shape.max_sphere_radius / shape.meters_per_unit;
     const std::string bound = max_radius > 0.0 ? fmt::format("-r{}", max_radius) : std::string();
     const std::filesystem::path cached =
-        cache_dir /
-        fmt::format("{}-{:016x}-{}{}.ist", shape.mesh.stem().string(), *hash, shape.spheres, bound);
+        cache_dir / fmt::format("{}-{:016x}-{}{}-t{}.ist", shape.mesh.stem().string(), *hash, shape.spheres,
+                                bound, collette::kSphereTreeBuilderVersion);
     auto loaded = collette::load_ist(cached);
     if (loaded && loaded->meta.source_mesh_hash == *hash) {
       asset = std::move(loaded).value();

@@ -269,7 +269,8 @@ TEST_F(IstFile, RejectsEveryMeaninglessFieldWithValidChecksums) {
        encode_edited(asset_, [](Parts& p) { p.nodes[0].radius *= 0.9f; }),
        {"invalid tree", "node 0", "does not enclose"}},
       {"inner node not enclosing its leaves",
-       encode_edited(asset_, [&](Parts& p) { p.nodes[inner].x += 0.01f; }),
+       // moved by twice its radius: every leaf below is then outside it, however loose the sphere
+       encode_edited(asset_, [&](Parts& p) { p.nodes[inner].x += 2.f * p.nodes[inner].radius; }),
        {"invalid tree", "does not enclose"}},
       {"node volume not the sum",
        encode_edited(asset_, [&](Parts& p) { p.nodes[inner].volume *= 1.01f; }),

@@ -8,6 +8,7 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -178,12 +179,18 @@ TEST(VolumeQuery, DeepPosesMatchBruteForce) {
   // with the AVX2 kernels where the CPU has them, and with the baseline kernels
   const auto la = make_packing(0.13, Shape::kBall, 71);
   const auto lb = make_packing(0.11, Shape::kBox, 72);
-  for (const auto& [arity_a, arity_b] : {std::pair{8, 8}, std::pair{4, 8}, std::pair{8, 3}}) {
-    const auto ta = build_sphere_tree(la, {.arity = arity_a});
-    const auto tb = build_sphere_tree(lb, {.arity = arity_b});
+  // balanced trees (leaves at one depth), and k-means trees, whose leaves at several depths bring
+  // leaf-against-inner visits
+  for (const auto& [arity_a, arity_b, split] :
+       {std::tuple{8, 8, SphereTreeSplit::kBalanced}, std::tuple{4, 8, SphereTreeSplit::kBalanced},
+        std::tuple{8, 3, SphereTreeSplit::kBalanced}, std::tuple{8, 8, SphereTreeSplit::kKMeans},
+        std::tuple{8, 3, SphereTreeSplit::kKMeans}}) {
+    const auto ta = build_sphere_tree(la, {.arity = arity_a, .split = split});
+    const auto tb = build_sphere_tree(lb, {.arity = arity_b, .split = split});
     ASSERT_TRUE(ta && tb);
-    const std::vector<Pose> poses =
-        testing::deep_poses(*ta, *tb, 3, 300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b));
+    const std::vector<Pose> poses = testing::deep_poses(
+        *ta, *tb, 3,
+        300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b + 100 * static_cast<int>(split)));
     for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
       SCOPED_TRACE(kernels.name);
       VolumeQuery query({.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
@@ -303,9 +310,13 @@ TEST(VolumeQuery, FastKernelsEqualTheScalarLensAtItsBranchPoints) {
 void expect_fast_equals_reference(float margin) {
   const auto la = make_packing(0.11, Shape::kBall, 81);
   const auto lb = make_packing(0.09, Shape::kRod, 82);
-  for (const auto& [arity_a, arity_b] : {std::pair{8, 8}, std::pair{8, 4}, std::pair{4, 4}}) {
-    const auto ta = build_sphere_tree(la, {.arity = arity_a});
-    const auto tb = build_sphere_tree(lb, {.arity = arity_b});
+  // balanced trees, and k-means trees (leaves at several depths: leaf-against-inner visits)
+  for (const auto& [arity_a, arity_b, split] :
+       {std::tuple{8, 8, SphereTreeSplit::kBalanced}, std::tuple{8, 4, SphereTreeSplit::kBalanced},
+        std::tuple{4, 4, SphereTreeSplit::kBalanced}, std::tuple{8, 8, SphereTreeSplit::kKMeans},
+        std::tuple{8, 4, SphereTreeSplit::kKMeans}}) {
+    const auto ta = build_sphere_tree(la, {.arity = arity_a, .split = split});
+    const auto tb = build_sphere_tree(lb, {.arity = arity_b, .split = split});
     ASSERT_TRUE(ta && tb);
     // the fast path with the AVX2 kernels (where the CPU has them) and with the baseline kernels
     for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
@@ -313,8 +324,9 @@ void expect_fast_equals_reference(float margin) {
       VolumeQuery fast(
           {.contact_margin = margin, .use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
       VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
-      for (const Pose& pose :
-           testing::deep_poses(*ta, *tb, 4, 400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b))) {
+      for (const Pose& pose : testing::deep_poses(
+               *ta, *tb, 4,
+               400u + static_cast<std::uint32_t>(arity_a * 10 + arity_b + 100 * static_cast<int>(split)))) {
         const VolumeQueryResult f = fast.run(*ta, *tb, pose);
         const VolumeQueryResult& r = reference.run(*ta, *tb, pose);
         ASSERT_GT(r.pair_count, 150);
@@ -343,16 +355,25 @@ TEST(VolumeQuery, FastPathEqualsReferencePathOnDeepPoses) { expect_fast_equals_r
 TEST(VolumeQuery, FastPathEqualsReferencePathWithContactMargin) { expect_fast_equals_reference(0.02f); }
 
 TEST(VolumeQuery, PrunesMostLeafPairs) {
-  // the traversal must test far fewer leaf pairs than brute force (n_a * n_b)
+  // the traversal must test far fewer leaf pairs than brute force (n_a * n_b); the k-means tree's
+  // tight leaf-level spheres keep within 50 tests per overlapping pair, the balanced tree (the
+  // default: eight leaves under each leaf-level node) tests more leaf pairs in its full SIMD blocks
+  // but visits fewer node pairs, for the same pairs
   const auto la = make_packing(0.08, Shape::kBall, 51);
-  const auto ta = build_sphere_tree(la);
-  ASSERT_TRUE(ta);
+  const auto balanced = build_sphere_tree(la);
+  const auto kmeans = build_sphere_tree(la, {.split = SphereTreeSplit::kKMeans});
+  ASSERT_TRUE(balanced && kmeans);
+  const Pose pose{quat_from_axis_angle({0, 1, 0}, 0.5), {1.5, 0, 0}};
   VolumeQuery q;
-  const auto& r = q.run(*ta, *ta, Pose{quat_from_axis_angle({0, 1, 0}, 0.5), {1.5, 0, 0}});
-  ASSERT_GT(r.stats.overlapping_pairs, 0);
+  const VolumeQueryResult b = q.run(*balanced, *balanced, pose);
+  const VolumeQueryResult& k = q.run(*kmeans, *kmeans, pose);
+  ASSERT_GT(k.stats.overlapping_pairs, 0);
   const double brute = static_cast<double>(la.size()) * static_cast<double>(la.size());
-  EXPECT_LT(static_cast<double>(r.stats.leaf_pairs_tested), 0.01 * brute);
-  EXPECT_LT(r.stats.leaf_pairs_tested, 50 * r.stats.overlapping_pairs);
+  EXPECT_LT(static_cast<double>(k.stats.leaf_pairs_tested), 0.01 * brute);
+  EXPECT_LT(static_cast<double>(b.stats.leaf_pairs_tested), 0.01 * brute);
+  EXPECT_LT(k.stats.leaf_pairs_tested, 50 * k.stats.overlapping_pairs);
+  EXPECT_EQ(b.stats.overlapping_pairs, k.stats.overlapping_pairs);
+  EXPECT_LT(b.stats.node_pairs_visited, k.stats.node_pairs_visited);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "tree_test_support.hpp"
@@ -25,17 +26,62 @@ TEST(SphereTree, BuildPassesValidateOnManyLeafSets) {
   sets.push_back(make_packing(0.05, Shape::kRod, 4));
   // identical centres: k-means cannot separate them, the builder must still split
   sets.push_back(std::vector<Sphere>(37, Sphere{1.f, 2.f, 3.f, 0.25f}));
-  for (int arity : {2, 4, 8}) {
-    for (std::size_t s = 0; s < sets.size(); ++s) {
-      const auto tree = build_sphere_tree(sets[s], {.arity = arity});
-      ASSERT_TRUE(tree) << tree.error().message;
-      const Status ok = validate(*tree);
-      EXPECT_TRUE(ok) << "set " << s << " arity " << arity << ": " << (ok ? "" : ok.error().message);
-      EXPECT_EQ(tree->leaf_count(), static_cast<int>(sets[s].size()));
-      EXPECT_LE(tree->node_count(), 2 * tree->leaf_count());
-      double volume = 0.0;
-      for (const Sphere& l : sets[s]) volume += 4.0 / 3.0 * kPi * std::pow(static_cast<double>(l.radius), 3);
-      EXPECT_NEAR(tree->total_volume(), volume, 1e-5 * volume);
+  for (const SphereTreeSplit split : {SphereTreeSplit::kBalanced, SphereTreeSplit::kKMeans}) {
+    for (int arity : {2, 4, 8}) {
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        const auto tree = build_sphere_tree(sets[s], {.arity = arity, .split = split});
+        ASSERT_TRUE(tree) << tree.error().message;
+        const Status ok = validate(*tree);
+        EXPECT_TRUE(ok) << "set " << s << " arity " << arity << " split " << static_cast<int>(split) << ": "
+                        << (ok ? "" : ok.error().message);
+        EXPECT_EQ(tree->leaf_count(), static_cast<int>(sets[s].size()));
+        EXPECT_LE(tree->node_count(), 2 * tree->leaf_count());
+        double volume = 0.0;
+        for (const Sphere& l : sets[s])
+          volume += 4.0 / 3.0 * kPi * std::pow(static_cast<double>(l.radius), 3);
+        EXPECT_NEAR(tree->total_volume(), volume, 1e-5 * volume);
+      }
+    }
+  }
+}
+
+// The balanced split: every leaf at the depth that n leaves need at the arity (within one level at
+// arity 2, where a node of three leaves has a leaf and a pair), and every inner node as full as
+// that allows (a node over m leaves has ceil(m / c) children, c = arity^(levels below it - 1)),
+// counted independently of the builder by walking the finished tree.
+TEST(SphereTree, BalancedSplitPutsLeavesAtOneDepthInFullNodes) {
+  for (const auto& [h, shape, seed] : {std::tuple{0.12, Shape::kBall, 2u}, std::tuple{0.05, Shape::kRod, 4u},
+                                       std::tuple{0.1, Shape::kBox, 3u}}) {
+    const auto leaves = make_packing(h, shape, seed);
+    for (int arity : {2, 3, 4, 8}) {
+      SCOPED_TRACE("arity " + std::to_string(arity) + ", " + std::to_string(leaves.size()) + " leaves");
+      const auto tree = build_sphere_tree(leaves, {.arity = arity});
+      ASSERT_TRUE(tree);
+      const std::vector<SphereTreeNode> nodes(tree->nodes().begin(), tree->nodes().end());
+      int levels = 1;  // of a tree over all leaves: the smallest L with arity^(L - 1) >= n
+      for (double full = 1.0; full < static_cast<double>(leaves.size()); full *= arity) ++levels;
+      EXPECT_EQ(tree->depth(), levels);
+      std::vector<int> depth(nodes.size(), 0), below(nodes.size(), 0);
+      depth[0] = 1;
+      for (std::size_t i = 0; i < nodes.size(); ++i)
+        for (int c = nodes[i].first; !nodes[i].is_leaf() && c < nodes[i].first + nodes[i].count; ++c)
+          depth[static_cast<std::size_t>(c)] = depth[i] + 1;
+      for (std::size_t i = nodes.size(); i-- > 0;) {
+        if (nodes[i].is_leaf()) {
+          below[i] = 1;
+          if (arity == 2)
+            EXPECT_GE(depth[i], levels - 1) << "leaf node " << i;
+          else
+            EXPECT_EQ(depth[i], levels) << "leaf node " << i;
+        }
+        if (nodes[i].parent >= 0) below[static_cast<std::size_t>(nodes[i].parent)] += below[i];
+      }
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes[i].is_leaf() || arity == 2) continue;
+        double capacity = 1.0;  // of a child: the largest power of the arity below the node's leaves
+        while (capacity * arity < below[i]) capacity *= arity;
+        EXPECT_EQ(nodes[i].count, static_cast<int>(std::ceil(below[i] / capacity))) << "node " << i;
+      }
     }
   }
 }
@@ -53,16 +99,18 @@ TEST(SphereTree, HierarchyIsBalancedAndTight) {
 
 TEST(SphereTree, BuildIsDeterministic) {
   const auto leaves = make_packing(0.1, Shape::kBox, 11);
-  const auto t1 = build_sphere_tree(leaves);
-  const auto t2 = build_sphere_tree(leaves);
-  ASSERT_TRUE(t1 && t2);
-  ASSERT_EQ(t1->node_count(), t2->node_count());
-  for (int i = 0; i < t1->node_count(); ++i) {
-    const auto& a = t1->nodes()[static_cast<std::size_t>(i)];
-    const auto& b = t2->nodes()[static_cast<std::size_t>(i)];
-    ASSERT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z && a.radius == b.radius && a.volume == b.volume &&
-                a.first == b.first && a.count == b.count && a.parent == b.parent)
-        << "node " << i;
+  for (const SphereTreeSplit split : {SphereTreeSplit::kBalanced, SphereTreeSplit::kKMeans}) {
+    const auto t1 = build_sphere_tree(leaves, {.split = split});
+    const auto t2 = build_sphere_tree(leaves, {.split = split});
+    ASSERT_TRUE(t1 && t2);
+    ASSERT_EQ(t1->node_count(), t2->node_count());
+    for (int i = 0; i < t1->node_count(); ++i) {
+      const auto& a = t1->nodes()[static_cast<std::size_t>(i)];
+      const auto& b = t2->nodes()[static_cast<std::size_t>(i)];
+      ASSERT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z && a.radius == b.radius && a.volume == b.volume &&
+                  a.first == b.first && a.count == b.count && a.parent == b.parent)
+          << "node " << i;
+    }
   }
 }
 
