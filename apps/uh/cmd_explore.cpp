@@ -67,6 +67,7 @@ int explore(const ExploreArgs& args) {
           {{"name", o.object},
            {"stiffness_n_per_mm", optional_number(e.stiffness_n_per_mm)},
            {"stiffness_per_press_n_per_mm", e.stiffness_per_press_n_per_mm},
+           {"press_reach_m", optional_number(e.press_reach_m)},
            {"friction_static", optional_number(e.friction_static)},
            {"friction_dynamic", optional_number(e.friction_dynamic)},
            {"texture_period_m", optional_number(e.texture_period_m)},
@@ -89,7 +90,15 @@ int explore(const ExploreArgs& args) {
   for (const auto& o : *explored) {
     const auto& e = o.estimate;
     std::printf("  %s\n", o.object.c_str());
-    std::printf("    stiffness  %s\n", shown(e.stiffness_n_per_mm, "{:.3f} N/mm").c_str());
+    std::printf(
+        "    stiffness  %s, pressed %s past first contact\n",
+        shown(e.stiffness_n_per_mm, "{:.3f} N/mm").c_str(),
+        shown(e.press_reach_m ? std::optional<double>(*e.press_reach_m * 1e3) : std::nullopt, "{:.2f} mm")
+            .c_str());
+    if (e.press_reach_m && options.press_depth_m && *e.press_reach_m < 0.95 * *options.press_depth_m)
+      std::printf(
+          "    (the force limit stopped the presses short of %.2f mm: a packed face reads low there)\n",
+          *options.press_depth_m * 1e3);
     std::printf("    friction   static %s, dynamic %s\n", shown(e.friction_static, "{:.3f}").c_str(),
                 shown(e.friction_dynamic, "{:.3f}").c_str());
     std::printf("    texture    period %s, ripple %.3f N RMS\n",

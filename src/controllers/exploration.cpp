@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/split_mix.hpp"
 #include "uh/core/statistics.hpp"
 #include "uh/haptico/device_registry.hpp"
 #include "uh/haptico/simulated_device.hpp"
@@ -29,6 +30,14 @@ constexpr double kPlaneWaveShare = 0.45;
 constexpr double kSlowAxisRipple = 0.6;
 constexpr double kApproachSpeed = 0.01;  // [m/s]
 constexpr double kMoveSpeed = 0.03;      // in the air between presses and strokes [m/s]
+// The simulated hand's own force limit [N]: above any tool's, so that the scene's tool and safety
+// limits are the ones that bind (a press into a packed face to 2.5 mm under a 1 cm ball asks
+// k pi (2 r d - d^2) times the fill there, 1.17: 40 N at k = 2.5e5 N/m^2)
+constexpr double kExplorerMaxForceN = 100.0;
+// by default a press stops at this share of the force limit: the samples it fits are never clamped
+constexpr double kPressShareOfLimit = 0.9;
+// a sample whose force is within this share of the limit may have been clamped: the fit leaves it out
+constexpr double kClampedShareOfLimit = 0.97;
 
 // Where the hand starts, which way it goes in and how the strokes are turned (planned from the
 // geometry before the run)
@@ -53,8 +62,12 @@ Vec3 around_axis(const Vec3& p, const Vec3& axis_point) {
 class ExplorerDevice final : public haptico::SimulatedDevice {
  public:
   ExplorerDevice(const haptico::SimDeviceOptions& device, const ExploreOptions& options,
-                 const ExplorePlan& plan, std::size_t capacity)
-      : SimulatedDevice("explorer", device), options_(options), plan_(plan), position_(plan.start) {
+                 const ExplorePlan& plan, double press_stop_n, std::size_t capacity)
+      : SimulatedDevice("explorer", device),
+        options_(options),
+        plan_(plan),
+        press_stop_n_(press_stop_n),
+        position_(plan.start) {
     trace_.reserve(capacity);
   }
 
@@ -119,7 +132,7 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
         update_normal(f, {}, dt);
         leg_ = press_;
         v = -options_.press_speed_m_per_s * normal_;
-        if (dot(f, normal_) >= options_.press_force_n || in_phase > 5.0 ||
+        if (dot(f, normal_) >= press_stop_n_ || in_phase > 5.0 ||
             (options_.press_depth_m && dot(touch_ - position_, normal_) >= *options_.press_depth_m)) {
           leg_ = -1;
           begin(ExplorePhase::kRelease, t);
@@ -304,6 +317,7 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
 
   ExploreOptions options_;
   ExplorePlan plan_;
+  double press_stop_n_;  // a press stops at this normal force [N]
   std::vector<ExploreSample> trace_;
   HapticSession* session_ = nullptr;
   Vec3 position_{};
@@ -328,15 +342,6 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
   Vec3 touch_{};                                        // where the press began
 };
 
-// splitmix64 for the seed's choices (the same run on every platform)
-double seeded_uniform(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  z ^= z >> 31;
-  return static_cast<double>(z >> 11) * 0x1.0p-53;
-}
-
 // The start 3 mm off the object where the site says (the seed moves it by up to 3 mm across the
 // approach), the approach direction and the stroke axes; from the packed shapes (geometry only,
 // never the material)
@@ -354,9 +359,9 @@ Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const P
     lo = {std::min(lo.x, c.x - r), std::min(lo.y, c.y - r), std::min(lo.z, c.z - r)};
     hi = {std::max(hi.x, c.x + r), std::max(hi.y, c.y + r), std::max(hi.z, c.z + r)};
   }
-  std::uint64_t rng = options.seed;
-  const double jitter_a = (seeded_uniform(rng) - 0.5) * 0.006, jitter_b = (seeded_uniform(rng) - 0.5) * 0.006;
-  const double turn = options.stroke_turn_rad.value_or(2.0 * kPi * seeded_uniform(rng));
+  core::SplitMix64 rng{options.seed};  // the seed's choices, the same run on every platform
+  const double jitter_a = (rng.uniform() - 0.5) * 0.006, jitter_b = (rng.uniform() - 0.5) * 0.006;
+  const double turn = options.stroke_turn_rad.value_or(2.0 * kPi * rng.uniform());
   const Vec3 middle{0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), lo.z};
   ExplorePlan plan;
   plan.axis_point = middle;
@@ -755,6 +760,10 @@ std::vector<StrokeForce> stroke_forces(const ExploreTrace& trace) {
   return out;
 }
 
+double press_stop_force_n(const ExploreOptions& options, double force_limit_n) {
+  return options.press_force_n.value_or(kPressShareOfLimit * force_limit_n);
+}
+
 MaterialEstimate estimate_material(const ExploreTrace& trace) {
   MaterialEstimate e;
   const ExploreOptions& o = trace.options;
@@ -765,9 +774,12 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
   // exactly quadratic, k pi (2 r d - d^2)); the press's stiffness is the slope where the fit
   // reaches zero force, at first touch: for a round tip 2 pi r k. The fit takes the depths from 15 %
   // to 95 % of the press's (a press to a depth: the same depths for every material) or the forces
-  // from 10 % to 95 % of the press force (a press to a force). The estimate is the presses' median
+  // from 10 % to 95 % of the press force (a press to a force), without the samples near the force
+  // limit (clamped: they read the limit, not the material). The estimate is the presses' median
   // (each also reads the packing's grain under the tip)
   {
+    const double press_stop_n = press_stop_force_n(o, trace.force_limit_n);
+    std::vector<double> reaches;
     std::int32_t presses = 0;
     for (const auto& s : x)
       if (s.phase == ExplorePhase::kPress) presses = std::max(presses, s.leg + 1);
@@ -792,13 +804,15 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
           deepest = std::max(deepest, d);
         }
       const double reach = deepest - first;
+      if (any) reaches.push_back(reach);
       std::vector<double> depth, force;
       for (const auto& s : x) {
         if (!in_press(s)) continue;
         const double fn = dot(s.force, n), d = -dot(s.position, n);
         const bool in_band = o.press_depth_m ? d - first >= 0.15 * reach && d - first <= 0.95 * reach
-                                             : fn >= 0.1 * o.press_force_n && fn <= 0.95 * o.press_force_n;
-        if (!in_band || fn < 2.0 * kTouchN) continue;
+                                             : fn >= 0.1 * press_stop_n && fn <= 0.95 * press_stop_n;
+        const bool clamped = norm(s.force) >= kClampedShareOfLimit * trace.force_limit_n;
+        if (!in_band || clamped || fn < 2.0 * kTouchN) continue;
         depth.push_back(d);
         force.push_back(fn);
       }
@@ -806,6 +820,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
     }
     if (!e.stiffness_per_press_n_per_mm.empty())
       e.stiffness_n_per_mm = core::median(e.stiffness_per_press_n_per_mm);
+    if (!reaches.empty()) e.press_reach_m = core::median(reaches);
   }
 
   // friction: per stroke, the largest ratio before a third of the stroke (breakaway) and the
@@ -957,12 +972,16 @@ Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const s
     alone.objects[0].shape.coverage = object_tree->coverage;
 
     const auto capacity = static_cast<std::size_t>(options.max_seconds * haptic_hz) + 16;
+    // the smallest force limit of the session's chain (haptico::ForceLimiter): the hand's, the tool's, the
+    // safety limit
+    const double force_limit_n =
+        std::min({kExplorerMaxForceN, alone.tool().force.max_force_n, alone.safety_limits.max_force_n});
     auto device = std::make_unique<ExplorerDevice>(
         haptico::SimDeviceOptions{.rate_hz = haptic_hz,
-                                  .max_force_n = 20.0,
+                                  .max_force_n = kExplorerMaxForceN,
                                   .dof_actuated = 3,
                                   .workspace_half_extents = {10.0, 10.0, 10.0}},
-        options, *plan, capacity);
+        options, *plan, press_stop_force_n(options, force_limit_n), capacity);
     ExplorerDevice* explorer = device.get();
     auto holder = std::make_shared<std::unique_ptr<haptico::HapticDevice>>(std::move(device));
     haptico::DeviceRegistry registry;
@@ -990,6 +1009,7 @@ Result<std::vector<ObjectExploration>> explore_scene(const Scene& scene, const s
     result.object = object.name;
     result.trace.samples = std::move(explorer->trace());
     result.trace.options = options;
+    result.trace.force_limit_n = force_limit_n;
     result.trace.stroke_axes[0] = plan->axes[0];
     result.trace.stroke_axes[1] = plan->axes[1];
     result.trace.axis_point = plan->axis_point;

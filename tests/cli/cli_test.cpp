@@ -867,6 +867,43 @@ TEST_F(CliTest, ExploreRecoversTheStiffnessOfAThickPackedBlock) {
   }
 }
 
+// Surfaces as stiff as the museum's materials (k = 1.5e5 and 2.5e5 N/m^2), flat and curved: a press
+// to 2.5 mm asks up to 40 N of the 1 cm ball, which the scene's tool and safety limits allow; the
+// presses reach their depth (a press stopped short by the force reads a packed face low) and the
+// stiffness is recovered within 5 % at every seed.
+TEST_F(CliTest, ExploreRecoversTheStiffnessOfStiffSurfaces) {
+  const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_stiff.json";
+  std::ifstream in(path);
+  const MaterialsScene scene{nlohmann::json::parse(in)};
+  const double r = scene.tool_radius();
+  for (const int seed : {1, 2, 3, 4}) {
+    const CommandRun run = uh(fmt::format("explore '{}' --json --seed {}", path.string(), seed),
+                              fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const nlohmann::json out = json_of(run);
+    ASSERT_EQ(out["objects"].size(), scene.scene["objects"].size());
+    for (const auto& object : scene.scene["objects"]) {
+      const std::string name = object["name"].get<std::string>();
+      const nlohmann::json e = explored(out, name);
+      const double k = scene.stiffness(name);
+      EXPECT_GE(k, 1.5e5) << name << ": as stiff as the museum's materials";
+      // the block's face is flat; ball.obj has radius 1, so a ball's radius is its meters_per_unit
+      const bool ball = object["mesh"].get<std::string>().ends_with("ball.obj");
+      const double r_eff = ball ? r * scene.radius(name) / (r + scene.radius(name)) : r;
+      const double reference = 2.0 * kPi * r_eff * k * 1e-3;  // N/mm
+      EXPECT_NEAR(e["stiffness_n_per_mm"].get<double>(), reference, 0.05 * reference)
+          << name << " seed " << seed;
+      EXPECT_GT(e["press_reach_m"].get<double>(), 0.0024)
+          << name << " seed " << seed << ": pressed 2.5 mm in";
+      // passive but for a sampled spring's leak: the force a tick sends lags the hand by the
+      // surface's stiffness times the travel in a tick (at most 1.2 times the reference at 2.5 mm
+      // under a packed face), over the 2.5 mm in and out of each of the five presses
+      const double leak = 5 * 2 * 1.2 * reference * 1e3 * 0.004 * 0.001 * 0.0025;  // J
+      EXPECT_LT(e["work_on_hand_j"].get<double>(), leak) << name << ": passive";
+    }
+  }
+}
+
 TEST_F(CliTest, MuseumJudgeReportsItsVerdictsAndTheirEvidence) {
   // the artifacts' packings are kept in the build tree (built once, like the test command's other caches)
   const std::string cache = fmt::format("UH_CACHE_DIR='{}' ", UH_TEST_CACHE_DIR);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "uh/forcecomp/material.hpp"
@@ -33,14 +34,16 @@ double normal_force(const Synthetic& m, const ExploreOptions& o, const Vec3& p) 
 }
 
 // a ball pressed into a plane, F = k pi (2 r d - d^2) (the surface at z = `surface`, first touch
-// at d = 0), labelled as press `press` (-1: unnumbered, as one press alone)
+// at d = 0), clamped at the trace's force limit as the limit chain does, labelled as press `press`
+// (-1: unnumbered, as one press alone)
 void add_press(ExploreTrace& trace, double& t, double k, double r, double surface, std::int32_t press) {
   const ExploreOptions& o = trace.options;
   const double dt = 0.001;
   for (double d = -0.0005;; d += o.press_speed_m_per_s * dt) {
-    const double f = d > 0.0 ? k * kPi * (2 * r * d - d * d) : 0.0;
+    const double f = std::min(d > 0.0 ? k * kPi * (2 * r * d - d * d) : 0.0, trace.force_limit_n);
     trace.samples.push_back({t += dt, {0, 0, surface + r - d}, {0, 0, f}, ExplorePhase::kPress, press});
-    if (f >= o.press_force_n || d >= o.press_depth_m.value_or(r)) break;  // as the hand does
+    // as the hand does
+    if (f >= press_stop_force_n(o, trace.force_limit_n) || d >= o.press_depth_m.value_or(r)) break;
   }
   for (int i = 0; i < 10; ++i)
     trace.samples.push_back({t += dt, {0, 0, surface + r}, {}, ExplorePhase::kRelease, -1});
@@ -114,6 +117,48 @@ TEST(Exploration, TheStiffnessIsTheMedianOfThePresses) {
         << "press " << i;
   ASSERT_TRUE(e.stiffness_n_per_mm.has_value());
   EXPECT_NEAR(*e.stiffness_n_per_mm, 2 * kPi * r * 3e4 * 1e-3, 0.005 * 2 * kPi * r * 3e4 * 1e-3);
+}
+
+// A stiff surface under a low force limit: pressed to a force above the limit (as a caller may
+// ask), the samples the limit chain clamped read the limit, not the material, and are left out of
+// the fit; pressed by default, the press stops at 90 % of the limit, short of its depth, and says
+// how deep it went. On a solid (the textbook law) both read the stiffness exactly.
+TEST(Exploration, APressReadsNoSampleClampedAtTheForceLimit) {
+  const double k = 1.5e5, r = 0.01, limit = 6.0;    // N/m^2, m, N: 2.5 mm in asks 20.6 N
+  const double reference = 2 * kPi * r * k * 1e-3;  // N/mm
+  ExploreTrace clamped;
+  clamped.force_limit_n = limit;
+  clamped.options.press_force_n = 20.0;
+  double t = 0.0;
+  add_press(clamped, t, k, r, 0.0, -1);
+  ASSERT_GT(std::count_if(clamped.samples.begin(), clamped.samples.end(),
+                          [&](const ExploreSample& s) { return s.force.z >= limit; }),
+            100)
+      << "the trace must hold clamped samples for the test to mean anything";
+  const MaterialEstimate e = estimate_material(clamped);
+  ASSERT_TRUE(e.stiffness_n_per_mm.has_value());
+  EXPECT_NEAR(*e.stiffness_n_per_mm, reference, 0.005 * reference);
+  // (add_press starts 0.5 mm above the surface)
+  const double air = 0.0005;
+  ASSERT_TRUE(e.press_reach_m.has_value());
+  EXPECT_NEAR(*e.press_reach_m, air + *clamped.options.press_depth_m, 1e-5);
+
+  ExploreTrace stopped;
+  stopped.force_limit_n = limit;
+  t = 0.0;
+  add_press(stopped, t, k, r, 0.0, -1);
+  const auto last_press =
+      std::find_if(stopped.samples.rbegin(), stopped.samples.rend(),
+                   [](const ExploreSample& s) { return s.phase == ExplorePhase::kPress; });
+  ASSERT_NE(last_press, stopped.samples.rend());
+  EXPECT_NEAR(last_press->force.z, 0.9 * limit, 0.1) << "the press stops at 90 % of the limit";
+  const MaterialEstimate s = estimate_material(stopped);
+  ASSERT_TRUE(s.stiffness_n_per_mm.has_value());
+  EXPECT_NEAR(*s.stiffness_n_per_mm, reference, 0.005 * reference);
+  // where k pi (2 r d - d^2) reaches 90 % of the limit
+  const double reach = r - std::sqrt(r * r - 0.9 * limit / (kPi * k));
+  ASSERT_TRUE(s.press_reach_m.has_value());
+  EXPECT_NEAR(*s.press_reach_m, air + reach, 2 * stopped.options.press_speed_m_per_s * 0.001);
 }
 
 TEST(Exploration, ASmoothFrictionlessTraceHasNoFrictionAndNoPeriod) {

@@ -10,6 +10,7 @@
 /// they never read the scene's material values.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,9 +46,12 @@ struct ExploreOptions {
   ExploreSite site{};
   /// Press this far past the first touch, then release [m]: every material is read over the same
   /// depths, so the packing's fill under the surface (which grows with depth under a packed face)
-  /// scales every stiffness alike. Empty: press to `press_force_n` instead.
+  /// scales every stiffness alike. Empty: press to the press force (below) instead.
   std::optional<double> press_depth_m = 0.0025;
-  double press_force_n = 7.0;  ///< press to this normal force (a press to a depth stops there too) [N]
+  /// Press to this normal force (a press to a depth stops there too) [N]. Empty: to 90 % of the
+  /// session's force limit (the smallest of the device's, the tool's and the safety limit), so that
+  /// a stiff surface is pressed as deep as the limit lets and no sample the fit reads is clamped.
+  std::optional<double> press_force_n;
   double press_speed_m_per_s = 0.004;  ///< speed of the press and release [m/s]
   /// How many presses: the first at the site, the others round it, `press_spread_m` away on the
   /// diagonals between the stroke axes, the hand moving between them in the air. A press reads the
@@ -116,6 +120,9 @@ struct ExploreSample {
 struct ExploreTrace {
   std::vector<ExploreSample> samples;
   ExploreOptions options{};
+  /// The smallest force limit the commanded forces went through (the device's, the tool's, the
+  /// safety limit) [N]: a sample near it may be clamped and says nothing of the material.
+  double force_limit_n = std::numeric_limits<double>::infinity();
   Vec3 stroke_axes[2]{};  ///< e1, e2: the stroke directions
   Vec3 axis_point{};      ///< a point of the footprint's vertical centre line (kAroundAxis goes round it)
 };
@@ -126,6 +133,10 @@ struct MaterialEstimate {
   /// slope of normal force against depth at first touch, the median of the presses'
   std::optional<double> stiffness_n_per_mm;
   std::vector<double> stiffness_per_press_n_per_mm;  ///< each press's slope, in the order pressed
+  /// How far past first contact the presses went (their median) [m]: short of `press_depth_m` when
+  /// the press force stopped them first (a stiff surface under a low force limit), and then the
+  /// stiffness is read over shallower depths, where a packed face is not yet full (it reads low).
+  std::optional<double> press_reach_m;
   std::optional<double> friction_static;     ///< tangential over normal force at breakaway
   std::optional<double> friction_dynamic;    ///< tangential over normal force while sliding
   std::optional<double> texture_period_m;    ///< dominant spatial period of the normal force ripple
@@ -137,6 +148,10 @@ struct MaterialEstimate {
   double texture_wave_share = 0.0;
   double ripple_axis_n[2] = {0.0, 0.0};  ///< RMS ripple of the strokes along each axis [N]
 };
+
+/// The normal force at which a press stops: `press_force_n`, by default 90 % of `force_limit_n`
+/// (the smallest force limit between the session and the device) [N].
+double press_stop_force_n(const ExploreOptions& options, double force_limit_n);
 
 /// Estimates the material from a trace alone (the device's positions, the commanded forces and the
 /// script's phase labels).
