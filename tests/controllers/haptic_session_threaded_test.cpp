@@ -148,7 +148,10 @@ TEST(HapticSessionThreaded, TwoToolsRunOnTwoHapticThreadsAndStopTogether) {
   EXPECT_EQ(right_last.force, Vec3{});
   EXPECT_EQ(norm((*session)->state(0).force_world), 0.0);
   // the left hand's ticks after the throw (with a margin for the thread that threw to trip the
-  // group: 5 periods) and before the session stopped were all zeroed
+  // group: 5 periods) and before the session stopped were all zeroed. How many such ticks the left
+  // thread runs before the owner stops it (its stop sends zero too) is the scheduler's choice, so
+  // the count of zeroed ticks is not asserted here: HapticManager's
+  // AFaultOfOneDeviceZeroesEveryDeviceOfItsGroup checks the group's zeroing tick by tick
   const SessionReport& r = (*session)->report();
   ASSERT_FALSE(r.tools[1].timeline.empty());
   const double thrown_at_s = r.tools[1].timeline.back().time_s;
@@ -157,7 +160,6 @@ TEST(HapticSessionThreaded, TwoToolsRunOnTwoHapticThreadsAndStopTogether) {
       EXPECT_EQ(t.force_n, 0.0) << "left hand at " << t.time_s << " s";
     }
   }
-  EXPECT_GT(r.tools[0].zeroed_ticks, 0u);
   std::filesystem::remove_all(cache);
 }
 

@@ -275,6 +275,39 @@ TEST(HapticManager, DeviceErrorLatchesZeroForce) {
   EXPECT_EQ(f.manager->stats().device_errors, 1u);
 }
 
+// Two devices of one fault group, stepped: when one faults, the other sends zero from its next
+// tick on (counted as zeroed, traced as such) although its own device is fine, and stays at zero.
+// Deterministic counterpart of the threaded two-tool session test, whose timing decides how many
+// ticks the other thread runs between the trip and the session's stop.
+TEST(HapticManager, AFaultOfOneDeviceZeroesEveryDeviceOfItsGroup) {
+  FaultGroup group;
+  const HapticManagerOptions options{.soft_start_s = 0.0, .limits = kNoRateLimit, .fault_group = &group};
+  Fixture left(options, false), right(options, false);
+  ASSERT_TRUE(left.manager->open());
+  ASSERT_TRUE(right.manager->open());
+  for (Fixture* f : {&left, &right})
+    f->manager->force_on_haptic_tick().add_delegate(
+        [](const DeviceState&, DeviceCommand& cmd) { cmd.force = {0.0, 0.0, 2.0}; });
+  left.manager->step(0.000);
+  right.manager->step(0.000);
+  EXPECT_EQ(left.device->last.force, (Vec3{0, 0, 2}));
+  EXPECT_EQ(right.device->last.force, (Vec3{0, 0, 2}));
+  EXPECT_FALSE(group.tripped());
+
+  right.device->status = DeviceStatus::kFault;
+  const TraceSample faulted = right.manager->step(0.001);
+  EXPECT_EQ(faulted.flags, kTraceDeviceError | kTraceZeroed);
+  EXPECT_TRUE(group.tripped());
+  for (int i = 0; i < 3; ++i) {
+    const TraceSample t = left.manager->step(0.001 + 0.001 * i);
+    EXPECT_EQ(t.flags & kTraceZeroed, kTraceZeroed) << "tick " << i;
+    EXPECT_EQ(t.sent.force, Vec3{});
+    EXPECT_EQ(left.device->last.force, Vec3{});
+  }
+  EXPECT_EQ(left.manager->stats().zeroed_ticks, 3u);
+  EXPECT_FALSE(left.manager->stats().faulted) << "the left device itself did not fault";
+}
+
 TEST(HapticManager, SoftStartFadesForceIn) {
   Fixture f({.rate_hz = 1000.0, .soft_start_s = 0.01});  // ten ticks
   ASSERT_TRUE(f.manager->open());
