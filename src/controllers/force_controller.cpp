@@ -2,22 +2,39 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace uh::controllers {
 namespace {
 
-// The volume-weighted centroid of one section's pairs [m, world frame].
-Vec3 section_centroid(const ContactFrame& frame, const ContactSection& section) {
-  Vec3 sum{};
+// The volume-weighted centroid of some pairs [m], the gradient of their volume with respect to
+// the tool's (B's) position [m^2] and their volume [m^3], world frame.
+struct PairsGeometry {
+  Vec3 centroid{};
+  Vec3 gradient{};
   double volume = 0.0;
-  for (const SpherePairContact& p : frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
-                                                          static_cast<std::size_t>(section.pair_count))) {
+};
+PairsGeometry pairs_geometry(std::span<const SpherePairContact> pairs,
+                             const forcecomp::PatchSelection& selection) {
+  PairsGeometry g;
+  Vec3 sum{};
+  for (const SpherePairContact& p : pairs) {
+    if (!selection.includes(p)) continue;
     const double v = static_cast<double>(p.volume);
     sum += v * Vec3{static_cast<double>(p.centroid_world[0]), static_cast<double>(p.centroid_world[1]),
                     static_cast<double>(p.centroid_world[2])};
-    volume += v;
+    g.gradient -= static_cast<double>(p.area) * Vec3{static_cast<double>(p.normal_world[0]),
+                                                     static_cast<double>(p.normal_world[1]),
+                                                     static_cast<double>(p.normal_world[2])};
+    g.volume += v;
   }
-  return volume > 0.0 ? sum / volume : Vec3{};
+  g.centroid = g.volume > 0.0 ? sum / g.volume : Vec3{};
+  return g;
+}
+
+void add(forcecomp::Wrench& sum, const forcecomp::Wrench& w) {
+  sum.force += w.force;
+  sum.torque += w.torque;
 }
 
 // Raises an atomic maximum written by one thread (the haptic thread) and read by others.
@@ -52,46 +69,116 @@ void ForceController::add_watched(collette::ObjectId object, double coverage_pro
     w->component = forcecomp::ForceComponent(options);
     forcecomp::SurfaceStageOptions stage = surface;
     stage.mode = options.mode;
-    w->surface = forcecomp::SurfaceStage(*material, stage);
+    for (PatchStage& s : w->stages) s.surface = forcecomp::SurfaceStage(*material, stage);
+    w->has_surface = w->stages[0].surface.active();
   }
   watched_.push_back(std::move(w));
 }
 
-void ForceController::hold_contact_geometry(Watched& w, const FrameContact& frame,
+void ForceController::take_patches(Watched& w, std::span<const FrameContact> patches,
+                                   const Pose& world_from_tool) {
+  // where each new patch touches the tool
+  Vec3 point_tool[forcecomp::kMaxContactPatches];
+  std::int32_t stage_of[forcecomp::kMaxContactPatches];
+  bool taken[forcecomp::kMaxContactPatches] = {};
+  const std::size_t n = std::min(patches.size(), static_cast<std::size_t>(forcecomp::kMaxContactPatches));
+  for (std::size_t i = 0; i < n; ++i) {
+    point_tool[i] = transform_point(inverse(patches[i].world_from_tool), patches[i].volume_centroid_world);
+    stage_of[i] = -1;
+  }
+  // greedily, the closest (patch, stage) first: a patch is the stage's when its point on the tool
+  // moved less than a link distance (the contact did not jump to another region of the tool)
+  for (;;) {
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_i = 0;
+    std::int32_t best_s = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (stage_of[i] >= 0) continue;
+      for (std::int32_t k = 0; k < forcecomp::kMaxContactPatches; ++k) {
+        const PatchStage& s = w.stages[k];
+        if (!s.live || taken[k]) continue;
+        const double d = norm(point_tool[i] - s.contact_point_tool);
+        if (d < std::max(patches[i].link, s.link) && d < best) {
+          best = d;
+          best_i = i;
+          best_s = k;
+        }
+      }
+    }
+    if (best_s < 0) break;
+    stage_of[best_i] = best_s;
+    taken[best_s] = true;
+  }
+  // stages left without a patch end their contact; new patches start a stick point in a free one
+  for (std::int32_t k = 0; k < forcecomp::kMaxContactPatches; ++k) {
+    PatchStage& s = w.stages[k];
+    if (s.live && !taken[k]) {
+      s.live = false;
+      s.surface.reset();
+      s.renderer.reset();
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (stage_of[i] < 0) {
+      for (std::int32_t k = 0; k < forcecomp::kMaxContactPatches && stage_of[i] < 0; ++k)
+        if (!w.stages[k].live) {
+          stage_of[i] = k;
+          w.stages[k].live = true;
+          w.stages[k].contact_point_tool = point_tool[i];  // no shift: a new stick point
+        }
+    }
+    PatchStage& s = w.stages[stage_of[i]];
+    s.index = static_cast<std::int32_t>(i);
+    s.link = patches[i].link;
+    hold_contact_geometry(s, patches[i], world_from_tool);
+  }
+}
+
+void ForceController::end_patches(Watched& w) {
+  for (PatchStage& s : w.stages) {
+    s.live = false;
+    s.surface.reset();
+    s.renderer.reset();
+  }
+}
+
+void ForceController::hold_contact_geometry(PatchStage& s, const FrameContact& frame,
                                             const Pose& world_from_tool) {
-  if (!w.surface.active()) return;
-  // the contact point: the overlap's volume centroid, fixed on the tool until the next frame
+  // the contact point: the patch's volume centroid, fixed on the tool until the next frame
   const Vec3 point_tool = transform_point(inverse(frame.world_from_tool), frame.volume_centroid_world);
   const Vec3 moved =
-      transform_point(world_from_tool, point_tool) - transform_point(world_from_tool, w.contact_point_tool);
-  w.surface.shift_contact_point(moved, frame.world_from_object);
-  w.contact_point_tool = point_tool;
-  w.contact_point_world_at_frame = frame.volume_centroid_world;
+      transform_point(world_from_tool, point_tool) - transform_point(world_from_tool, s.contact_point_tool);
+  s.surface.shift_contact_point(moved, frame.world_from_object);
+  s.contact_point_tool = point_tool;
+  s.contact_point_world_at_frame = frame.volume_centroid_world;
   // depth: a round tip of radius r pressed d in overlaps pi r d^2 through a disk of 2 pi r d, so
   // d = 2 V / |dV/dx| (a flat face gives V / |dV/dx|, half of it: the texture then reads deeper)
   const double gradient = norm(frame.volume_gradient_world);
-  w.depth_at_frame_m = gradient > 0.0 ? 2.0 * frame.total_volume / gradient : 0.0;
+  s.depth_at_frame_m = gradient > 0.0 ? 2.0 * frame.total_volume / gradient : 0.0;
 }
 
-forcecomp::Wrench ForceController::add_surface(Watched& w, const forcecomp::Wrench& penalty,
-                                               const Pose& world_from_tool,
+forcecomp::Wrench ForceController::add_surface(const Watched& w, PatchStage& s,
+                                               const forcecomp::Wrench& penalty, const Pose& world_from_tool,
                                                const forcecomp::BodyMotion& tool_motion) {
-  if (!w.surface.active()) return penalty;
   forcecomp::ContactGeometry contact;
   contact.normal_world = normalized(penalty.force);
-  contact.point_world = transform_point(world_from_tool, w.contact_point_tool);
+  contact.point_world = transform_point(world_from_tool, s.contact_point_tool);
   // the depth follows the tool between frames: moving along -n goes deeper
   contact.depth_m =
-      w.depth_at_frame_m - dot(contact.normal_world, contact.point_world - w.contact_point_world_at_frame);
+      s.depth_at_frame_m - dot(contact.normal_world, contact.point_world - s.contact_point_world_at_frame);
   contact.world_from_object = w.world_from_object;
   contact.world_from_tool = world_from_tool;
-  return w.surface.apply(penalty, contact, tool_motion.center_of_mass_world).wrench;
+  return s.surface.apply(penalty, contact, tool_motion.center_of_mass_world).added;
+}
+
+void ForceController::bind(collette::CollisionWorld& world) {
+  world_ = &world;
+  collision_connection_ = world.on_collision().connect<&ForceController::on_collision>(*this);
 }
 
 void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManager& manager) {
-  world_ = &world;
+  bind(world);
   manager_ = &manager;
-  collision_connection_ = world.on_collision().connect<&ForceController::on_collision>(*this);
   force_connection_ = manager.force_on_haptic_tick().connect<&ForceController::on_force>(*this);
 }
 
@@ -112,19 +199,36 @@ void ForceController::publish_model(Watched& w, const ContactFrame& frame, const
   const auto pairs = section != nullptr ? frame.pairs().subspan(static_cast<std::size_t>(section->first_pair),
                                                                 static_cast<std::size_t>(section->pair_count))
                                         : std::span<const SpherePairContact>{};
-  forcecomp::WrenchModel& m = w.models.write_buffer();
-  m = forcecomp::build_wrench_model(pairs, world_from_other, world_from_tool_at_frame,
-                                    w.component.penalty_input(at_frame, {}, w.coverage_product), options_.model);
-  m.sequence = frame.sequence;
-  m.time_s = frame.time_s;
-  w.modelled_contact = m.contact;
+  FrameModels& f = w.models.write_buffer();
+  const forcecomp::PenaltyInput input = w.component.penalty_input(at_frame, {}, w.coverage_product);
+  const auto build = [&](const forcecomp::PatchSelection& selection) {
+    forcecomp::WrenchModel m = forcecomp::build_wrench_model(
+        pairs, world_from_other, world_from_tool_at_frame, input, options_.model, selection);
+    m.sequence = frame.sequence;
+    m.time_s = frame.time_s;
+    return m;
+  };
+  f.whole = build({});
+  f.patches = {};
+  if (w.has_surface && f.whole.contact) {
+    // a patch's model per patch; one patch (or pairs too shallow to place) is the whole
+    f.patches = forcecomp::find_contact_patches(pairs);
+    if (f.patches.count <= 1) {
+      f.patches.count = 1;
+      f.patch_models[0] = f.whole;
+    } else {
+      for (std::int32_t i = 0; i < f.patches.count; ++i) f.patch_models[i] = build({&f.patches, i});
+    }
+  }
+  w.modelled_contact = f.whole.contact;
   w.models.publish();
 }
 
 void ForceController::on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame) {
   if (b != tool_ || !uses_model()) return;  // the tool is always B of its watchers: forces push B out of A
   if (a != ContactFrame::kEveryObject) {
-    if (Watched* w = find_watched(a)) publish_model(*w, frame, frame.sections().empty() ? nullptr : &frame.sections().front());
+    if (Watched* w = find_watched(a))
+      publish_model(*w, frame, frame.sections().empty() ? nullptr : &frame.sections().front());
     return;
   }
   // the tool against everything: a model per touched object, and one without contact for each
@@ -155,26 +259,47 @@ void ForceController::take_frame(const ContactFrame& frame, const Pose& world_fr
       w->held.clear();
       w->held_wrench = {};
       w->held_pairs = 0;
-      if (!model) w->surface.reset();
+      if (!model) end_patches(*w);
       continue;
     }
     w->held.hold(frame, *section);
     w->world_from_object = section->world_from_a;
-    if (!model) {
-      // the section's centroid: the frame's when it has one section, else the pairs' own
-      const Vec3 centroid = frame.section_count == 1 ? frame.volume_centroid_world : section_centroid(frame, *section);
-      hold_contact_geometry(*w,
-                            {section->world_from_b, section->world_from_a, centroid, section->volume_gradient_world,
-                             section->total_volume},
-                            world_from_tool);
-    }
+    const auto pairs = frame.pairs().subspan(static_cast<std::size_t>(section->first_pair),
+                                             static_cast<std::size_t>(section->pair_count));
     if (!options_.multi_rate) {
       // held-force mode: the frame's own force, kept until the next frame
-      const auto r = w->component.evaluate(frame.pairs().subspan(static_cast<std::size_t>(section->first_pair),
-                                                                 static_cast<std::size_t>(section->pair_count)),
-                                           tool_motion, {}, w->coverage_product);
+      const auto r = w->component.evaluate(pairs, tool_motion, {}, w->coverage_product);
       w->held_wrench = r.wrench;
       w->held_pairs = r.pair_count;
+    }
+    if (model || !w->has_surface) continue;
+    // the section's patches and where each touches; one patch is the whole section (its centroid
+    // the frame's when it has one section, else the pairs' own)
+    w->held_patches = forcecomp::find_contact_patches(pairs);
+    const std::int32_t count = std::max(w->held_patches.count, 1);
+    FrameContact found[forcecomp::kMaxContactPatches];
+    for (std::int32_t i = 0; i < count; ++i) {
+      const forcecomp::PatchSelection selection{count > 1 ? &w->held_patches : nullptr, i};
+      const PairsGeometry g = pairs_geometry(pairs, selection);
+      const bool whole = count == 1;
+      found[i] = {section->world_from_b,
+                  section->world_from_a,
+                  whole && frame.section_count == 1 ? frame.volume_centroid_world : g.centroid,
+                  whole ? section->volume_gradient_world : g.gradient,
+                  whole ? section->total_volume : g.volume,
+                  w->held_patches.patch[i].link};
+    }
+    take_patches(*w, {found, static_cast<std::size_t>(count)}, world_from_tool);
+    if (!options_.multi_rate) {
+      // each patch's force at the frame (the held pairs at the frame's poses)
+      for (PatchStage& s : w->stages)
+        if (s.live)
+          s.held_wrench =
+              count > 1 ? w->component
+                              .evaluate(w->held, section->world_from_a, section->world_from_b, tool_motion,
+                                        {}, w->coverage_product, {&w->held_patches, s.index})
+                              .wrench
+                        : w->held_wrench;
     }
   }
 }
@@ -208,22 +333,29 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   if ((!model || options_.check_model) && world_ != nullptr) {
     // the previous frames' slots go back to the collision thread: hold the new ones where they lie
     for (const collette::WatcherId watcher : watchers_)
-      if (const ContactFrame* frame = world_->take_contact(watcher)) take_frame(*frame, world_from_tool, tool_motion);
+      if (const ContactFrame* frame = world_->take_contact(watcher))
+        take_frame(*frame, world_from_tool, tool_motion);
   }
   for (auto& w : watched_) {
     if (model) {
       if (w->models.update()) {
-        const forcecomp::WrenchModel& m = w->models.read_buffer();
+        const FrameModels& f = w->models.read_buffer();
+        const forcecomp::WrenchModel& m = f.whole;
         frames_received_.fetch_add(1, std::memory_order_relaxed);
         w->renderer.take(m);
-        if (m.contact) {
-          w->world_from_object = m.world_from_other;
-          hold_contact_geometry(*w,
-                                {m.world_from_tool, m.world_from_other, m.volume_centroid_world,
-                                 m.volume_gradient_world, m.total_volume},
-                                world_from_tool);
-        } else {
-          w->surface.reset();
+        if (m.contact) w->world_from_object = m.world_from_other;
+        if (m.contact && w->has_surface) {
+          FrameContact found[forcecomp::kMaxContactPatches];
+          for (std::int32_t i = 0; i < f.patches.count; ++i) {
+            const forcecomp::WrenchModel& p = f.patch_models[i];
+            found[i] = {p.world_from_tool,       p.world_from_other, p.volume_centroid_world,
+                        p.volume_gradient_world, p.total_volume,     f.patches.patch[i].link};
+          }
+          take_patches(*w, {found, static_cast<std::size_t>(f.patches.count)}, world_from_tool);
+          for (PatchStage& s : w->stages)
+            if (s.live) s.renderer.take(f.patch_models[s.index]);
+        } else if (w->has_surface) {
+          end_patches(*w);
         }
       }
       if (options_.check_model && !w->held.empty())
@@ -236,27 +368,42 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
       if (!w->renderer.active(now)) continue;
       const forcecomp::Wrench r = w->renderer.render(now, world_from_tool.rotation, tool_motion);
       const forcecomp::WrenchModel& m = w->renderer.model();
-      const forcecomp::Wrench felt = m.contact ? add_surface(*w, r, world_from_tool, tool_motion) : r;
-      contact.force += felt.force;
-      contact.torque += felt.torque;
+      contact.force += r.force;
+      contact.torque += r.torque;
+      if (m.contact && w->has_surface)
+        for (PatchStage& s : w->stages)
+          if (s.live)
+            add(contact, add_surface(*w, s, s.renderer.render(now, world_from_tool.rotation, tool_motion),
+                                     world_from_tool, tool_motion));
       pairs += m.pair_count;
       if (m.contact) oldest_data_s = std::min(oldest_data_s, m.time_s);
       continue;
     }
     if (w->held.empty()) continue;
     oldest_data_s = std::min(oldest_data_s, w->held.time_s());
+    forcecomp::Wrench penalty = w->held_wrench;
     if (options_.multi_rate) {
       const auto r = w->component.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
                                            w->coverage_product);
-      const forcecomp::Wrench felt = add_surface(*w, r.wrench, world_from_tool, tool_motion);
-      contact.force += felt.force;
-      contact.torque += felt.torque;
+      penalty = r.wrench;
       pairs += r.pair_count;
     } else {
-      const forcecomp::Wrench felt = add_surface(*w, w->held_wrench, world_from_tool, tool_motion);
-      contact.force += felt.force;
-      contact.torque += felt.torque;
       pairs += w->held_pairs;
+    }
+    add(contact, penalty);
+    if (!w->has_surface) continue;
+    const bool one = w->held_patches.count <= 1;
+    for (PatchStage& s : w->stages) {
+      if (!s.live) continue;
+      // a patch's penalty: the pairs of the patch re-evaluated (or held); one patch is the whole
+      const forcecomp::Wrench patch =
+          one || !options_.multi_rate
+              ? (one ? penalty : s.held_wrench)
+              : w->component
+                    .evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
+                              w->coverage_product, {&w->held_patches, s.index})
+                    .wrench;
+      add(contact, add_surface(*w, s, patch, world_from_tool, tool_motion));
     }
   }
 
@@ -313,8 +460,8 @@ ForceControllerStats ForceController::stats() const {
   s.model_held_ticks = model_held_ticks_.load(std::memory_order_relaxed);
   s.model_checked_ticks = model_checked_ticks_.load(std::memory_order_relaxed);
   if (s.model_checked_ticks > 0)
-    s.model_error_rms_n =
-        std::sqrt(model_error_sum_sq_.load(std::memory_order_relaxed) / static_cast<double>(s.model_checked_ticks));
+    s.model_error_rms_n = std::sqrt(model_error_sum_sq_.load(std::memory_order_relaxed) /
+                                    static_cast<double>(s.model_checked_ticks));
   s.model_error_max_n = model_error_max_n_.load(std::memory_order_relaxed);
   s.safety = safety_.counters();
   return s;

@@ -42,8 +42,9 @@ PenaltyResult ForceComponent::evaluate(const ContactFrame& frame, const BodyMoti
 
 PenaltyResult ForceComponent::evaluate(HeldContactSet& held, const Pose& world_from_a,
                                        const Pose& world_from_b, const BodyMotion& self,
-                                       const BodyMotion& other, double coverage_product) const {
-  return held.evaluate(world_from_a, world_from_b, penalty_input(self, other, coverage_product));
+                                       const BodyMotion& other, double coverage_product,
+                                       const PatchSelection& selection) const {
+  return held.evaluate(world_from_a, world_from_b, penalty_input(self, other, coverage_product), selection);
 }
 
 }  // namespace uh::forcecomp

@@ -59,7 +59,8 @@ void HeldContactSet::clear() {
   time_s_ = 0.0;
 }
 
-std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_from_a, const Pose& world_from_b) {
+std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_from_a,
+                                                              const Pose& world_from_b) {
   const std::size_t n = std::min(held_.size(), static_cast<std::size_t>(scratch_capacity_));
   dropped_pairs_ += held_.size() - n;
   for (std::size_t i = 0; i < n; ++i) {
@@ -85,7 +86,8 @@ std::span<const SpherePairContact> HeldContactSet::reevaluate(const Pose& world_
   return {scratch_.get(), n};
 }
 
-PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& world_from_b, const PenaltyInput& input) {
+PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& world_from_b,
+                                       const PenaltyInput& input, const PatchSelection& selection) {
   // everything in A's frame: A's spheres need no transform, B's one; the sums turn back at the end
   const Pose a_from_world = inverse(world_from_a);
   const Pose a_from_b = a_from_world * world_from_b;
@@ -137,7 +139,7 @@ PenaltyResult HeldContactSet::evaluate(const Pose& world_from_a, const Pose& wor
   // pass 2: the same per-pair terms in float, fed to the law in double
   for (const SpherePairContact& p : held_) {
     Local l;
-    if (!place(p, l)) continue;
+    if (!place(p, l) || !selection.includes(p)) continue;
     const float d = std::sqrt(l.d2);
     const SphereOverlap<float> o = sphere_overlap(d, p.sphere_a_local.radius, p.sphere_b_local.radius);
     if (!(o.volume > 0.f)) continue;

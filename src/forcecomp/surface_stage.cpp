@@ -95,9 +95,10 @@ SurfaceResult SurfaceStage::apply(const Wrench& penalty, const ContactGeometry& 
     out.sliding = !sticking_;
   }
 
-  const Vec3 added = texture_force + friction_force;
-  out.wrench.force += added;
-  if (options_.mode == ForceMode::k6Dof) out.wrench.torque += cross(p - tool_center_of_mass_world, added);
+  out.added.force = texture_force + friction_force;
+  if (options_.mode == ForceMode::k6Dof) out.added.torque = cross(p - tool_center_of_mass_world, out.added.force);
+  out.wrench.force += out.added.force;
+  out.wrench.torque += out.added.torque;
   out.friction_force_world = friction_force;
   out.texture_force_world = texture_force;
   touching_ = true;

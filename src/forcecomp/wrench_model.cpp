@@ -41,7 +41,7 @@ double area_derivative(double d, double inv_d, double r1, double r2) {
 
 WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const Pose& world_from_a,
                                const Pose& world_from_b, const PenaltyInput& input,
-                               const WrenchModelOptions& options) {
+                               const WrenchModelOptions& options, const PatchSelection& selection) {
   WrenchModel m;
   const bool tool_is_b = input.tool_side == ContactSide::kB;
   const Pose& world_from_tool = tool_is_b ? world_from_b : world_from_a;
@@ -80,6 +80,7 @@ WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const P
                 r.m[2][0] * x + r.m[2][1] * y + r.m[2][2] * z + t.z};
   };
   double total = 0.0;
+  double all_volume = 0.0;  // of every pair, selected or not: it scales the damping
   double weight = 0.0, weighted_radius = 0.0, weighted_lever2 = 0.0;
   double plain_radius = 0.0, plain_lever2 = 0.0;
   for (const SpherePairContact& p : pairs) {
@@ -93,6 +94,8 @@ WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const P
     const double d = norm(delta);
     const SphereOverlap<double> o = sphere_overlap(d, r_other, r_tool);
     if (!(o.volume > 0.0) || !std::isfinite(o.volume)) continue;
+    all_volume += o.volume;
+    if (!selection.includes(p)) continue;
     ++m.pair_count;
     total += o.volume;
     // coincident centres leave the centre line to the query's normal, and no sideways stiffness
@@ -165,7 +168,7 @@ WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const P
   m.contact = true;
   m.volume_centroid_world = (1.0 / total) * volume_moment;
 
-  const double damping_scale = input.damping / std::max(total, damping_full_volume(input) * calibration);
+  const double damping_scale = input.damping / std::max(all_volume, damping_full_volume(input) * calibration);
   for (int r = 0; r < 6; ++r)
     for (int c = 0; c < 6; ++c) m.damping[r][c] = damping_scale * volume_jj[r][c];
 

@@ -51,6 +51,11 @@ TEST(RealTime, TickPathsDoNotAllocate) {
     if (tick % 5 == 0) renderer.take(build_wrench_model(*frame, tool.penalty_input(self, {})));
     const Wrench modelled = renderer.render(0.001 * tick, moved.rotation, self);
     sink += modelled.force.x;
+    // friction per contact patch: the patches of a frame, a patch's model and its held pairs
+    const ContactPatches patches = find_contact_patches(frame->pairs());
+    const PatchSelection first{&patches, 0};
+    sink += build_wrench_model(frame->pairs(), Pose{}, Pose{}, tool.penalty_input(self, {}), {}, first).wrench.force.x;
+    sink += tool.evaluate(held, Pose{}, moved, self, {}, 1.0, first).wrench.force.x;
     const Wrench safe = safety.apply(fused.wrench, 0.001 * tick, 0.0);
     const CouplingOutput out = coupling.step(moved, {}, {}, safe, 0.001);
     sink += direct.wrench.force.x + two_step.wrench.force.x + out.device_wrench.force.x;

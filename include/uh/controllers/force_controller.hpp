@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "uh/collette/collision_world.hpp"
@@ -13,6 +14,7 @@
 #include "uh/core/contact.hpp"
 #include "uh/core/delegator.hpp"
 #include "uh/core/latest_value.hpp"
+#include "uh/forcecomp/contact_patches.hpp"
 #include "uh/forcecomp/force_component.hpp"
 #include "uh/forcecomp/force_safety.hpp"
 #include "uh/forcecomp/held_contact_set.hpp"
@@ -54,14 +56,14 @@ struct ForceControllerOptions {
 
 /// What the controller did so far; a snapshot, plain data.
 struct ForceControllerStats {
-  std::uint64_t ticks = 0;              ///< force ticks run
-  std::uint64_t contact_ticks = 0;      ///< ticks with at least one held pair of positive volume
-  std::uint64_t frames_received = 0;    ///< contact frames taken over from the collision thread
-  double max_force_n = 0.0;             ///< largest |force| it asked for [N], before the limit chain
-  double max_torque_nm = 0.0;           ///< largest |torque| it asked for [N m], before the limit chain
-  double max_force_step_n = 0.0;        ///< largest tick-to-tick change of the contact force before limits [N]
-  double last_force_n = 0.0;            ///< |force| of the last tick [N]
-  std::int32_t last_pairs = 0;          ///< pairs used in the last tick
+  std::uint64_t ticks = 0;            ///< force ticks run
+  std::uint64_t contact_ticks = 0;    ///< ticks with at least one held pair of positive volume
+  std::uint64_t frames_received = 0;  ///< contact frames taken over from the collision thread
+  double max_force_n = 0.0;           ///< largest |force| it asked for [N], before the limit chain
+  double max_torque_nm = 0.0;         ///< largest |torque| it asked for [N m], before the limit chain
+  double max_force_step_n = 0.0;      ///< largest tick-to-tick change of the contact force before limits [N]
+  double last_force_n = 0.0;          ///< |force| of the last tick [N]
+  std::int32_t last_pairs = 0;        ///< pairs used in the last tick
   std::uint64_t model_clamped_ticks = 0;  ///< kModel: ticks beyond a model's trust range (clamped)
   std::uint64_t model_held_ticks = 0;     ///< kModel: ticks that held the last wrench (far beyond it)
   std::uint64_t model_checked_ticks = 0;  ///< check_model: ticks compared with the exact re-evaluation
@@ -114,6 +116,9 @@ class ForceController {
   /// Connects to the world's OnCollision and the manager's ForceOnHapticTick. The coupling's proxy
   /// is placed at the handle on the first tick. Controlling thread, before the threads start.
   void bind(collette::CollisionWorld& world, haptico::HapticManager& manager);
+  /// Connects to the world's OnCollision only: the caller runs on_force() itself (a test, a host
+  /// that steps the controller), whose tick time is then the device state's time_s.
+  void bind(collette::CollisionWorld& world);
 
   /// OnCollision handler: collision thread; real-time safe.
   void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
@@ -133,27 +138,51 @@ class ForceController {
 
  private:
   bool uses_model() const { return options_.multi_rate && options_.tick_force == TickForce::kModel; }
+  // A frame's models for the haptic thread (kModel): the pair's whole model, whose wrench is the
+  // penalty felt, and, when the pair renders friction or texture, its contact patches' models
+  // (forcecomp/contact_patches.hpp), whose wrenches split it into one normal force per patch.
+  // Fixed-size plain data: it crosses in a LatestValue.
+  struct FrameModels {
+    forcecomp::WrenchModel whole;
+    forcecomp::ContactPatches patches;  // count 0 without a surface stage or without contact
+    forcecomp::WrenchModel patch_models[forcecomp::kMaxContactPatches];
+  };
+  // The friction and texture of one contact patch (haptic thread): its stick point lives as long
+  // as the patch is found again, frame after frame, near the same point of the tool.
+  struct PatchStage {
+    bool live = false;                        // a patch of the held frame or model is rendered here
+    std::int32_t index = 0;                   // which patch of the held frame or model
+    double link = 0.0;                        // how far its point may move on the tool and stay it [m]
+    forcecomp::SurfaceStage surface;          // friction and texture after the patch's penalty
+    forcecomp::WrenchModelRenderer renderer;  // kModel: the patch's model
+    forcecomp::Wrench held_wrench{};          // held-force mode: the patch's force at the frame
+    Vec3 contact_point_tool{};                // the patch's contact point, tool frame [m]
+    Vec3 contact_point_world_at_frame{};      // where that point was when the frame was queried [m]
+    double depth_at_frame_m = 0.0;            // the patch's penetration estimate [m]
+  };
   struct Watched {
     collette::ObjectId object = -1;
-    double coverage_product = 1.0;             // c_object * c_tool
-    forcecomp::ForceComponent component;       // the tool's, with the pair's material stiffness and damping
-    forcecomp::SurfaceStage surface;           // friction and texture after the penalty (haptic thread)
-    Vec3 contact_point_tool{};                 // the held frame's contact point, tool frame [m]
-    Vec3 contact_point_world_at_frame{};       // where that point was when the frame was queried [m]
-    double depth_at_frame_m = 0.0;             // the held frame's penetration estimate [m]
-    LatestValue<forcecomp::WrenchModel> models;  // collision thread -> haptic thread (kModel)
-    bool modelled_contact = false;             // collision thread: the last model published had contact
-    forcecomp::WrenchModelRenderer renderer;   // haptic thread
-    forcecomp::HeldContactSet held;            // haptic thread: a view of the world's frame, its section
-    bool in_frame = false;                     // haptic thread: scratch of taking a frame
-    Pose world_from_object{};                  // object pose used by the held frame's query
-    forcecomp::Wrench held_wrench{};           // force of the newest frame (held-force mode)
+    double coverage_product = 1.0;        // c_object * c_tool
+    forcecomp::ForceComponent component;  // the tool's, with the pair's material stiffness and damping
+    bool has_surface = false;             // the material has friction or texture (else no patches)
+    PatchStage stages[forcecomp::kMaxContactPatches];  // haptic thread, by stage, not by patch
+    LatestValue<FrameModels> models;                   // collision thread -> haptic thread (kModel)
+    bool modelled_contact = false;            // collision thread: the last model published had contact
+    forcecomp::WrenchModelRenderer renderer;  // haptic thread
+    forcecomp::HeldContactSet held;           // haptic thread: a view of the world's frame, its section
+    forcecomp::ContactPatches held_patches;   // haptic thread: the held section's patches (with a surface)
+    bool in_frame = false;                    // haptic thread: scratch of taking a frame
+    Pose world_from_object{};                 // object pose used by the held frame's query
+    forcecomp::Wrench held_wrench{};          // force of the newest frame (held-force mode)
     std::int32_t held_pairs = 0;
-    explicit Watched(const forcecomp::WrenchModelOptions& model) : renderer(model) {}
+    explicit Watched(const forcecomp::WrenchModelOptions& model) : renderer(model) {
+      for (PatchStage& s : stages) s.renderer = forcecomp::WrenchModelRenderer(model);
+    }
   };
   Watched* find_watched(collette::ObjectId object);
   void publish_model(Watched& w, const ContactFrame& frame, const ContactSection* section);
-  void take_frame(const ContactFrame& frame, const Pose& world_from_tool, const forcecomp::BodyMotion& tool_motion);
+  void take_frame(const ContactFrame& frame, const Pose& world_from_tool,
+                  const forcecomp::BodyMotion& tool_motion);
 
   collette::ObjectId tool_;
   forcecomp::ForceComponent component_;
@@ -174,19 +203,25 @@ class ForceController {
   bool proxy_placed_ = false;
   Vec3 last_contact_force_{};
 
-  // the one place where materials come in: friction and texture on the pair's penalty wrench
-  forcecomp::Wrench add_surface(Watched& w, const forcecomp::Wrench& penalty, const Pose& world_from_tool,
-                                const forcecomp::BodyMotion& tool_motion);
   // where a frame was found: the tool's and the object's poses, the overlap's volume centroid and
-  // its gradient (from a ContactFrame or a WrenchModel)
+  // its gradient (of a patch, from a ContactFrame or a WrenchModel), and the patch's link distance
   struct FrameContact {
     Pose world_from_tool{};
     Pose world_from_object{};
     Vec3 volume_centroid_world{};
     Vec3 volume_gradient_world{};
     double total_volume = 0.0;
+    double link = 0.0;
   };
-  void hold_contact_geometry(Watched& w, const FrameContact& frame, const Pose& world_from_tool);
+  // the patches of a new frame or model take over the stages of the last one's (by where they
+  // touch the tool), the others start new stick points or end
+  void take_patches(Watched& w, std::span<const FrameContact> patches, const Pose& world_from_tool);
+  void hold_contact_geometry(PatchStage& s, const FrameContact& frame, const Pose& world_from_tool);
+  void end_patches(Watched& w);
+  // the one place where materials come in: friction and texture of one patch on its penalty
+  // wrench; returns what they add
+  forcecomp::Wrench add_surface(const Watched& w, PatchStage& s, const forcecomp::Wrench& penalty,
+                                const Pose& world_from_tool, const forcecomp::BodyMotion& tool_motion);
 
   // published to stats() readers
   std::atomic<std::uint64_t> ticks_{0};

@@ -6,6 +6,7 @@
 
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
+#include "uh/forcecomp/contact_patches.hpp"
 #include "uh/forcecomp/force_params.hpp"
 #include "uh/forcecomp/penalty_force.hpp"
 
@@ -49,10 +50,11 @@ class ForceComponent {
   PenaltyResult evaluate(const ContactFrame& frame, const BodyMotion& self, const BodyMotion& other = {},
                          double coverage_product = 1.0) const;
   /// Multi-rate: re-evaluates a held pair set at the current poses of A and B and computes the
-  /// force (HeldContactSet::evaluate). `held` is not const: it writes its preallocated scratch.
+  /// force (HeldContactSet::evaluate; of one patch's pairs with a `selection`). `held` is not
+  /// const: it writes its preallocated scratch.
   PenaltyResult evaluate(HeldContactSet& held, const Pose& world_from_a, const Pose& world_from_b,
-                         const BodyMotion& self, const BodyMotion& other = {},
-                         double coverage_product = 1.0) const;
+                         const BodyMotion& self, const BodyMotion& other = {}, double coverage_product = 1.0,
+                         const PatchSelection& selection = {}) const;
 
   /// The PenaltyInput this component uses for the given motions and packings.
   PenaltyInput penalty_input(const BodyMotion& self, const BodyMotion& other,

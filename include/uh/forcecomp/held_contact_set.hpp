@@ -9,6 +9,7 @@
 
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
+#include "uh/forcecomp/contact_patches.hpp"
 #include "uh/forcecomp/penalty_force.hpp"
 
 namespace uh::forcecomp {
@@ -59,8 +60,11 @@ class HeldContactSet {
   /// evaluate_penalty(reevaluate(world_from_a, world_from_b), input), without scratch: it works in
   /// A's frame (one rotation per pair), per pair in float, sums in double, in two passes over the
   /// held pairs (the total volume, which scales the damping, then the forces). The result is in
-  /// the world frame. Real-time safe.
-  PenaltyResult evaluate(const Pose& world_from_a, const Pose& world_from_b, const PenaltyInput& input);
+  /// the world frame. With a patch `selection`, the force of that patch's pairs only, their
+  /// damping scaled by the volume of all held pairs (so that the patches' forces sum to the
+  /// whole's; its total_volume stays the whole's). Real-time safe.
+  PenaltyResult evaluate(const Pose& world_from_a, const Pose& world_from_b, const PenaltyInput& input,
+                         const PatchSelection& selection = {});
 
   std::int32_t size() const { return static_cast<std::int32_t>(held_.size()); }
   bool empty() const { return held_.empty(); }

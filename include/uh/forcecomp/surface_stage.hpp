@@ -61,6 +61,7 @@ struct ContactGeometry {
 /// What the stage added this tick.
 struct SurfaceResult {
   Wrench wrench{};  ///< penalty + friction + texture, on the tool, torque about its centre of mass
+  Wrench added{};   ///< friction + texture alone (wrench - penalty, without its rounding)
   Vec3 friction_force_world{};  ///< the friction part [N]
   Vec3 texture_force_world{};   ///< the texture part [N]
   double normal_force_n = 0.0;  ///< N: the penalty force along the normal [N]

@@ -45,6 +45,7 @@
 
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
+#include "uh/forcecomp/contact_patches.hpp"
 #include "uh/forcecomp/penalty_force.hpp"
 #include "uh/forcecomp/virtual_coupling.hpp"  // rotation_vector
 #include "uh/forcecomp/wrench.hpp"
@@ -97,11 +98,14 @@ static_assert(std::is_trivially_copyable_v<WrenchModel>);
 /// Builds the model of the pairs found with the objects at world_from_a, world_from_b, under
 /// `input` (law, stiffness, coverage product, damping, mode, tool side); input.tool's centre of
 /// mass must be the tool's at the frame pose (its velocities are not used). Only the spheres of
-/// each pair are read (volumes, normals and points are recomputed in double). Any thread; does
-/// not allocate; O(pairs).
+/// each pair are read (volumes, normals and points are recomputed in double). With a patch
+/// `selection`, the model of that patch's pairs only (contact_patches.hpp): its damping is scaled
+/// by the volume of all the pairs, as in the whole model, so that W0, S and D of the patches sum
+/// to the whole model's (its total_volume, centroid and gradient are the patch's own). Any thread;
+/// does not allocate; O(pairs).
 WrenchModel build_wrench_model(std::span<const SpherePairContact> pairs, const Pose& world_from_a,
                                const Pose& world_from_b, const PenaltyInput& input,
-                               const WrenchModelOptions& options = {});
+                               const WrenchModelOptions& options = {}, const PatchSelection& selection = {});
 
 /// Same from a collision frame at the poses it used, with its sequence and time: the one place
 /// that reads a ContactFrame's pair storage for the model.
