@@ -81,8 +81,10 @@ struct ForceControllerStats {
 /// newest frame of each of its watchers straight from the world's handoff
 /// (CollisionWorld::take_contact: the frame crosses threads once and is used where it lies, never
 /// copied), holds each object's pairs and evaluates the volumetric penalty force and torque on the
-/// tool (ForceComponent, its law),
-/// optionally through a virtual coupling, applies ForceSafety (NaN guard, watchdog on the age of
+/// tool (ForceComponent, its law), adds the friction and texture of each contact patch of pairs
+/// with such a material (the patches' models travel with the model; for frames taken on the
+/// haptic thread the patches are found there, once per frame), optionally through a virtual
+/// coupling, applies ForceSafety (NaN guard, watchdog on the age of
 /// the contact data) and adds the result, in the device frame, to the command; the manager's
 /// limit chain bounds the sum.
 ///
@@ -102,8 +104,11 @@ class ForceController {
   /// product of the object's and the tool's packing coverages (forcecomp::PenaltyInput), by which
   /// the gradient law is calibrated. `material` is the pair's combined material
   /// (forcecomp::combine_materials): its stiffness and damping replace the tool's for this pair,
-  /// its friction and texture are rendered by a SurfaceStage after the penalty wrench; without
-  /// one the pair feels as the tool's force parameters say. Controlling thread, before bind().
+  /// its friction and texture are rendered after the penalty wrench by a SurfaceStage per contact
+  /// patch (forcecomp/contact_patches.hpp: each connected region of the overlap has its own stick
+  /// point and normal force, so a tool pinched between two faces of the object rubs on both);
+  /// without one, or without friction and texture, the pair feels as the tool's force parameters
+  /// say and no patches are found. Controlling thread, before bind().
   void add_watched(collette::ObjectId object, double coverage_product = 1.0,
                    const forcecomp::ContactMaterial* material = nullptr,
                    const forcecomp::SurfaceStageOptions& surface = {});

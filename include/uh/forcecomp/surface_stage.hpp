@@ -3,6 +3,10 @@
 /// SurfaceStage: friction and texture of one contact, rendered after the penalty force on the
 /// haptic tick (docs/forcecomp.md, "Materials").
 ///
+/// One contact is one contact patch (contact_patches.hpp), a connected region of the overlap, fed
+/// that patch's penalty wrench: a tool touching an object in two places has two stages, so that
+/// the friction is mu (N1 + N2), not mu |N1 + N2| (ForceController keeps one per patch).
+///
 /// It reads the penalty wrench of the contact (whatever computed it: a collision frame, the held
 /// pairs re-evaluated, a linearised model) and a little contact geometry (ContactGeometry: the
 /// normal, a point of the tool at the contact, a depth estimate) and adds:
