@@ -44,6 +44,7 @@ const Groove& groove() {
     const auto ball = load_shape_tree(
         {.mesh = testing::test_assets() / "meshes" / "ball.obj", .spheres = 100, .meters_per_unit = 0.01},
         cache);
+    std::filesystem::remove_all(cache);  // the trees are in memory
     EXPECT_TRUE(slab.has_value() && ball.has_value());
     if (!slab || !ball) return out;
     // the packed ball's surface lies a little inside the mesh's: its widest leaf extent along y
