@@ -68,6 +68,8 @@ int explore(const ExploreArgs& args) {
            {"stiffness_n_per_mm", optional_number(e.stiffness_n_per_mm)},
            {"stiffness_per_press_n_per_mm", e.stiffness_per_press_n_per_mm},
            {"press_reach_m", optional_number(e.press_reach_m)},
+           {"damping_n_s_per_m", optional_number(e.damping_n_s_per_m)},
+           {"damping_per_press_n_s_per_m", e.damping_per_press_n_s_per_m},
            {"friction_static", optional_number(e.friction_static)},
            {"friction_dynamic", optional_number(e.friction_dynamic)},
            {"texture_period_m", optional_number(e.texture_period_m)},
@@ -99,6 +101,11 @@ int explore(const ExploreArgs& args) {
       std::printf(
           "    (the force limit stopped the presses short of %.2f mm: a packed face reads low there)\n",
           *options.press_depth_m * 1e3);
+    // (a damping that rounds to zero prints as 0.000, not -0.000)
+    const std::optional<double> damping =
+        e.damping_n_s_per_m ? std::optional<double>(std::fabs(*e.damping_n_s_per_m) < 5e-4 ? 0.0 : *e.damping_n_s_per_m)
+                            : std::nullopt;
+    std::printf("    damping    %s\n", shown(damping, "{:.3f} N s/m").c_str());
     std::printf("    friction   static %s, dynamic %s\n", shown(e.friction_static, "{:.3f}").c_str(),
                 shown(e.friction_dynamic, "{:.3f}").c_str());
     std::printf("    texture    period %s, ripple %.3f N RMS\n",

@@ -119,6 +119,51 @@ TEST(Exploration, TheStiffnessIsTheMedianOfThePresses) {
   EXPECT_NEAR(*e.stiffness_n_per_mm, 2 * kPi * r * 3e4 * 1e-3, 0.005 * 2 * kPi * r * 3e4 * 1e-3);
 }
 
+// A press in to 2.5 mm and back out along the same spring, with a damper b along the normal:
+// F = k pi (2 r d - d^2) + b v, v the speed into the surface (+ in, - out), never pulling
+void add_damped_press(ExploreTrace& trace, double& t, double k, double r, double b, std::int32_t press) {
+  const double v = trace.options.press_speed_m_per_s, dt = 0.001, deepest = 0.0025;
+  const auto force = [&](double d, double speed) {
+    return d > 0.0 ? std::max(0.0, k * kPi * (2 * r * d - d * d) + b * speed) : 0.0;
+  };
+  double d = -0.0005;
+  for (; d < deepest; d += v * dt)
+    trace.samples.push_back({t += dt, {0, 0, r - d}, {0, 0, force(d, v)}, ExplorePhase::kPress, press});
+  for (; d > -0.0005; d -= v * dt)
+    trace.samples.push_back({t += dt, {0, 0, r - d}, {0, 0, force(d, -v)}, ExplorePhase::kRelease, -1});
+  for (int i = 0; i < 10; ++i) trace.samples.push_back({t += dt, {0, 0, r + 0.001}, {}, ExplorePhase::kMove, -1});
+}
+
+// The damping is read from the loop between each press and its release: each press's b, and the
+// median of the presses; a spring alone (the same curve in and out) reads none.
+TEST(Exploration, TheDampingIsTheLoopBetweenPressAndRelease) {
+  const double r = 0.01, k = 2e4;
+  const double b[] = {0.5, 0.52, 3.0, 0.48, 0.0};  // N s/m; median 0.5
+  ExploreTrace trace;
+  double t = 0.0;
+  for (std::int32_t press = 0; press < 5; ++press) add_damped_press(trace, t, k, r, b[press], press);
+  const MaterialEstimate e = estimate_material(trace);
+  ASSERT_EQ(e.damping_per_press_n_s_per_m.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i)
+    EXPECT_NEAR(e.damping_per_press_n_s_per_m[i], b[i], 1e-3 + 1e-3 * b[i]) << "press " << i;
+  ASSERT_TRUE(e.damping_n_s_per_m.has_value());
+  EXPECT_NEAR(*e.damping_n_s_per_m, 0.5, 1e-3);
+  // the stiffness is read from the way in alone, its damping force a constant b v there
+  ASSERT_TRUE(e.stiffness_n_per_mm.has_value());
+
+  ExploreTrace springy;
+  t = 0.0;
+  add_damped_press(springy, t, k, r, 0.0, 0);
+  const MaterialEstimate s = estimate_material(springy);
+  ASSERT_TRUE(s.damping_n_s_per_m.has_value());
+  EXPECT_NEAR(*s.damping_n_s_per_m, 0.0, 1e-6);
+  // a press released without contact (no way out to compare with) says nothing of the damping
+  ExploreTrace one_way;
+  t = 0.0;
+  add_press(one_way, t, k, r, 0.0, 0);
+  EXPECT_FALSE(estimate_material(one_way).damping_n_s_per_m.has_value());
+}
+
 // A stiff surface under a low force limit: pressed to a force above the limit (as a caller may
 // ask), the samples the limit chain clamped read the limit, not the material, and are left out of
 // the fit; pressed by default, the press stops at 90 % of the limit, short of its depth, and says

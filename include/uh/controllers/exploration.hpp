@@ -137,6 +137,15 @@ struct MaterialEstimate {
   /// the press force stopped them first (a stiff surface under a low force limit), and then the
   /// stiffness is read over shallower depths, where a packed face is not yet full (it reads low).
   std::optional<double> press_reach_m;
+  /// The damping felt along the normal [N s/m]: per press, the normal force over the deeper part
+  /// of the press (60 % to 95 % of its depth) fitted as a smooth function of depth plus this times
+  /// the speed into the surface (the loop between the press and its release at
+  /// `press_speed_m_per_s`); the median of the presses. Under the volumetric penalty law it is the
+  /// material's `damping` times the overlap-weighted mean cos^2 between the sphere pairs' normals
+  /// and the contact normal: the material's value on a smooth face, 11-14 % less on a packed flat
+  /// face (docs/exploration.md).
+  std::optional<double> damping_n_s_per_m;
+  std::vector<double> damping_per_press_n_s_per_m;  ///< each press's, in the order pressed
   std::optional<double> friction_static;     ///< tangential over normal force at breakaway
   std::optional<double> friction_dynamic;    ///< tangential over normal force while sliding
   std::optional<double> texture_period_m;    ///< dominant spatial period of the normal force ripple
