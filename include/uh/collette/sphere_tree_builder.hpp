@@ -5,11 +5,11 @@
 /// By default (SphereTreeSplit::kBalanced) every leaf ends at the same depth and the inner nodes
 /// are as full as the arity allows: a node over m leaves gets as few children as hold them when a
 /// child holds at most arity^(h-1) leaves (h: the levels m leaves need), of equal sizes, grouped by
-/// recursive bisection along the principal axis of the centres or a fixed direction that cuts
-/// better. Full nodes fill the volume query's SIMD blocks, and leaves at one depth mean that the
-/// simultaneous descent never meets a leaf against an inner node: on the query benchmark's deep
-/// random poses this visits 4,620 node pairs where the k-means tree visits 7,256, for the same
-/// pairs (docs/benchmarks.md).
+/// recursive bisection along the principal axis of the centres or a fixed direction, whichever
+/// gives the halves the smallest enclosing spheres, refined by balanced 2-means. Full nodes fill the
+/// volume query's SIMD blocks, and leaves at one depth mean that the simultaneous descent never
+/// meets a leaf against an inner node: on the query benchmark's deep random poses this visits
+/// 4,388 node pairs where the k-means tree visits 7,256, for the same pairs (docs/benchmarks.md).
 /// SphereTreeSplit::kKMeans splits each node's leaves into up to `arity` clusters by k-means on the
 /// sphere centres, weighted by sphere volume (a deterministic stand-in for the batch neural gas of
 /// the original IST), seeded by volume quantiles along the longest axis: tighter spheres, unevenly
@@ -25,9 +25,10 @@
 
 namespace uh::collette {
 
-/// Changes whenever build_sphere_tree()'s default output changes (2: balanced trees), so that
-/// caches of built trees can be keyed by it and rebuilt.
-inline constexpr int kSphereTreeBuilderVersion = 2;
+/// Changes whenever build_sphere_tree()'s default output changes (2: balanced trees; 3: their cuts
+/// chosen by enclosing spheres and refined by 2-means), so that caches of built trees can be keyed
+/// by it and rebuilt.
+inline constexpr int kSphereTreeBuilderVersion = 3;
 
 /// How build_sphere_tree() divides a node's leaves among its children.
 enum class SphereTreeSplit {
@@ -46,7 +47,7 @@ struct SphereTreeBuildOptions {
 /// Builds the hierarchy over `leaves` (mesh frame; non-overlapping in an IST, though the builder
 /// does not require it). Fails with a message for an empty set, a bad option or a leaf with a
 /// non-finite centre or a radius that is not positive and finite.
-/// Not real-time safe; any thread. About 0.15 s for 10,000 leaves (k-means: 0.03 s).
+/// Not real-time safe; any thread. About 0.18 s for 10,000 leaves (k-means: 0.03 s).
 Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options = {});
 
 }  // namespace uh::collette
