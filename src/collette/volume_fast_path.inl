@@ -75,6 +75,19 @@ template <int W>
   }
 }
 
+// B's block kb moved into A's frame: moved by the first visit of this run that needs it, then read
+// from the traversal's MovedBlocks (the same lanes, bit for bit)
+template <int W>
+[[gnu::always_inline]] inline const float* moved_block(const Traversal& t, float* moved, std::uint32_t* stamp,
+                                                       std::uint32_t run, std::int32_t kb) {
+  float* out = moved + static_cast<std::size_t>(kb) * 4 * W;
+  if (stamp[kb] != run) {
+    transform_block<W>(t, kb, out);
+    stamp[kb] = run;
+  }
+  return out;
+}
+
 // Lanes i .. i + V::kWidth - 1 of the batch through the lens kernel into `out` (lanes from 0);
 // returns the lanes that overlap (bit j: lane i + j) and, in `near`, those apart by less than
 // `margin` (only when margin > 0). The operations of uh::sphere_overlap<float>, branch by branch,
@@ -164,8 +177,10 @@ inline void flush(Traversal& t) {
 template <int WA, int WB>
 void run_fast(Traversal& t, std::size_t stop_at) {
   static_assert(WA <= 8 && WB <= 8);
-  alignas(32) float tb[4 * WB];
   LeafBatch& lb = *t.batch;
+  float* const moved = t.moved->data();
+  std::uint32_t* const stamp = t.moved->stamp.data();
+  const std::uint32_t run = t.moved->run;
   const SphereTree::Blocks& a = t.a;
   const SphereTree::Blocks& b = t.b;
   const float sm = t.search_margin;
@@ -177,7 +192,7 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     if (e.a < 0) {
       // A is a leaf: B's children against it
       const Sphere& s = t.leaves_a[~e.a];
-      transform_block<WB>(t, e.b, tb);
+      const float* tb = moved_block<WB>(t, moved, stamp, run, e.b);
       const std::uint32_t leaf_b = b.leaf_mask[e.b];
       const std::uint32_t hits =
           overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius + sm) &
@@ -216,7 +231,7 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     }
     // both inner: every child of B (moved once) against all children of A; bit 8 j + k of the mask
     // is child j of B against child k of A
-    transform_block<WB>(t, e.b, tb);
+    const float* tb = moved_block<WB>(t, moved, stamp, run, e.b);
     const std::uint32_t leaf_b = b.leaf_mask[e.b];
     const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
     t.leaf_tests += kBitCount[leaf_a] * kBitCount[leaf_b];

@@ -51,6 +51,7 @@ struct QueryWorker {
   // the worker's scratch and results
   std::vector<VolumeQuery::StackEntry> stack;
   std::unique_ptr<LeafBatch> batch = std::make_unique<LeafBatch>();
+  std::unique_ptr<MovedBlocks> moved = std::make_unique<MovedBlocks>();
   std::vector<PairOverlap> pairs;
   int chunk_first_pair[kMaxChunks] = {};  // where chunk c's pairs start in `pairs` (worker's chunks)
   int chunk_pair_count[kMaxChunks] = {};
@@ -135,6 +136,7 @@ struct QueryWorker {
 VolumeQuery::VolumeQuery(const VolumeQueryOptions& options)
     : options_(options),
       batch_(std::make_unique<detail::LeafBatch>()),
+      moved_(std::make_unique<detail::MovedBlocks>()),
       kernel_lanes_(!options.use_avx2                                   ? 4
                     : options.use_avx512 && detail::avx512::supported() ? 16
                     : detail::avx2::supported()                         ? 8
@@ -193,7 +195,7 @@ int run_shared(detail::QueryWorker& w, Traversal& t, int lanes, const SphereTree
 
   // post the run, then take chunks from the front until none is left
   w.traversal =
-      detail::make_traversal(a, b, b_in_a, options, &w.stack, w.pairs.data(), nullptr, w.batch.get());
+      detail::make_traversal(a, b, b_in_a, options, &w.stack, w.pairs.data(), nullptr, w.batch.get(), w.moved.get());
   w.traversal.capacity = static_cast<std::int32_t>(w.pairs.size());
   w.traversal.search_margin = t.search_margin;
   w.lanes = lanes;
@@ -266,8 +268,9 @@ void finish(const Traversal& t, bool collect_pairs, VolumeQueryResult& result) {
 }  // namespace
 
 void VolumeQuery::traverse(const SphereTree& a, const SphereTree& b, const Pose& b_in_a, bool keep_candidates) {
-  Traversal t =
-      detail::make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_, batch_.get());
+  const bool fast = !keep_candidates && !options_.reference_kernel;
+  Traversal t = detail::make_traversal(a, b, b_in_a, options_, &stack_, pairs_.data(), &candidates_, batch_.get(),
+                                       fast ? moved_.get() : nullptr);
   if (keep_candidates) {
     t.search_margin += options_.coherence_skin;
     candidates_.clear();

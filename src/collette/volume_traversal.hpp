@@ -67,6 +67,7 @@ struct Traversal {
   std::vector<VolumeQuery::Candidate>*
       candidates;            // keeping traversals: (A leaf, B leaf index) within search_margin
   detail::LeafBatch* batch;  // leaf pairs waiting for the SIMD lens kernel (batched traversals)
+  detail::MovedBlocks* moved;  // B's blocks moved into A's frame, begun for this run (fast path)
   std::int32_t stored = 0;
   std::int64_t overlapping = 0;
   std::int64_t near = 0;  // stored-or-counted pairs within the margin that do not overlap
@@ -324,8 +325,10 @@ struct Traversal {
 inline Traversal make_traversal(const SphereTree& a, const SphereTree& b, const Pose& b_in_a,
                                 const VolumeQueryOptions& options,
                                 std::vector<VolumeQuery::StackEntry>* stack, PairOverlap* pairs,
-                                std::vector<VolumeQuery::Candidate>* candidates, detail::LeafBatch* batch) {
+                                std::vector<VolumeQuery::Candidate>* candidates, detail::LeafBatch* batch,
+                                detail::MovedBlocks* moved = nullptr) {
   const float margin = std::max(0.f, options.contact_margin);
+  if (moved) moved->begin(b.blocks().size, b.blocks().width);
   return Traversal{a.blocks(),
                    b.blocks(),
                    a.leaves().data(),
@@ -338,6 +341,7 @@ inline Traversal make_traversal(const SphereTree& a, const SphereTree& b, const 
                    margin,
                    candidates,
                    batch,
+                   moved,
                    0,
                    0,
                    0,

@@ -71,13 +71,15 @@ class SphereTree {
     const std::uint8_t* leaf_mask = nullptr;///< block k: bit j set when child j is a leaf
     int width = 4;
     std::int32_t root = 0;                  ///< traversal id of the root
+    std::int32_t size = 0;                  ///< number of blocks (inner nodes)
   };
   /// Packing density of each node: leaf volume below / volume of its sphere, in (0, 1]; 1 for a
   /// leaf. Derived by the constructor for the time-critical query's expected overlaps.
   std::span<const float> density() const { return density_; }
 
   Blocks blocks() const {
-    return {block_bounds_.data(), block_child_.data(), block_count_.data(), block_leaf_mask_.data(), block_width_, root_id_};
+    return {block_bounds_.data(), block_child_.data(), block_count_.data(), block_leaf_mask_.data(), block_width_, root_id_,
+            static_cast<std::int32_t>(block_count_.size())};
   }
 
  private:

@@ -33,6 +33,7 @@ namespace uh::collette {
 
 namespace detail {
 struct LeafBatch;
+struct MovedBlocks;
 struct QueryWorker;
 }  // namespace detail
 
@@ -198,6 +199,7 @@ class VolumeQuery {
 
   VolumeQueryOptions options_;
   std::unique_ptr<detail::LeafBatch> batch_;  // leaf pairs waiting for the SIMD lens kernel (10 KB)
+  std::unique_ptr<detail::MovedBlocks> moved_;  // B's blocks moved into A's frame this run (fast path)
   std::vector<StackEntry> stack_;
   std::vector<PairOverlap> pairs_;
   VolumeQueryResult result_;
