@@ -18,9 +18,11 @@
 // (`reference_kernel`: the scalar path before the SIMD kernels) on the same pose; each pose 10 times.
 // Counters: median, p90 and max of both over all poses and repetitions, and the ratio of the medians.
 // Each iteration also runs the query with the AVX2 kernels (`avx2_median_us`: `use_avx512` off),
-// with the baseline kernels (`sse2_median_us`: `use_avx2` off; `kernel_lanes` says which width the
-// default took: 16 with AVX-512) and with its worker thread (`two_threads_*`, and how many of the
-// frontier's chunks the worker ran per query); the six run in a rotating order.
+// with the AVX-512 kernels where the CPU has them (`avx512_median_us`: `force_avx512`, which the
+// default takes only on AMD's CPUs), with the baseline kernels (`sse2_median_us`: `use_avx2` off;
+// `kernel_lanes` says which width the default took: 16 with AVX-512) and with its worker thread
+// (`two_threads_*`, and how many of the frontier's chunks the worker ran per query); the seven run
+// in a rotating order.
 
 #include <benchmark/benchmark.h>
 
@@ -453,13 +455,15 @@ void BM_DeepRandomPoses(benchmark::State& state) {
   VolumeQuery reference({.reference_kernel = true});
   VolumeQuery baseline({.use_avx2 = false});
   VolumeQuery avx2_only({.use_avx512 = false});
+  VolumeQuery avx512_forced({.force_avx512 = true});
   VolumeQuery shared({.worker_thread = true});
   fcl::CollisionObjectd a(s.fcl_model, fcl::Transform3d::Identity());
   fcl::CollisionObjectd b(s.fcl_model, fcl::Transform3d::Identity());
   const fcl::CollisionRequestd request(1000000, true);
-  std::vector<double> ours, reference_times, fcl_times, baseline_times, avx2_times, shared_times;
+  std::vector<double> ours, reference_times, fcl_times, baseline_times, avx2_times, avx512_times, shared_times;
   ours.reserve(1 << 14);
   avx2_times.reserve(1 << 14);
+  avx512_times.reserve(1 << 14);
   baseline_times.reserve(1 << 14);
   shared_times.reserve(1 << 14);
   double worker_chunks = 0.0;
@@ -502,19 +506,20 @@ void BM_DeepRandomPoses(benchmark::State& state) {
       fcl_times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       contacts += static_cast<double>(result.numContacts());
     };
-    // all six on the same pose, in an order that rotates, so that each sees the same load and
+    // all seven on the same pose, in an order that rotates, so that each sees the same load and
     // the same share of caches warmed by the one before
-    const std::function<void()> runs[6] = {run_ours,
+    const std::function<void()> runs[7] = {run_ours,
                                            run_reference,
                                            run_fcl,
                                            [&] { run_other(baseline, baseline_times); },
                                            [&] { run_other(avx2_only, avx2_times); },
+                                           [&] { run_other(avx512_forced, avx512_times); },
                                            [&] { run_other(shared, shared_times); }};
-    for (std::size_t i = 0; i < 6; ++i) runs[(k + i) % 6]();
+    for (std::size_t i = 0; i < 7; ++i) runs[(k + i) % 7]();
     worker_chunks += shared.worker_chunks();
     // the fast path (each kernel width, one or two threads) must give exactly the reference path's
     // totals and pairs
-    for (const VolumeQuery* q : {&query, &baseline, &avx2_only, &shared})
+    for (const VolumeQuery* q : {&query, &baseline, &avx2_only, &avx512_forced, &shared})
       if (q->result().total_volume != reference.result().total_volume ||
           q->result().pair_count != reference.result().pair_count)
         ++mismatches;
@@ -527,10 +532,12 @@ void BM_DeepRandomPoses(benchmark::State& state) {
   std::sort(reference_times.begin(), reference_times.end());
   std::sort(baseline_times.begin(), baseline_times.end());
   std::sort(avx2_times.begin(), avx2_times.end());
+  std::sort(avx512_times.begin(), avx512_times.end());
   std::sort(shared_times.begin(), shared_times.end());
   state.counters["reference_median_us"] = quantile(reference_times, 0.5) * 1e6;
   state.counters["sse2_median_us"] = quantile(baseline_times, 0.5) * 1e6;
   state.counters["avx2_median_us"] = quantile(avx2_times, 0.5) * 1e6;
+  state.counters["avx512_median_us"] = quantile(avx512_times, 0.5) * 1e6;
   state.counters["two_threads_median_us"] = quantile(shared_times, 0.5) * 1e6;
   state.counters["two_threads_p90_us"] = quantile(shared_times, 0.9) * 1e6;
   state.counters["two_threads_worker_chunks"] = worker_chunks / n;

@@ -137,10 +137,12 @@ VolumeQuery::VolumeQuery(const VolumeQueryOptions& options)
     : options_(options),
       batch_(std::make_unique<detail::LeafBatch>()),
       moved_(std::make_unique<detail::MovedBlocks>()),
-      kernel_lanes_(!options.use_avx2                                   ? 4
-                    : options.use_avx512 && detail::avx512::supported() ? 16
-                    : detail::avx2::supported()                         ? 8
-                                                                        : 4) {
+      kernel_lanes_(!options.use_avx2 ? 4
+                    : options.use_avx512 && detail::avx512::supported() &&
+                            (options.force_avx512 || detail::avx512::preferred())
+                        ? 16
+                    : detail::avx2::supported() ? 8
+                                                : 4) {
   if (options_.worker_thread) worker_ = std::make_unique<detail::QueryWorker>(options_.pair_capacity);
   options_.pair_capacity = std::max(0, options_.pair_capacity);
   // the traversal keeps its own top: the vector is storage, sized to its capacity

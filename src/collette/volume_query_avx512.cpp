@@ -39,6 +39,16 @@ bool supported() {
          __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
 }
 
+// AMD's Zen 4 runs a 512-bit operation as two 256-bit halves at full clock: there the 16-lane
+// kernels measured 0.87-0.89 of the 8-lane ones' median. Intel's AVX-512 cores lower the clock while
+// they run 512-bit arithmetic (also for the few 512-bit double sums that the compiler vectorises in
+// this file's lens loop): on a Xeon of family 6 model 167 the 8-lane kernels measured 0.90-0.93 of
+// the 16-lane ones' median (docs/benchmarks.md), as compilers too prefer 256-bit vectors there.
+bool preferred() {
+  __builtin_cpu_init();
+  return __builtin_cpu_is("amd");
+}
+
 }  // namespace uh::collette::detail::avx512
 
 #if defined(__clang__)
@@ -70,6 +80,7 @@ using BlockLanes = std::conditional_t<(W < 8), F4, F8>;
 
 namespace uh::collette::detail::avx512 {
 bool supported() { return false; }
+bool preferred() { return false; }
 // never called (supported() is false); the baseline path, should it be
 void run_fast(Traversal& t) { sse2::run_fast(t); }
 void expand(Traversal& t, std::size_t entries) { sse2::expand(t, entries); }

@@ -369,6 +369,9 @@ void expand(Traversal& t, std::size_t entries);
 namespace avx512 {
 /// True when this build has the AVX-512 path and the CPU running it supports AVX-512 F, VL, DQ, BW.
 bool supported();
+/// True when the CPU is one whose 512-bit code the default takes (AMD's: they run it at the clock
+/// of narrower code; Intel's lower the clock for it, and the 8-lane kernels measured faster there).
+bool preferred();
 /// Only when supported().
 void run_fast(Traversal& t);
 void expand(Traversal& t, std::size_t entries);

@@ -193,7 +193,8 @@ TEST(VolumeQuery, DeepPosesMatchBruteForce) {
         300u + static_cast<std::uint32_t>(arity_a * 10 + arity_b + 100 * static_cast<int>(split)));
     for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
       SCOPED_TRACE(kernels.name);
-      VolumeQuery query({.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
+      VolumeQuery query(
+          {.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512, .force_avx512 = kernels.force_avx512});
       for (std::size_t k = 0; k < poses.size(); ++k) {
         expect_pose_matches_brute_force(query, *ta, *tb, la, lb, poses[k], static_cast<int>(k));
         EXPECT_GT(query.result().stats.overlapping_pairs, 300) << "not deep: the test would prove little";
@@ -202,21 +203,25 @@ TEST(VolumeQuery, DeepPosesMatchBruteForce) {
   }
 }
 
-// The kernels the fast path may take on this machine: AVX-512 where the CPU has it, else AVX2 where
-// it has that (neither on Windows builds), and always the baseline (SSE2); the options force the
-// narrower ones.
+// The kernels the fast path may take on this machine: AVX-512 where the CPU has it and is AMD's (or
+// with force_avx512), else AVX2 where it has that (neither on Windows builds), and always the
+// baseline (SSE2); the options force the narrower ones.
 TEST(VolumeQuery, TakesTheWidestKernelsTheCpuHas) {
 #if defined(__x86_64__) && !defined(_WIN32)
   __builtin_cpu_init();
   const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
   const bool cpu_has_avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
                               __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
+  const bool amd = __builtin_cpu_is("amd");
 #else
-  const bool cpu_has_avx2 = false, cpu_has_avx512 = false;
+  const bool cpu_has_avx2 = false, cpu_has_avx512 = false, amd = false;
 #endif
-  EXPECT_EQ(VolumeQuery().kernel_lanes(), cpu_has_avx512 ? 16 : cpu_has_avx2 ? 8 : 4);
-  EXPECT_EQ(VolumeQuery().uses_avx512(), cpu_has_avx512);
-  EXPECT_EQ(VolumeQuery().uses_avx2(), cpu_has_avx2 && !cpu_has_avx512);
+  const bool default_avx512 = cpu_has_avx512 && amd;
+  EXPECT_EQ(VolumeQuery().kernel_lanes(), default_avx512 ? 16 : cpu_has_avx2 ? 8 : 4);
+  EXPECT_EQ(VolumeQuery().uses_avx512(), default_avx512);
+  EXPECT_EQ(VolumeQuery().uses_avx2(), cpu_has_avx2 && !default_avx512);
+  EXPECT_EQ(VolumeQuery({.force_avx512 = true}).kernel_lanes(), cpu_has_avx512 ? 16 : cpu_has_avx2 ? 8 : 4);
+  EXPECT_EQ(VolumeQuery({.use_avx512 = false, .force_avx512 = true}).kernel_lanes(), cpu_has_avx2 ? 8 : 4);
   EXPECT_EQ(VolumeQuery({.use_avx512 = false}).kernel_lanes(), cpu_has_avx2 ? 8 : 4);
   EXPECT_EQ(VolumeQuery({.use_avx2 = false}).kernel_lanes(), 4);
   EXPECT_EQ(VolumeQuery({.use_avx2 = false, .use_avx512 = true}).kernel_lanes(), 4);
@@ -261,7 +266,8 @@ TEST(VolumeQuery, FastKernelsEqualTheScalarLensAtItsBranchPoints) {
     const auto tb = build_sphere_tree(lb, {.arity = arity});
     ASSERT_TRUE(ta && tb);
     for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
-      VolumeQuery q({.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
+      VolumeQuery q(
+          {.use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512, .force_avx512 = kernels.force_avx512});
       q.run(*ta, *tb, Pose{});
       std::set<std::pair<int, int>> got;
       for (const PairOverlap& p : q.pairs()) {
@@ -322,7 +328,10 @@ void expect_fast_equals_reference(float margin) {
     for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
       SCOPED_TRACE(kernels.name);
       VolumeQuery fast(
-          {.contact_margin = margin, .use_avx2 = kernels.use_avx2, .use_avx512 = kernels.use_avx512});
+          {.contact_margin = margin,
+           .use_avx2 = kernels.use_avx2,
+           .use_avx512 = kernels.use_avx512,
+           .force_avx512 = kernels.force_avx512});
       VolumeQuery reference({.contact_margin = margin, .reference_kernel = true});
       for (const Pose& pose : testing::deep_poses(
                *ta, *tb, 4,

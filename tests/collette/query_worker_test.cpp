@@ -45,14 +45,16 @@ TEST(VolumeQueryWorker, SameResultsAsOneThreadOnDeepPoses) {
     for (const float margin : {0.f, 0.02f}) {
       for (const testing::KernelChoice& kernels : testing::kKernelChoices) {
         SCOPED_TRACE(kernels.name);
-        const bool avx2 = kernels.use_avx2, avx512 = kernels.use_avx512;
+        const bool avx2 = kernels.use_avx2, avx512 = kernels.use_avx512, force = kernels.force_avx512;
         // the worker claims first, so that its part (and the merge) runs in every run
         VolumeQuery shared({.contact_margin = margin,
                             .use_avx2 = avx2,
                             .use_avx512 = avx512,
+                            .force_avx512 = force,
                             .worker_thread = true,
                             .worker_claims_first = true});
-        VolumeQuery single({.contact_margin = margin, .use_avx2 = avx2, .use_avx512 = avx512});
+        VolumeQuery single(
+            {.contact_margin = margin, .use_avx2 = avx2, .use_avx512 = avx512, .force_avx512 = force});
         int worker_chunks = 0;
         for (const Pose& pose : poses) {
           expect_same_as_one_thread(shared, single, *ta, *tb, pose);
@@ -63,7 +65,11 @@ TEST(VolumeQueryWorker, SameResultsAsOneThreadOnDeepPoses) {
         EXPECT_GT(single.result().pair_count, 150);
         // and a run where the caller may take every chunk (whatever the worker manages)
         VolumeQuery racing(
-            {.contact_margin = margin, .use_avx2 = avx2, .use_avx512 = avx512, .worker_thread = true});
+            {.contact_margin = margin,
+             .use_avx2 = avx2,
+             .use_avx512 = avx512,
+             .force_avx512 = force,
+             .worker_thread = true});
         for (int repeat = 0; repeat < 3; ++repeat)
           for (const Pose& pose : poses) expect_same_as_one_thread(racing, single, *ta, *tb, pose);
       }

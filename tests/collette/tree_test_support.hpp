@@ -145,13 +145,14 @@ inline void expect_identical_totals(const VolumeQueryResult& got, const VolumeQu
 }
 
 // The volume query's fast-path kernel widths a test runs: the widest the CPU has (AVX-512 where it
-// has it), AVX2 (where it has it) and the baseline. On a CPU without them the wider choices take
-// the widest it has, so every choice is still a real query.
+// has it, also where the default would not take it), AVX2 (where it has it) and the baseline. On a
+// CPU without them the wider choices take the widest it has, so every choice is still a real query.
 struct KernelChoice {
-  bool use_avx2, use_avx512;
+  bool use_avx2, use_avx512, force_avx512;
   const char* name;
 };
-inline constexpr KernelChoice kKernelChoices[] = {
-    {true, true, "widest kernels"}, {true, false, "AVX2 kernels"}, {false, false, "baseline kernels"}};
+inline constexpr KernelChoice kKernelChoices[] = {{true, true, true, "widest kernels"},
+                                                  {true, false, false, "AVX2 kernels"},
+                                                  {false, false, false, "baseline kernels"}};
 
 }  // namespace uh::collette::testing

@@ -82,9 +82,13 @@ struct VolumeQueryOptions {
   /// for Windows have the baseline kernels only.
   bool use_avx2 = true;
   /// With use_avx2: run them sixteen lanes wide (AVX-512) when the CPU has AVX-512 F, VL, DQ and
-  /// BW (VolumeQuery::uses_avx512()); false stops at AVX2. Same results, bit for bit. Builds for
-  /// Windows leave it out, as the AVX2 kernels.
+  /// BW and is AMD's (VolumeQuery::uses_avx512()): Intel's AVX-512 cores lower their clock for
+  /// 512-bit arithmetic, and there the AVX2 kernels measured faster (docs/benchmarks.md); false
+  /// stops at AVX2. Same results, bit for bit. Builds for Windows leave it out, as the AVX2 kernels.
   bool use_avx512 = true;
+  /// With use_avx2 and use_avx512: take the AVX-512 kernels on any CPU that has them, Intel's too
+  /// (tests and benchmarks compare every width).
+  bool force_avx512 = false;
   /// Share each traversal with a second thread that the query owns (started at construction,
   /// joined by the destructor; it sleeps between runs): the calling thread runs the first node
   /// pairs, then both take chunks of the remaining frontier, the caller from the front and the
@@ -166,7 +170,8 @@ class VolumeQuery {
   std::span<const PairOverlap> pairs() const { return {pairs_.data(), static_cast<std::size_t>(result_.pair_count)}; }
   const VolumeQueryOptions& options() const { return options_; }
   /// The fast path's kernel width, chosen at construction: 16 (AVX-512: options().use_avx2,
-  /// use_avx512 and the CPU has it), 8 (AVX2: use_avx2 and the CPU has it) or 4 (the baseline).
+  /// use_avx512 and the CPU has it and is AMD's, or force_avx512), 8 (AVX2: use_avx2 and the CPU
+  /// has it) or 4 (the baseline).
   int kernel_lanes() const { return kernel_lanes_; }
   /// True when runs take the AVX2 kernels (eight lanes).
   bool uses_avx2() const { return kernel_lanes_ == 8; }
