@@ -26,6 +26,26 @@ struct F8 {
   [[gnu::always_inline]] static F8 spread_pair(F8 v, int j) {
     return {_mm256_permutevar8x32_ps(v.v, _mm256_setr_epi32(j, j, j, j, j + 1, j + 1, j + 1, j + 1))};
   }
+  /// Eight fields of eight lanes (field i, lane j at f[i * stride + j]) into eight rows of eight
+  /// (rows[8 j + i]): an 8 x 8 transpose.
+  [[gnu::always_inline]] static void to_rows(const float* f, int stride, float* rows) {
+    __m256 r[8], t[8];
+    for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(f + i * stride);
+    for (int i = 0; i < 8; i += 2) {
+      t[i] = _mm256_unpacklo_ps(r[i], r[i + 1]);
+      t[i + 1] = _mm256_unpackhi_ps(r[i], r[i + 1]);
+    }
+    for (int i = 0; i < 8; i += 4) {
+      r[i] = _mm256_shuffle_ps(t[i], t[i + 2], 0x44);
+      r[i + 1] = _mm256_shuffle_ps(t[i], t[i + 2], 0xee);
+      r[i + 2] = _mm256_shuffle_ps(t[i + 1], t[i + 3], 0x44);
+      r[i + 3] = _mm256_shuffle_ps(t[i + 1], t[i + 3], 0xee);
+    }
+    for (int i = 0; i < 4; ++i) {
+      _mm256_storeu_ps(rows + 8 * i, _mm256_permute2f128_ps(r[i], r[i + 4], 0x20));
+      _mm256_storeu_ps(rows + 8 * (i + 4), _mm256_permute2f128_ps(r[i], r[i + 4], 0x31));
+    }
+  }
 };
 
 [[gnu::always_inline]] inline void store(float* p, F8 a) { _mm256_storeu_ps(p, a.v); }

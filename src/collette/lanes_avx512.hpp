@@ -31,6 +31,12 @@ struct F16 {
   [[gnu::always_inline]] static F16 load_twice(const float* p) {
     return {_mm512_broadcast_f32x8(_mm256_loadu_ps(p))};
   }
+  /// Eight fields of sixteen lanes (field i, lane j at f[i * stride + j]) into sixteen rows of
+  /// eight (rows[8 j + i]): F8's transpose on each half.
+  [[gnu::always_inline]] static void to_rows(const float* f, int stride, float* rows) {
+    F8::to_rows(f, stride, rows);
+    F8::to_rows(f + 8, stride, rows + 64);
+  }
   /// lane j of the eight lanes v in lanes 0..7, lane j + 1 in lanes 8..15 (one permute)
   [[gnu::always_inline]] static F16 spread_pair(F8 v, int j) {
     const __m512i index = _mm512_mask_mov_epi32(_mm512_set1_epi32(j), 0xff00, _mm512_set1_epi32(j + 1));

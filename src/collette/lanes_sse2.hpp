@@ -28,6 +28,19 @@ struct F4 {
   [[gnu::always_inline]] static F4 load(const float* p) { return {_mm_loadu_ps(p)}; }
   [[gnu::always_inline]] static F4 set1(float x) { return {_mm_set1_ps(x)}; }
   [[gnu::always_inline]] static F4 zero() { return {_mm_setzero_ps()}; }
+  /// Eight fields of four lanes (field i, lane j at f[i * stride + j]) into four rows of eight
+  /// (rows[8 j + i]): two 4 x 4 transposes.
+  [[gnu::always_inline]] static void to_rows(const float* f, int stride, float* rows) {
+    for (int h = 0; h < 8; h += 4) {
+      __m128 r0 = _mm_loadu_ps(f + h * stride), r1 = _mm_loadu_ps(f + (h + 1) * stride);
+      __m128 r2 = _mm_loadu_ps(f + (h + 2) * stride), r3 = _mm_loadu_ps(f + (h + 3) * stride);
+      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+      _mm_storeu_ps(rows + h, r0);
+      _mm_storeu_ps(rows + 8 + h, r1);
+      _mm_storeu_ps(rows + 16 + h, r2);
+      _mm_storeu_ps(rows + 24 + h, r3);
+    }
+  }
 };
 
 [[gnu::always_inline]] inline void store(float* p, F4 a) { _mm_storeu_ps(p, a.v); }
@@ -64,6 +77,10 @@ struct F4 {
   static F4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
   static F4 set1(float x) { return {{x, x, x, x}}; }
   static F4 zero() { return set1(0.f); }
+  static void to_rows(const float* f, int stride, float* rows) {
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 8; ++i) rows[8 * j + i] = f[i * stride + j];
+  }
 };
 
 template <typename Op>

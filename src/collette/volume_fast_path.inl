@@ -142,6 +142,11 @@ inline void flush(Traversal& t) {
   LeafBatch& lb = *t.batch;
   lb.pad();
   LensLanes lanes;
+  alignas(32) float rows[16 * 8];  // lane j's pair: rows[8 j .. 8 j + 8) (PairSums' order)
+  static_assert(offsetof(LensLanes, area) == offsetof(LensLanes, volume) + 16 * sizeof(float) &&
+                offsetof(LensLanes, cz) == offsetof(LensLanes, volume) + 7 * 16 * sizeof(float) &&
+                offsetof(LensLanes, nx) == offsetof(LensLanes, volume) + 2 * 16 * sizeof(float));
+  PairSums sums(t.sum);
   constexpr int kGroup = V::kWidth;
   static_assert(kGroup <= LeafBatch::kPad);
   for (int i = 0; i < lb.count; i += kGroup) {
@@ -149,13 +154,13 @@ inline void flush(Traversal& t) {
     const std::uint32_t hits = lens_lanes(lb, i, t.margin, lanes, near_lanes);
     const std::uint32_t valid = lb.count - i >= kGroup ? (1u << kGroup) - 1u : (1u << (lb.count - i)) - 1u;
     std::uint32_t todo = (hits | near_lanes) & valid;
+    if (todo) V::to_rows(lanes.volume, 16, rows);
     while (todo) {
       const int j = std::countr_zero(todo);
       todo &= todo - 1u;
       const int k = i + j;
       if ((hits >> j) & 1u) {
-        t.add_overlap(lanes.volume[j], lanes.area[j], lanes.nx[j], lanes.ny[j], lanes.nz[j], lanes.cx[j],
-                      lanes.cy[j], lanes.cz[j], lb.leaf_a[k], lb.leaf_b[k]);
+        t.add_overlap_row(sums, rows + 8 * j, lb.leaf_a[k], lb.leaf_b[k]);
       } else {
         const float dx = lb.bx[k] - lb.ax[k], dy = lb.by[k] - lb.ay[k], dz = lb.bz[k] - lb.az[k];
         t.add_near_pair(dx, dy, dz, std::sqrt(dx * dx + dy * dy + dz * dz), lb.ax[k], lb.ay[k], lb.az[k],
@@ -163,6 +168,7 @@ inline void flush(Traversal& t) {
       }
     }
   }
+  sums.store(t.sum);
   lb.count = 0;
 }
 

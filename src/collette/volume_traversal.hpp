@@ -12,7 +12,9 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -32,6 +34,69 @@ struct Totals {
   double nx = 0.0, ny = 0.0, nz = 0.0;
   double gx = 0.0, gy = 0.0, gz = 0.0;  // sum of pi a^2 * normal
   double cx = 0.0, cy = 0.0, cz = 0.0;
+};
+
+// The totals while the fast path sums a batch's pairs: the doubles of Totals, two to a register,
+// each updated by the operations add_overlap() performs on it (a product of two floats widened to
+// double, then one add), so every sum is bit for bit add_overlap()'s. A pair comes as a row of
+// eight floats: volume, area, nx, ny, nz, cx, cy, cz (PairOverlap's order from its volume on).
+struct PairSums {
+#if defined(__SSE2__)
+  __m128d volume, nxy, nz_cx, cyz, gxy, gz;  // volume and gz: the low lane
+
+  explicit PairSums(const Totals& s)
+      : volume(_mm_set_sd(s.volume)),
+        nxy(_mm_setr_pd(s.nx, s.ny)),
+        nz_cx(_mm_setr_pd(s.nz, s.cx)),
+        cyz(_mm_setr_pd(s.cy, s.cz)),
+        gxy(_mm_setr_pd(s.gx, s.gy)),
+        gz(_mm_set_sd(s.gz)) {}
+
+  // two floats of the row, widened
+  [[gnu::always_inline]] static __m128d widened(const float* p) {
+    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+  }
+  [[gnu::always_inline]] void add(const float* row) {
+    const __m128d vd = _mm_set1_pd(static_cast<double>(row[0]));
+    const __m128d ad = _mm_set1_pd(static_cast<double>(row[1]));
+    const __m128d n_xy = widened(row + 2), n_z_c_x = widened(row + 4), c_yz = widened(row + 6);
+    volume = _mm_add_sd(volume, vd);
+    nxy = _mm_add_pd(nxy, _mm_mul_pd(vd, n_xy));
+    nz_cx = _mm_add_pd(nz_cx, _mm_mul_pd(vd, n_z_c_x));
+    cyz = _mm_add_pd(cyz, _mm_mul_pd(vd, c_yz));
+    gxy = _mm_add_pd(gxy, _mm_mul_pd(ad, n_xy));
+    gz = _mm_add_sd(gz, _mm_mul_sd(ad, n_z_c_x));
+  }
+  void store(Totals& s) const {
+    s.volume = _mm_cvtsd_f64(volume);
+    _mm_storel_pd(&s.nx, nxy);
+    _mm_storeh_pd(&s.ny, nxy);
+    _mm_storel_pd(&s.nz, nz_cx);
+    _mm_storeh_pd(&s.cx, nz_cx);
+    _mm_storel_pd(&s.cy, cyz);
+    _mm_storeh_pd(&s.cz, cyz);
+    _mm_storel_pd(&s.gx, gxy);
+    _mm_storeh_pd(&s.gy, gxy);
+    s.gz = _mm_cvtsd_f64(gz);
+  }
+#else
+  Totals sum;
+  explicit PairSums(const Totals& s) : sum(s) {}
+  void add(const float* row) {
+    const double vd = static_cast<double>(row[0]), ad = static_cast<double>(row[1]);
+    sum.volume += vd;
+    sum.nx += vd * static_cast<double>(row[2]);
+    sum.ny += vd * static_cast<double>(row[3]);
+    sum.nz += vd * static_cast<double>(row[4]);
+    sum.cx += vd * static_cast<double>(row[5]);
+    sum.cy += vd * static_cast<double>(row[6]);
+    sum.cz += vd * static_cast<double>(row[7]);
+    sum.gx += ad * static_cast<double>(row[2]);
+    sum.gy += ad * static_cast<double>(row[3]);
+    sum.gz += ad * static_cast<double>(row[4]);
+  }
+  void store(Totals& s) const { s = sum; }
+#endif
 };
 
 // byte j all ones when bit j of the index is set: spreads a child mask over the 8-bit rows of a
@@ -121,6 +186,23 @@ struct Traversal {
       p.centroid[0] = cx;
       p.centroid[1] = cy;
       p.centroid[2] = cz;
+    }
+  }
+
+  // add_overlap() for a pair as a row of eight floats (PairSums), summed into `sums`
+  [[gnu::always_inline]] inline void add_overlap_row(PairSums& sums, const float* row, std::int32_t la,
+                                                     std::int32_t lb) {
+    static_assert(offsetof(PairOverlap, area) == offsetof(PairOverlap, volume) + 4 &&
+                  offsetof(PairOverlap, normal) == offsetof(PairOverlap, volume) + 8 &&
+                  offsetof(PairOverlap, centroid) == offsetof(PairOverlap, volume) + 20 &&
+                  sizeof(PairOverlap) == offsetof(PairOverlap, volume) + 32);
+    sums.add(row);
+    ++overlapping;
+    if (stored < capacity) {
+      PairOverlap& p = out[stored++];
+      p.leaf_a = la;
+      p.leaf_b = lb;
+      std::memcpy(reinterpret_cast<char*>(&p) + offsetof(PairOverlap, volume), row, 8 * sizeof(float));
     }
   }
 
