@@ -29,9 +29,10 @@ struct LeafBatch {
   std::int32_t leaf_a[kCapacity], leaf_b[kCapacity];
   int count = 0;
 
-  [[gnu::always_inline]] inline void add(float xa, float ya, float za, float ra, float xb, float yb, float zb, float rb,
-                                         std::int32_t la, std::int32_t lb) {
-    const int i = count++;
+  /// Pair i: the traversal keeps the count in a register while it appends, and stores it before
+  /// the batch is evaluated.
+  [[gnu::always_inline]] inline void set(int i, float xa, float ya, float za, float ra, float xb, float yb, float zb,
+                                         float rb, std::int32_t la, std::int32_t lb) {
     ax[i] = xa;
     ay[i] = ya;
     az[i] = za;

@@ -190,11 +190,32 @@ void run_fast(Traversal& t, std::size_t stop_at) {
   const SphereTree::Blocks& a = t.a;
   const SphereTree::Blocks& b = t.b;
   const float sm = t.search_margin;
-  while (t.top > 0 && t.top < stop_at) {
-    if (lb.count > LeafBatch::kCapacity - WA * WB) flush(t);
-    const VolumeQuery::StackEntry e = (*t.stack)[--t.top];
-    ++t.visited;
-    t.reserve_stack(static_cast<std::size_t>(WA * WB));
+  // the stack's top, the batch's count and the statistics in locals (registers) during the loop:
+  // in memory, every push and every appended pair would store them again, since the compiler cannot
+  // tell them apart from the entries and pairs being written
+  VolumeQuery::StackEntry* stack = t.stack->data();
+  std::size_t top = t.top, room = t.stack->size();
+  int count = lb.count;
+  std::int64_t visited = 0, leaf_tests = 0;
+  const auto push = [&](std::int32_t ia, std::int32_t ib, float ax, float ay, float az, float ar, float bx,
+                        float by, float bz, float br) [[gnu::always_inline]] {
+    t.prefetch_pair<WA, WB>(ia, ib);
+    stack[top++] = {ia, ib, ax, ay, az, ar, bx, by, bz, br};
+  };
+  while (top > 0 && top < stop_at) {
+    if (count > LeafBatch::kCapacity - WA * WB) {
+      lb.count = count;
+      flush(t);
+      count = 0;
+    }
+    const VolumeQuery::StackEntry e = stack[--top];
+    ++visited;
+    if (room - top < static_cast<std::size_t>(WA * WB)) {
+      t.top = top;
+      t.reserve_stack(static_cast<std::size_t>(WA * WB));
+      stack = t.stack->data();
+      room = t.stack->size();
+    }
     if (e.a < 0) {
       // A is a leaf: B's children against it
       const Sphere& s = t.leaves_a[~e.a];
@@ -203,16 +224,15 @@ void run_fast(Traversal& t, std::size_t stop_at) {
       const std::uint32_t hits =
           overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, s.x, s.y, s.z, s.radius + sm) &
           ((1u << b.count[e.b]) - 1u);
-      t.leaf_tests += kBitCount[leaf_b];
+      leaf_tests += kBitCount[leaf_b];
       const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
       for (std::uint32_t m = hits & leaf_b; m; m &= m - 1u) {
         const int j = std::countr_zero(m);
-        lb.add(s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
+        lb.set(count++, s.x, s.y, s.z, s.radius, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], ~e.a, ~cb[j]);
       }
       for (std::uint32_t m = hits & ~leaf_b; m; m &= m - 1u) {
         const int j = std::countr_zero(m);
-        t.push_prefetched<WA, WB>(e.a, cb[j], e.ax, e.ay, e.az, e.ar, tb[j], tb[WB + j], tb[2 * WB + j],
-                                  tb[3 * WB + j]);
+        push(e.a, cb[j], e.ax, e.ay, e.az, e.ar, tb[j], tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
       }
       continue;
     }
@@ -223,15 +243,14 @@ void run_fast(Traversal& t, std::size_t stop_at) {
       // B is a leaf: A's children against it (padding lanes of A never overlap)
       const std::uint32_t hits =
           overlap_mask<WA>(ab, ab + WA, ab + 2 * WA, ab + 3 * WA, e.bx, e.by, e.bz, e.br + sm);
-      t.leaf_tests += kBitCount[leaf_a];
+      leaf_tests += kBitCount[leaf_a];
       for (std::uint32_t m = hits & leaf_a; m; m &= m - 1u) {
         const int k = std::countr_zero(m);
-        lb.add(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
+        lb.set(count++, ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br, ~ca[k], ~e.b);
       }
       for (std::uint32_t m = hits & ~leaf_a; m; m &= m - 1u) {
         const int k = std::countr_zero(m);
-        t.push_prefetched<WA, WB>(ca[k], e.b, ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by,
-                                  e.bz, e.br);
+        push(ca[k], e.b, ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], e.bx, e.by, e.bz, e.br);
       }
       continue;
     }
@@ -240,7 +259,7 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     const float* tb = moved_block<WB>(t, moved, stamp, run, e.b);
     const std::uint32_t leaf_b = b.leaf_mask[e.b];
     const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
-    t.leaf_tests += kBitCount[leaf_a] * kBitCount[leaf_b];
+    leaf_tests += kBitCount[leaf_a] * kBitCount[leaf_b];
     // only B's children that reach A's node sphere can reach a leaf below A: the rows of the others
     // (a third to a half) are dropped. When a row is one group of lanes (or two rows are, with
     // sixteen lanes), every row is tested in a loop of fixed length (no branch to mispredict) and
@@ -265,15 +284,19 @@ void run_fast(Traversal& t, std::size_t stop_at) {
         hits & kByteMask[leaf_b] & (static_cast<std::uint64_t>(leaf_a) * 0x0101010101010101ull);
     for (std::uint64_t m = leaf_pairs; m; m &= m - 1u) {
       const int bit = std::countr_zero(m), j = bit >> 3, k = bit & 7;
-      lb.add(ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],
+      lb.set(count++, ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],
              tb[3 * WB + j], ~ca[k], ~cb[j]);
     }
     for (std::uint64_t m = hits & ~leaf_pairs; m; m &= m - 1u) {
       const int bit = std::countr_zero(m), j = bit >> 3, k = bit & 7;
-      t.push_prefetched<WA, WB>(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j],
-                                tb[WB + j], tb[2 * WB + j], tb[3 * WB + j]);
+      push(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],
+           tb[3 * WB + j]);
     }
   }
+  t.top = top;
+  t.visited += visited;
+  t.leaf_tests += leaf_tests;
+  lb.count = count;
   flush(t);
 }
 

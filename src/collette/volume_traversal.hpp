@@ -287,8 +287,7 @@ struct Traversal {
   // them: each visit's loads depend on the visit before, and without the prefetch the traversal is
   // bound by that latency rather than by its arithmetic.
   template <int WA, int WB>
-  void push_prefetched(std::int32_t ia, std::int32_t ib, float ax, float ay, float az, float ar, float bx,
-                       float by, float bz, float br) {
+  [[gnu::always_inline]] inline void prefetch_pair(std::int32_t ia, std::int32_t ib) const {
 #if defined(__SSE2__)
     if (ia >= 0) {
       const char* pa = reinterpret_cast<const char*>(a.bounds + static_cast<std::size_t>(ia) * 4 * WA);
@@ -302,8 +301,10 @@ struct Traversal {
       _mm_prefetch(pb, _MM_HINT_T0);
       if constexpr (WB == 8) _mm_prefetch(pb + 64, _MM_HINT_T0);
     }
+#else
+    (void)ia;
+    (void)ib;
 #endif
-    push(ia, ib, ax, ay, az, ar, bx, by, bz, br);
   }
 
   // room for n more entries (grows, rarely, outside steady state)
