@@ -261,12 +261,15 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     const std::int32_t* cb = b.child + static_cast<std::size_t>(e.b) * WB;
     leaf_tests += kBitCount[leaf_a] * kBitCount[leaf_b];
     // only B's children that reach A's node sphere can reach a leaf below A: the rows of the others
-    // (a third to a half) are dropped. When a row is one group of lanes (or two rows are, with
-    // sixteen lanes), every row is tested in a loop of fixed length (no branch to mispredict) and
-    // the mask drops rows afterwards; narrower lanes test only the rows kept.
+    // (a third to a half) are dropped. The pair's push tested them (e.rows) unless it came from
+    // elsewhere. When a row is one group of lanes (or two rows are, with sixteen lanes), every row is
+    // tested in a loop of fixed length (no branch to mispredict) and the mask drops rows afterwards;
+    // narrower lanes test only the rows kept.
     const std::uint32_t rows =
-        overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, e.ax, e.ay, e.az, e.ar + sm) &
-        ((1u << b.count[e.b]) - 1u);
+        e.rows != VolumeQuery::kRowsUnknown
+            ? e.rows
+            : overlap_mask<WB>(tb, tb + WB, tb + 2 * WB, tb + 3 * WB, e.ax, e.ay, e.az, e.ar + sm) &
+                  ((1u << b.count[e.b]) - 1u);
     std::uint64_t hits = 0;
     if constexpr (2 * WA == V::kWidth && WB == 8) {
       using B8 = BlockLanes<8>;
@@ -289,8 +292,24 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     }
     for (std::uint64_t m = hits & ~leaf_pairs; m; m &= m - 1u) {
       const int bit = std::countr_zero(m), j = bit >> 3, k = bit & 7;
-      push(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],
-           tb[3 * WB + j]);
+      if (ca[k] >= 0 && cb[j] >= 0) {
+        // two inner nodes: their visit's rows tested now (B's child moved into A's frame now rather
+        // than at the visit), and the pair pushed only when a row is left, without a branch: about
+        // three in ten such pairs have none (their visit would find nothing)
+        const float* tj = moved_block<WB>(t, moved, stamp, run, cb[j]);
+        const std::uint32_t r = overlap_mask<WB>(tj, tj + WB, tj + 2 * WB, tj + 3 * WB, ab[k], ab[WA + k],
+                                                 ab[2 * WA + k], ab[3 * WA + k] + sm) &
+                                ((1u << b.count[cb[j]]) - 1u);
+        const char* pa = reinterpret_cast<const char*>(a.bounds + static_cast<std::size_t>(ca[k]) * 4 * WA);
+        prefetch(pa);
+        if constexpr (WA == 8) prefetch(pa + 64);
+        stack[top] = {ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j],
+                      tb[2 * WB + j], tb[3 * WB + j], r};
+        top += r != 0 ? 1 : 0;
+      } else {
+        push(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],
+             tb[3 * WB + j]);
+      }
     }
   }
   t.top = top;

@@ -181,6 +181,8 @@ class VolumeQuery {
   /// calling thread ran them all).
   int worker_chunks() const { return worker_chunks_; }
 
+  /// StackEntry::rows of a pair whose rows were not tested when it was pushed.
+  static constexpr std::uint32_t kRowsUnknown = ~0u;
   /// One entry of the traversal stack: a node pair known to overlap, as traversal ids
   /// (SphereTree::Blocks), with both node spheres, B's already in A's frame (so each B node is
   /// transformed once per visit).
@@ -189,6 +191,9 @@ class VolumeQuery {
     std::int32_t b;
     float ax, ay, az, ar;
     float bx, by, bz, br;
+    /// Fast path: bit j set when child j of B reaches A's node sphere, found when the pair was
+    /// pushed; kRowsUnknown when not tested.
+    std::uint32_t rows = kRowsUnknown;
   };
 
   /// A kept leaf pair: A's leaf index and the slot of B's leaf in the run's moved-B-leaves buffer.
