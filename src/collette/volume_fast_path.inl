@@ -264,7 +264,8 @@ void run_fast(Traversal& t, std::size_t stop_at) {
     // (a third to a half) are dropped. The pair's push tested them (e.rows) unless it came from
     // elsewhere. When a row is one group of lanes (or two rows are, with sixteen lanes), every row is
     // tested in a loop of fixed length (no branch to mispredict) and the mask drops rows afterwards;
-    // narrower lanes test only the rows kept.
+    // with eight lanes, the loop runs over the first four kept rows; narrower lanes test only the
+    // rows kept.
     const std::uint32_t rows =
         e.rows != VolumeQuery::kRowsUnknown
             ? e.rows
@@ -278,7 +279,18 @@ void run_fast(Traversal& t, std::size_t stop_at) {
       for (int j = 0; j < WB; j += 2) hits |= row_pair_mask<WA>(ab, bx, by, bz, br, j);
       hits &= kByteMask[rows];
     } else if constexpr (WA <= V::kWidth) {
-      for (int j = 0; j < WB; ++j) hits |= row_mask<WA, WB>(ab, tb, j, sm);
+      // the first four kept rows in a loop of fixed length (the row indices from a table), the
+      // others after, when there are more than four (about a quarter of the visits on the deep
+      // random poses): half the row tests of a loop over all eight for the other three quarters,
+      // and no branch per row
+      std::uint32_t list = kRowList[rows];
+      for (int i = 0; i < 4; ++i, list >>= 8) hits |= row_mask<WA, WB>(ab, tb, static_cast<int>(list & 0xffu), sm);
+      if (kBitCount[rows] > 4) {
+        std::uint32_t rest = rows;
+        for (int i = 0; i < 4; ++i) rest &= rest - 1u;
+        list = kRowList[rest];
+        for (int i = 0; i < 4; ++i, list >>= 8) hits |= row_mask<WA, WB>(ab, tb, static_cast<int>(list & 0xffu), sm);
+      }
       hits &= kByteMask[rows];
     } else {
       for (std::uint32_t m = rows; m; m &= m - 1u) hits |= row_mask<WA, WB>(ab, tb, std::countr_zero(m), sm);

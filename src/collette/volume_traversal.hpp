@@ -109,6 +109,24 @@ inline constexpr auto kByteMask = [] {
   return t;
 }();
 
+// the first four set bits of a child mask, a byte each from the lowest, the first repeated where
+// fewer are set (0 when none)
+inline constexpr auto kRowList = [] {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t m = 0; m < 256; ++m) {
+    std::uint32_t list = 0, first = 0;
+    int n = 0;
+    for (std::uint32_t j = 0; j < 8 && n < 4; ++j)
+      if ((m >> j) & 1u) {
+        if (n == 0) first = j;
+        list |= j << (8 * n++);
+      }
+    for (; n < 4; ++n) list |= first << (8 * n);
+    t[m] = list;
+  }
+  return t;
+}();
+
 // number of bits set in a child mask (popcount is not in the baseline ISA)
 inline constexpr auto kBitCount = [] {
   std::array<std::uint8_t, 256> t{};
