@@ -200,7 +200,7 @@ void run_fast(Traversal& t, std::size_t stop_at) {
   const auto push = [&](std::int32_t ia, std::int32_t ib, float ax, float ay, float az, float ar, float bx,
                         float by, float bz, float br) [[gnu::always_inline]] {
     t.prefetch_pair<WA, WB>(ia, ib);
-    stack[top++] = {ia, ib, ax, ay, az, ar, bx, by, bz, br};
+    store_entry(stack + top++, ia, ib, ax, ay, az, ar, bx, by, bz, br, VolumeQuery::kRowsUnknown);
   };
   while (top > 0 && top < stop_at) {
     if (count > LeafBatch::kCapacity - WA * WB) {
@@ -208,7 +208,7 @@ void run_fast(Traversal& t, std::size_t stop_at) {
       flush(t);
       count = 0;
     }
-    const VolumeQuery::StackEntry e = stack[--top];
+    const VolumeQuery::StackEntry e = load_entry(stack + --top);
     ++visited;
     if (room - top < static_cast<std::size_t>(WA * WB)) {
       t.top = top;
@@ -315,8 +315,8 @@ void run_fast(Traversal& t, std::size_t stop_at) {
         const char* pa = reinterpret_cast<const char*>(a.bounds + static_cast<std::size_t>(ca[k]) * 4 * WA);
         prefetch(pa);
         if constexpr (WA == 8) prefetch(pa + 64);
-        stack[top] = {ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j],
-                      tb[2 * WB + j], tb[3 * WB + j], r};
+        store_entry(stack + top, ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j],
+                    tb[WB + j], tb[2 * WB + j], tb[3 * WB + j], r);
         top += r != 0 ? 1 : 0;
       } else {
         push(ca[k], cb[j], ab[k], ab[WA + k], ab[2 * WA + k], ab[3 * WA + k], tb[j], tb[WB + j], tb[2 * WB + j],

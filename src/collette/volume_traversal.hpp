@@ -36,6 +36,38 @@ struct Totals {
   double cx = 0.0, cy = 0.0, cz = 0.0;
 };
 
+// A stack entry stored and loaded as three 16-byte pieces. The visit after a push usually pops the
+// entry just pushed; when a load spans two stores of it (the compiler's own copy stores the ids,
+// then the spheres, then the rows, and loads 16 bytes at a time), it cannot be forwarded from them
+// and waits until they reach the cache.
+static_assert(sizeof(VolumeQuery::StackEntry) == 48);
+[[gnu::always_inline]] inline void store_entry(VolumeQuery::StackEntry* p, std::int32_t ia, std::int32_t ib, float ax,
+                                               float ay, float az, float ar, float bx, float by, float bz, float br,
+                                               std::uint32_t rows) {
+#if defined(__SSE2__)
+  const auto i = [](float x) { return std::bit_cast<std::int32_t>(x); };
+  __m128i* q = reinterpret_cast<__m128i*>(p);
+  _mm_storeu_si128(q, _mm_setr_epi32(ia, ib, i(ax), i(ay)));
+  _mm_storeu_si128(q + 1, _mm_castps_si128(_mm_setr_ps(az, ar, bx, by)));
+  _mm_storeu_si128(q + 2, _mm_setr_epi32(i(bz), i(br), static_cast<std::int32_t>(rows), 0));
+#else
+  *p = {ia, ib, ax, ay, az, ar, bx, by, bz, br, rows};
+#endif
+}
+[[gnu::always_inline]] inline VolumeQuery::StackEntry load_entry(const VolumeQuery::StackEntry* p) {
+  VolumeQuery::StackEntry e;
+#if defined(__SSE2__)
+  const __m128i* q = reinterpret_cast<const __m128i*>(p);
+  __m128i* r = reinterpret_cast<__m128i*>(&e);
+  _mm_storeu_si128(r, _mm_loadu_si128(q));
+  _mm_storeu_si128(r + 1, _mm_loadu_si128(q + 1));
+  _mm_storeu_si128(r + 2, _mm_loadu_si128(q + 2));
+#else
+  e = *p;
+#endif
+  return e;
+}
+
 // The totals while the fast path sums a batch's pairs: the doubles of Totals, two to a register,
 // each updated by the operations add_overlap() performs on it (a product of two floats widened to
 // double, then one add), so every sum is bit for bit add_overlap()'s. A pair comes as a row of

@@ -194,6 +194,7 @@ class VolumeQuery {
     /// Fast path: bit j set when child j of B reaches A's node sphere, found when the pair was
     /// pushed; kRowsUnknown when not tested.
     std::uint32_t rows = kRowsUnknown;
+    std::uint32_t unused = 0;  ///< pads the entry to three 16-byte pieces (the fast path's stores and loads)
   };
 
   /// A kept leaf pair: A's leaf index and the slot of B's leaf in the run's moved-B-leaves buffer.
