@@ -155,6 +155,11 @@ inline void flush(Traversal& t) {
     const std::uint32_t valid = lb.count - i >= kGroup ? (1u << kGroup) - 1u : (1u << (lb.count - i)) - 1u;
     std::uint32_t todo = (hits | near_lanes) & valid;
     if (todo) V::to_rows(lanes.volume, 16, rows);
+    if (hits == (1u << kGroup) - 1u && t.stored + kGroup <= t.capacity) {
+      // every lane overlaps (most groups): the pairs in lane order, without scanning the bits
+      for (int j = 0; j < kGroup; ++j) t.add_overlap_row(sums, rows + 8 * j, lb.leaf_a[i + j], lb.leaf_b[i + j]);
+      continue;
+    }
     while (todo) {
       const int j = std::countr_zero(todo);
       todo &= todo - 1u;
