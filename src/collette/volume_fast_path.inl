@@ -203,7 +203,7 @@ void run_fast(Traversal& t, std::size_t stop_at) {
   int count = lb.count;
   std::int64_t visited = 0, leaf_tests = 0;
   const auto push = [&](std::int32_t ia, std::int32_t ib, float ax, float ay, float az, float ar, float bx,
-                        float by, float bz, float br) [[gnu::always_inline]] {
+                        float by, float bz, float br) __attribute__((always_inline)) {
     t.prefetch_pair<WA, WB>(ia, ib);
     store_entry(stack + top++, ia, ib, ax, ay, az, ar, bx, by, bz, br, VolumeQuery::kRowsUnknown);
   };
