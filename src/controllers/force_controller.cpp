@@ -352,9 +352,13 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
                         p.volume_gradient_world, p.total_volume,     f.patches.patch[i].link};
           }
           take_patches(*w, {found, static_cast<std::size_t>(f.patches.count)}, world_from_tool);
-          for (PatchStage& s : w->stages)
-            if (s.live) s.renderer.take(f.patch_models[s.index]);
+          w->modelled_patches = f.patches.count;
+          // one patch is the whole model, which w->renderer renders already
+          if (f.patches.count > 1)
+            for (PatchStage& s : w->stages)
+              if (s.live) s.renderer.take(f.patch_models[s.index]);
         } else if (w->has_surface) {
+          w->modelled_patches = 0;
           end_patches(*w);
         }
       }
@@ -370,10 +374,15 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
       const forcecomp::WrenchModel& m = w->renderer.model();
       contact.force += r.force;
       contact.torque += r.torque;
+      // a patch's penalty: its own model's, or, for one patch, the whole one just rendered (as on
+      // the held paths below)
       if (m.contact && w->has_surface)
         for (PatchStage& s : w->stages)
           if (s.live)
-            add(contact, add_surface(*w, s, s.renderer.render(now, world_from_tool.rotation, tool_motion),
+            add(contact, add_surface(*w, s,
+                                     w->modelled_patches > 1
+                                         ? s.renderer.render(now, world_from_tool.rotation, tool_motion)
+                                         : r,
                                      world_from_tool, tool_motion));
       pairs += m.pair_count;
       if (m.contact) oldest_data_s = std::min(oldest_data_s, m.time_s);

@@ -176,6 +176,7 @@ class ForceController {
     forcecomp::WrenchModelRenderer renderer;  // haptic thread
     forcecomp::HeldContactSet held;           // haptic thread: a view of the world's frame, its section
     forcecomp::ContactPatches held_patches;   // haptic thread: the held section's patches (with a surface)
+    std::int32_t modelled_patches = 0;        // haptic thread: patches of the model taken last (kModel)
     bool in_frame = false;                    // haptic thread: scratch of taking a frame
     Pose world_from_object{};                 // object pose used by the held frame's query
     forcecomp::Wrench held_wrench{};          // force of the newest frame (held-force mode)
