@@ -530,6 +530,7 @@ void CollisionWorld::run_step(double time_s) {
     watcher.touching = touching;
     watcher.frames.publish();
   }
+  on_step_.broadcast(time_s);
 
   last_pairs_.store(pairs_this_step, std::memory_order_relaxed);
   if (pairs_this_step > max_pairs_.load(std::memory_order_relaxed))

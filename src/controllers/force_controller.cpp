@@ -320,6 +320,13 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   }
   const Vec3 handle_velocity = mapping_.tool_velocity_world(state);
   const Vec3 handle_angular_velocity = mapping_.angular_velocity_world(state);
+  if (proxy_ != nullptr) {
+    double data_s = now;
+    std::int32_t holding = 0;
+    const forcecomp::Wrench spring = proxy_wrench(world_from_handle_tool, data_s, holding);
+    finish_tick(spring, spring, now, data_s, holding, command);
+    return;
+  }
   const Pose world_from_tool = options_.use_coupling ? coupling_.world_from_proxy() : world_from_handle_tool;
   const forcecomp::BodyMotion tool_motion =
       component_.body_motion(world_from_tool, handle_velocity, handle_angular_velocity);
@@ -428,10 +435,6 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
     }
   }
 
-  const double step = norm(contact.force - last_contact_force_);
-  if (std::isfinite(step)) raise_max(max_force_step_n_, step);
-  last_contact_force_ = contact.force;
-
   forcecomp::Wrench to_device = contact;
   if (options_.use_coupling) {
     // the coupling takes the contact torque about the proxy's origin, the penalty gives it about the CoM
@@ -440,6 +443,37 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
     to_device = coupling_.step(world_from_handle_tool, handle_velocity, handle_angular_velocity, on_proxy, dt)
                     .device_wrench;
   }
+  finish_tick(contact, to_device, now, oldest_data_s, pairs, command);
+}
+
+forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s,
+                                                std::int32_t& holding) {
+  if (const ProxyState* s = proxy_->take()) {
+    proxy_state_ = *s;
+    have_proxy_state_ = true;
+    frames_received_.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (!have_proxy_state_) {
+    rendered_proxy_ = world_from_handle_tool;  // the tool appears at the handle (ToolProxy places it there)
+    return {};
+  }
+  data_time_s = proxy_state_.time_s;
+  holding = proxy_state_.active;
+  const Pose proxy = proxy_->slide(proxy_state_, world_from_handle_tool);
+  rendered_proxy_ = proxy;
+  forcecomp::Wrench w;
+  w.force = coupling_.stiffness() * (proxy.position - world_from_handle_tool.position);
+  if (component_.options().mode == forcecomp::ForceMode::k6Dof)
+    w.torque = coupling_.angular_stiffness() *
+               forcecomp::rotation_vector(proxy.rotation * conjugate(world_from_handle_tool.rotation));
+  return w;
+}
+
+void ForceController::finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,
+                                  double oldest_data_s, std::int32_t pairs, haptico::DeviceCommand& command) {
+  const double step = norm(contact.force - last_contact_force_);
+  if (std::isfinite(step)) raise_max(max_force_step_n_, step);
+  last_contact_force_ = contact.force;
   const forcecomp::Wrench safe = safety_.apply(to_device, now, oldest_data_s);
   const Vec3 force_device = mapping_.to_device(safe.force);
   const Vec3 torque_device = mapping_.to_device(safe.torque);

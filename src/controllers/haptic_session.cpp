@@ -32,6 +32,7 @@ struct HapticSession::ToolRig {
   std::string path;  // the tool's place in the scene file, for messages: "tool" or "tools[i]"
   collette::ObjectId tool_id = -1;
   std::unique_ptr<haptico::HapticManager> manager;
+  std::unique_ptr<ToolProxy> proxy;  // with ForceControllerOptions::proxy enabled
   std::unique_ptr<ForceController> force_controller;
   std::unique_ptr<BridgingController> bridging_controller;
   ScopedConnection sent_connection;
@@ -57,11 +58,13 @@ struct HapticSession::ToolRig {
     // haptic thread: one snapshot per tick through the triple buffer, no lock, no allocation
     SessionState& s = state_out.write_buffer();
     const WorkspaceMapping& mapping = bridging_controller->mapping();
-    const Pose& tool = bridging_controller->last_pose();
+    const Pose& handle = bridging_controller->last_pose();
+    const Pose& tool = proxy ? force_controller->rendered_proxy() : handle;
     s.tool = index;
     s.time_s = sample.tick_time_s - session->t0_s_;
     s.tool_position_world = tool.position;
     s.tool_orientation_world = tool.rotation;
+    s.handle_position_world = handle.position;
     s.force_world = mapping.to_world(sample.sent.force);
     s.torque_world = mapping.to_world(sample.sent.torque);
     s.contact_pairs = force_controller->last_pairs();
@@ -103,7 +106,9 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
       .rate_hz = session->collision_hz_,
       .raise_priority = options.raise_priority,
-      .contact_margin = options.contact_margin.value_or(scene.contact_margin),
+      // the proxy's constraints are the pairs within the margin: it may step no farther than that
+      .contact_margin = std::max(options.contact_margin.value_or(scene.contact_margin),
+                                 force_options.proxy.enabled ? force_options.proxy.step_m : 0.0),
       .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;
@@ -180,6 +185,11 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
         {.params = tool.force, .mode = tool.mode, .side = forcecomp::ContactSide::kB});
     rig->force_controller =
         std::make_unique<ForceController>(rig->tool_id, component, tool.workspace, force_options);
+    if (force_options.proxy.enabled) {
+      rig->proxy = std::make_unique<ToolProxy>(world, rig->tool_id, *tool_tree->tree, force_options.proxy,
+                                               tool.mode == forcecomp::ForceMode::k6Dof);
+      rig->force_controller->render_through(rig->proxy.get());
+    }
     if (watch_all) {
       auto w = world.add_tool_watcher(rig->tool_id);
       if (!w) return w.error();
@@ -196,9 +206,11 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       const forcecomp::ContactMaterial material =
           forcecomp::combine_materials(scene.objects[i].material, tool.material, tool.force);
       rig->force_controller->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage, &material);
+      if (rig->proxy) rig->proxy->watch(object_ids[i]);
     }
+    if (rig->proxy) rig->proxy->bind();
     rig->bridging_controller = std::make_unique<BridgingController>(world, rig->tool_id, tool.workspace,
-                                                                    rig->force_controller.get());
+                                                                    rig->force_controller.get(), rig->proxy.get());
     rig->bridging_controller->bind(*rig->manager);
     rig->force_controller->bind(world, *rig->manager);
     ToolRig& r = *rig;
@@ -586,6 +598,8 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     t.model_error_rms_n = fc.model_error_rms_n;
     t.model_error_max_n = fc.model_error_max_n;
     t.coupling = fcon.options().use_coupling;
+    t.proxy = rig->proxy != nullptr;
+    if (rig->proxy) t.proxy_stats = rig->proxy->stats();
   }
   const collette::CollisionWorldStats ws = world_->stats();
   r.collision_target_hz = collision_hz_;
@@ -622,6 +636,20 @@ void HapticSession::publish_report() {
 }
 
 namespace {
+
+// force.proxy: null without one
+nlohmann::json proxy_report_json(const ToolReport& r) {
+  if (!r.proxy) return nullptr;
+  const ToolProxyStats& p = r.proxy_stats;
+  return {{"updates", p.updates},
+          {"contact_updates", p.contact_updates},
+          {"unsolved", p.unsolved},
+          {"capped_steps", p.capped_steps},
+          {"max_constraints", p.max_constraints},
+          {"deepest_m", p.deepest_m},
+          {"solve_us", {{"p50", p.solve_time.p50_ns * 1e-3}, {"p99", p.solve_time.p99_ns * 1e-3},
+                        {"max", p.solve_time.max_ns * 1e-3}}}};
+}
 
 // a tool's part of the report: device.*, haptic.*, force.*, contact.*, energy.*
 nlohmann::json tool_report_json(const ToolReport& r) {
@@ -668,7 +696,8 @@ nlohmann::json tool_report_json(const ToolReport& r) {
               {"checked_ticks", r.model_checked_ticks},
               {"error_rms_n", r.model_error_rms_n},
               {"error_max_n", r.model_error_max_n}}},
-            {"coupling", r.coupling}}},
+            {"coupling", r.coupling},
+            {"proxy", proxy_report_json(r)}}},
           {"contact", {{"ticks", r.contact_ticks}}},
           {"energy", {{"work_on_hand_j", r.work_on_hand_j}}}};
 }

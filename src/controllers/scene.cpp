@@ -271,7 +271,7 @@ Status read_workspace(const FieldReader& r, const json& j, const std::string& pa
 Status read_force_options(const FieldReader& r, const json& j, const std::string& path, Scene& scene) {
   ForceControllerOptions& o = scene.force;
   UH_CHECK(r.require_object(j, path));
-  UH_CHECK(r.check_keys(j, path, {"multi_rate", "tick_force", "safety", "coupling"}));
+  UH_CHECK(r.check_keys(j, path, {"multi_rate", "tick_force", "safety", "coupling", "proxy"}));
   UH_CHECK(r.boolean(j, path, "multi_rate", o.multi_rate));
   std::string tick_force = "model";
   UH_CHECK(r.string(j, path, "tick_force", tick_force, false));
@@ -313,6 +313,20 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
     UH_CHECK(r.number(*it, p, "passivity_margin", c.passivity_margin, 1e-3, 1.0));
     UH_CHECK(r.number(*it, p, "proxy_mass_kg", c.proxy_mass_kg, 1e-6, 1e4));
     UH_CHECK(r.number(*it, p, "proxy_inertia_kg_m2", c.proxy_inertia_kg_m2, 1e-12, 1e3));
+  }
+  if (const auto it = j.find("proxy"); it != j.end()) {
+    const std::string p = FieldReader::join(path, "proxy");
+    UH_CHECK(r.require_object(*it, p));
+    UH_CHECK(r.check_keys(*it, p, {"enabled", "step_m", "penetration_m", "max_constraints"}));
+    auto& x = o.proxy;
+    UH_CHECK(r.boolean(*it, p, "enabled", x.enabled));
+    UH_CHECK(r.number(*it, p, "step_m", x.step_m, 1e-5, 0.05));
+    UH_CHECK(r.number(*it, p, "penetration_m", x.penetration_m, 0.0, 0.01));
+    double capacity = x.max_constraints;
+    UH_CHECK(r.number(*it, p, "max_constraints", capacity, 16.0, 1e6));
+    x.max_constraints = static_cast<std::int32_t>(capacity);
+    if (x.enabled && o.use_coupling)
+      return r.error(p, "the proxy and force.coupling (the simulated tool of the penalty path) exclude each other");
   }
   return Ok{};
 }

@@ -163,6 +163,11 @@ class CollisionWorld {
   /// pairs (overlapping, or within the contact margin), and once more with an empty frame
   /// (pair_count 0) when that ends.
   DelegateSink<ObjectId, ObjectId, const ContactFrame&> on_collision() { return DelegateSink(on_collision_); }
+  /// Binds OnStep: called on the collision thread (or the thread calling step()) at the end of
+  /// every step, after its OnCollision calls, with the step's time [s]. A mover that decides an
+  /// object's next pose from this step's contacts (a tool's proxy) binds here and calls set_pose()
+  /// from it: the next step queries that pose. Bind before start().
+  DelegateSink<double> on_step() { return DelegateSink(on_step_); }
 
   /// Sets the world pose of an object. One writer thread per object; real-time safe (lock-free).
   /// Returns false (and counts it in stats().stale_poses) for a stale, unknown or static id.
@@ -268,6 +273,7 @@ class CollisionWorld {
   std::vector<Change> retire_backlog_;  // retired but not yet handed back (queue full)
   DynamicAabbTree broad_phase_;
   OnCollision on_collision_;
+  Delegator<double> on_step_;
   VolumeQuery volume_query_;
   DistanceQuery distance_query_;
   FixedRateLoop loop_;

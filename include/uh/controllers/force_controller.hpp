@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "uh/collette/collision_world.hpp"
+#include "uh/controllers/tool_proxy.hpp"
 #include "uh/controllers/workspace_mapping.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/delegator.hpp"
@@ -52,6 +53,10 @@ struct ForceControllerOptions {
   /// Optional spring-damper between the handle and a simulated tool (proxy).
   bool use_coupling = false;
   forcecomp::VirtualCouplingOptions coupling{};
+  /// The 6-DOF god-object (controllers/tool_proxy.hpp): when enabled, the device feels the spring
+  /// of `coupling` (its passivity-bounded stiffness) between the handle and the proxy instead of
+  /// the penalty forces, and the tool in the collision world is the proxy.
+  ToolProxyOptions proxy{};
 };
 
 /// What the controller did so far; a snapshot, plain data.
@@ -130,6 +135,11 @@ class ForceController {
   /// ForceOnHapticTick handler: haptic thread; real-time safe.
   void on_force(const haptico::DeviceState& state, haptico::DeviceCommand& command);
 
+  /// Renders the spring to this tool's proxy instead of penalty forces (the proxy outlives the
+  /// controller's ticks). Controlling thread, before bind().
+  void render_through(ToolProxy* proxy) { proxy_ = proxy; }
+  /// With a proxy: the proxy the last tick rendered against (slid towards the handle). Haptic thread.
+  const Pose& rendered_proxy() const { return rendered_proxy_; }
   /// The coupling (null without one); the BridgingController reads its proxy pose.
   const forcecomp::VirtualCoupling* coupling() const { return options_.use_coupling ? &coupling_ : nullptr; }
   /// True once the coupling's proxy has been placed at the handle (haptic thread only).
@@ -186,6 +196,12 @@ class ForceController {
     }
   };
   Watched* find_watched(collette::ObjectId object);
+  // proxy mode: the spring between the handle and the proxy slid towards it; sets the data's time
+  // and the constraints holding the proxy
+  forcecomp::Wrench proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s, std::int32_t& holding);
+  // the end of every tick: statistics, the safety stage, the device frame
+  void finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,
+                   double oldest_data_s, std::int32_t pairs, haptico::DeviceCommand& command);
   void publish_model(Watched& w, const ContactFrame& frame, const ContactSection* section);
   void take_frame(const ContactFrame& frame, const Pose& world_from_tool,
                   const forcecomp::BodyMotion& tool_motion);
@@ -202,6 +218,11 @@ class ForceController {
   haptico::HapticManager* manager_ = nullptr;
   ScopedConnection collision_connection_;
   ScopedConnection force_connection_;
+
+  ToolProxy* proxy_ = nullptr;
+  ProxyState proxy_state_{};      // haptic thread: the newest proxy taken
+  Pose rendered_proxy_{};         // haptic thread: it, slid towards the handle
+  bool have_proxy_state_ = false;
 
   // haptic thread state
   double last_tick_s_ = 0.0;

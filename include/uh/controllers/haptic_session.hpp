@@ -104,6 +104,9 @@ struct ToolReport {
   std::uint64_t model_checked_ticks = 0;
   double model_error_rms_n = 0.0, model_error_max_n = 0.0;  ///< with check_model
   bool coupling = false;
+  /// The god-object (ForceControllerOptions::proxy): whether it rendered, and ToolProxyStats.
+  bool proxy = false;
+  ToolProxyStats proxy_stats{};
   std::vector<TimelineSample> timeline;
 };
 
@@ -135,8 +138,9 @@ struct SessionReport : ToolReport {
 struct SessionState {
   std::int32_t tool = 0;               ///< the tool's index in Scene::tools
   double time_s = 0.0;                 ///< that tick's time since start() [s] (stepped: simulated time)
-  Vec3 tool_position_world{};          ///< origin of the tool's mesh frame in the world [m]
+  Vec3 tool_position_world{};          ///< origin of the tool's mesh frame in the world [m] (the proxy's, with one)
   Quat tool_orientation_world{};       ///< the tool's orientation in the world (unit quaternion)
+  Vec3 handle_position_world{};        ///< where the device's handle puts that origin [m] (the tool's, without a proxy)
   Vec3 force_world{};                  ///< force sent to the device, in the world frame [N]
   Vec3 torque_world{};                 ///< torque sent to the device, in the world frame [N m]
   std::int32_t contact_pairs = 0;      ///< sphere pairs the force of that tick used

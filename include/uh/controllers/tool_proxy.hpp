@@ -1,0 +1,141 @@
+#pragma once
+/// \file
+/// ToolProxy: the 6-DOF god-object of one tool, moved on the collision thread. The tool in the
+/// collision world is the proxy, not the handle: every collision step it moves towards the
+/// handle's pose as far as the sphere pairs near it allow (forcecomp::ProxySolver), so it never
+/// passes through a surface, however thin or however hard the hand pushes. The device then feels
+/// the spring between the handle and the proxy (ForceController).
+///
+/// Why it cannot tunnel: the world delivers every leaf pair closer than its contact margin (set to
+/// at least `step_m`), each becomes a linear constraint that is conservative for translation
+/// (a sphere pair's distance is a convex function of the translation), and no point of the tool
+/// moves by more than `step_m` in a step, so a pair the step did not see cannot be reached. The
+/// rotation's curvature (a point moves on an arc, the constraint sees the chord's tangent) is taken
+/// off every gap. Pairs beyond the constraint capacity shrink the step to their smallest gap.
+/// Moving objects are taken at the poses of the step's query.
+///
+/// Threads: construct, watch() and bind() on the controlling thread before the threads start;
+/// set_target() and take() on the haptic thread (the handle's side); on_collision() and on_step()
+/// run on the collision thread, which is then the tool's only mover in the world. stats() from any
+/// thread. The collision-thread path never allocates, locks, throws or logs.
+
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "uh/collette/collision_world.hpp"
+#include "uh/core/contact.hpp"
+#include "uh/core/delegator.hpp"
+#include "uh/core/latency_histogram.hpp"
+#include "uh/core/latest_value.hpp"
+#include "uh/forcecomp/proxy_solver.hpp"
+
+namespace uh::controllers {
+
+/// Options of a ToolProxy (aggregate; scene field `force.proxy`, docs/scenes.md).
+struct ToolProxyOptions {
+  bool enabled = false;           ///< render through the proxy (the penalty path when false)
+  /// Most any point of the tool moves in one collision step [m] (a hand faster than step_m times
+  /// the collision rate drags the proxy behind it). The world's contact margin is raised to it.
+  double step_m = 0.002;
+  /// How far the proxy's spheres may overlap the object's [m]: the proxy rests this deep.
+  double penetration_m = 0.0001;
+  /// Most constraints a step holds (the nearest pairs first is not guaranteed: the rest shrink
+  /// the step instead).
+  std::int32_t max_constraints = 4096;
+};
+
+/// The proxy as the haptic thread reads it. Plain data.
+struct ProxyState {
+  Pose world_from_proxy{};       ///< the proxy's pose, world frame
+  double time_s = 0.0;           ///< time of the collision step that set it [s]
+  std::int32_t constraints = 0;  ///< constraints of that step
+  /// The constraints holding the proxy at the end of that step, about its new pose (gap 0: met
+  /// exactly): between steps the haptic thread slides the proxy along them towards the handle.
+  std::int32_t active = 0;
+  forcecomp::ProxyConstraint holding[6] = {};
+  double reach_m = 0.0;          ///< how far a point may move from the proxy before the next step [m]
+};
+
+/// What the proxy did so far. Plain data.
+struct ToolProxyStats {
+  std::uint64_t updates = 0;           ///< collision steps that moved (or held) the proxy
+  std::uint64_t contact_updates = 0;   ///< of which with at least one constraint active
+  std::uint64_t unsolved = 0;          ///< steps whose constraints contradicted each other
+  std::uint64_t capped_steps = 0;      ///< steps shortened because pairs exceeded max_constraints
+  std::int32_t max_constraints = 0;    ///< most constraints of one step
+  double deepest_m = 0.0;              ///< deepest overlap of a constrained pair beyond penetration_m [m], >= 0
+  LatencySummary solve_time;           ///< the solver's time per step with constraints [ns]
+};
+
+class ToolProxy {
+ public:
+  /// `tool_tree` gives the tool's extent (the length that weighs rotation against translation).
+  /// `rotate`: 6-DOF (false: the proxy turns with the handle, constraints on its position only).
+  ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, const collette::SphereTree& tool_tree,
+            const ToolProxyOptions& options, bool rotate);
+  ToolProxy(const ToolProxy&) = delete;
+  ToolProxy& operator=(const ToolProxy&) = delete;
+
+  /// Pairs with `object` constrain the proxy (others, such as other tools, pass through).
+  /// Controlling thread, before bind().
+  void watch(collette::ObjectId object) { watched_.push_back(object); }
+  /// Connects to the world's OnCollision and OnStep. Controlling thread, before the threads start.
+  void bind();
+
+  /// Where the handle puts the tool now. Haptic thread; real-time safe.
+  void set_target(const Pose& world_from_handle_tool) { target_.write(world_from_handle_tool); }
+  /// The newest proxy if a newer one than the last call arrived, else null. Haptic thread.
+  const ProxyState* take() { return state_.update() ? &state_.read_buffer() : nullptr; }
+
+  /// OnCollision handler: the step's pairs with watched objects become constraints. Collision thread.
+  void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
+  /// OnStep handler: solves, moves the proxy in the world, publishes it. Collision thread.
+  void on_step(double time_s);
+
+  /// The proxy of `state` slid towards the handle along the constraints that hold it, by at most
+  /// its reach: what the device renders against between collision steps, so that the force
+  /// follows the handle at the haptic rate (zero in free space). Haptic thread; real-time safe.
+  Pose slide(const ProxyState& state, const Pose& world_from_handle_tool) const;
+
+  ToolProxyStats stats() const;
+  const ToolProxyOptions& options() const { return options_; }
+  /// The extent used to weigh rotation against translation [m].
+  double radius_m() const { return solver_.options().radius_m; }
+
+ private:
+  bool is_watched(std::int32_t object) const;
+  void add_section(const ContactFrame& frame, const ContactSection& section);
+  Pose advance(const Pose& from, const Pose& target, ProxyState& out);
+  double wanted_step(const Pose& from, const Pose& target, double limit, Vec3& t, Vec3& w) const;
+
+  collette::CollisionWorld* world_;
+  collette::ObjectId tool_;
+  ToolProxyOptions options_;
+  forcecomp::ProxySolver solver_;
+  std::vector<collette::ObjectId> watched_;
+  ScopedConnection collision_connection_;
+  ScopedConnection step_connection_;
+  LatestValue<Pose> target_;       // haptic thread -> collision thread
+  LatestValue<ProxyState> state_;  // collision thread -> haptic thread
+
+  // collision thread
+  std::vector<forcecomp::ProxyConstraint> constraints_;  // capacity max_constraints, fixed
+  std::int32_t constraint_count_ = 0;
+  double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
+  bool placed_ = false;
+  Pose proxy_{};
+  Pose queried_{};               // the tool pose this step's frames were queried at
+  bool have_query_ = false;
+
+  std::atomic<std::uint64_t> updates_{0};
+  std::atomic<std::uint64_t> contact_updates_{0};
+  std::atomic<std::uint64_t> unsolved_{0};
+  std::atomic<std::uint64_t> capped_steps_{0};
+  std::atomic<std::int32_t> max_constraints_{0};
+  std::atomic<double> deepest_m_{0.0};
+  LatencyHistogram solve_time_;
+};
+
+}  // namespace uh::controllers

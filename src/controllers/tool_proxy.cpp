@@ -1,0 +1,202 @@
+#include "uh/controllers/tool_proxy.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "uh/forcecomp/virtual_coupling.hpp"
+
+namespace uh::controllers {
+namespace {
+
+// The tool's extent about its own origin: the farthest point of its root sphere [m].
+double tool_radius(const collette::SphereTree& tree) {
+  if (tree.empty()) return 0.01;
+  const collette::SphereTreeNode& root = tree.root();
+  const double r = norm(Vec3{root.x, root.y, root.z}) + static_cast<double>(root.radius);
+  return r > 0.0 ? r : 0.01;
+}
+
+Vec3 centre(const Sphere& s) { return {s.x, s.y, s.z}; }
+
+// The rotation of a rotation vector (axis times angle).
+Quat quat_from_rotation_vector(const Vec3& w) {
+  const double angle = norm(w);
+  return angle > 0.0 ? quat_from_axis_angle(w / angle, angle) : Quat{};
+}
+
+// The step from `from` to `target` as a translation t and a rotation vector w, shortened so that
+// no point of the tool moves farther than sqrt(2) * limit (|t| + R |w| <= sqrt(2) |(t, R w)|).
+// Returns |(t, R w)| before shortening.
+double wanted_step_of(const Pose& from, const Pose& target, double radius, double limit, Vec3& t, Vec3& w) {
+  t = target.position - from.position;
+  w = forcecomp::rotation_vector(target.rotation * conjugate(from.rotation));
+  const double length = std::sqrt(squared_norm(t) + radius * radius * squared_norm(w));
+  if (length > limit) {
+    t = t * (limit / length);
+    w = w * (limit / length);
+  }
+  return length;
+}
+
+void raise_max(std::atomic<double>& max, double value) {
+  if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
+}
+
+}  // namespace
+
+ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, const collette::SphereTree& tool_tree,
+                     const ToolProxyOptions& options, bool rotate)
+    : world_(&world),
+      tool_(tool),
+      options_(options),
+      solver_({.radius_m = tool_radius(tool_tree), .rotate = rotate}),
+      constraints_(static_cast<std::size_t>(std::max<std::int32_t>(options.max_constraints, 16))) {}
+
+void ToolProxy::bind() {
+  collision_connection_ = world_->on_collision().connect<&ToolProxy::on_collision>(*this);
+  step_connection_ = world_->on_step().connect<&ToolProxy::on_step>(*this);
+}
+
+bool ToolProxy::is_watched(std::int32_t object) const {
+  return std::find(watched_.begin(), watched_.end(), object) != watched_.end();
+}
+
+void ToolProxy::on_collision(collette::ObjectId, collette::ObjectId b, const ContactFrame& frame) {
+  if (b != tool_) return;
+  for (const ContactSection& section : frame.sections())
+    if (is_watched(section.object_a)) add_section(frame, section);
+}
+
+// Each leaf pair of the section becomes a constraint: the gap between its spheres (less what the
+// proxy may sink) may close, no more, along the line of their centres.
+void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& section) {
+  queried_ = section.world_from_b;
+  have_query_ = true;
+  const auto pairs = frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
+                                           static_cast<std::size_t>(section.pair_count));
+  const auto capacity = static_cast<std::int32_t>(constraints_.size());
+  for (const SpherePairContact& p : pairs) {
+    const Vec3 a = transform_point(section.world_from_a, centre(p.sphere_a_local));
+    const Vec3 b = transform_point(section.world_from_b, centre(p.sphere_b_local));
+    const double distance = norm(b - a);
+    const Vec3 n = distance > 1e-12 ? (b - a) / distance
+                                    : Vec3{p.normal_world[0], p.normal_world[1], p.normal_world[2]};
+    const double rb = static_cast<double>(p.sphere_b_local.radius);
+    const double gap =
+        distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
+    if (constraint_count_ == capacity) {
+      dropped_gap_m_ = std::min(dropped_gap_m_, gap);
+      continue;
+    }
+    constraints_[static_cast<std::size_t>(constraint_count_++)] = {
+        .normal = n, .lever = (b - rb * n) - section.world_from_b.position, .gap = gap};
+  }
+}
+
+// One god-object step from `from` towards `target`: the wanted step, shortened so that no point of
+// the tool moves farther than the pairs the step saw allow, projected onto the constraints.
+Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
+  const bool turns = solver_.options().rotate;
+  const double radius = solver_.options().radius_m;
+  const double reach = std::min(options_.step_m, std::max(dropped_gap_m_, 0.0));
+  const double limit = reach / std::sqrt(2.0);
+  Vec3 t, w;
+  const double length = wanted_step(from, target, limit, t, w);
+  // a point at lever r turns on an arc: it falls short of the chord's tangent by at most
+  // |w|^2 |r| / 2 <= |(t, R w)|^2 / (2 R)
+  const double arc = squared_norm(w) > 0.0 ? std::min(length, limit) * std::min(length, limit) / (2.0 * radius) : 0.0;
+  const std::span<forcecomp::ProxyConstraint> rows{constraints_.data(), static_cast<std::size_t>(constraint_count_)};
+  double deepest = 0.0;
+  for (forcecomp::ProxyConstraint& c : rows) {
+    deepest = std::max(deepest, -c.gap);
+    c.gap -= arc;
+  }
+  raise_max(deepest_m_, deepest);
+  forcecomp::ProxyStep step{.translation = t, .rotation = w};
+  if (!rows.empty()) {
+    const auto started = std::chrono::steady_clock::now();
+    step = solver_.solve(rows, t, w);
+    solve_time_.record(static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - started).count()));
+    if (!step.converged) unsolved_.fetch_add(1, std::memory_order_relaxed);
+    if (step.active > 0) contact_updates_.fetch_add(1, std::memory_order_relaxed);
+    // from too deep the projection may be longer than the bound: the rest waits for the next step
+    const double moved = std::sqrt(squared_norm(step.translation) + radius * radius * squared_norm(step.rotation));
+    if (moved > limit) {
+      step.translation = step.translation * (limit / moved);
+      step.rotation = step.rotation * (limit / moved);
+    }
+  }
+  const Quat turn = quat_from_rotation_vector(turns ? step.rotation : w);
+  Pose next;
+  next.position = from.position + step.translation;
+  next.rotation = normalized(turn * from.rotation);
+  // the constraints that hold it, carried to the new pose (met exactly there)
+  out.active = 0;
+  for (std::int32_t i = 0; i < step.active && !rows.empty(); ++i) {
+    const forcecomp::ProxyConstraint& c = rows[static_cast<std::size_t>(step.active_index[i])];
+    out.holding[out.active++] = {.normal = c.normal, .lever = rotate(turn, c.lever), .gap = 0.0};
+  }
+  out.reach_m = options_.step_m;
+  return next;
+}
+
+double ToolProxy::wanted_step(const Pose& from, const Pose& target, double limit, Vec3& t, Vec3& w) const {
+  return wanted_step_of(from, target, solver_.options().radius_m, limit, t, w);
+}
+
+Pose ToolProxy::slide(const ProxyState& state, const Pose& world_from_handle_tool) const {
+  Vec3 t, w;
+  wanted_step(state.world_from_proxy, world_from_handle_tool, state.reach_m / std::sqrt(2.0), t, w);
+  const forcecomp::ProxyStep step =
+      state.active > 0 ? solver_.solve({state.holding, static_cast<std::size_t>(state.active)}, t, w)
+                       : forcecomp::ProxyStep{.translation = t, .rotation = w};
+  Pose out;
+  out.position = state.world_from_proxy.position + step.translation;
+  out.rotation = normalized(quat_from_rotation_vector(step.rotation) * state.world_from_proxy.rotation);
+  return out;
+}
+
+void ToolProxy::on_step(double time_s) {
+  const bool fresh = target_.update();
+  if (!fresh && !placed_) return;
+  const Pose& target = target_.read_buffer();
+  if (constraint_count_ == static_cast<std::int32_t>(constraints_.size()))
+    capped_steps_.fetch_add(1, std::memory_order_relaxed);
+  ProxyState& out = state_.write_buffer();
+  out.active = 0;
+  out.reach_m = options_.step_m;
+  if (!placed_) {
+    proxy_ = target;  // the tool appears where the handle is, as without a proxy
+    placed_ = true;
+  } else {
+    proxy_ = advance(have_query_ ? queried_ : proxy_, target, out);
+  }
+  max_constraints_.store(std::max(max_constraints_.load(std::memory_order_relaxed), constraint_count_),
+                         std::memory_order_relaxed);
+  out.world_from_proxy = proxy_;
+  out.time_s = time_s;
+  out.constraints = constraint_count_;
+  state_.publish();
+  world_->set_pose(tool_, proxy_);
+  updates_.fetch_add(1, std::memory_order_relaxed);
+  constraint_count_ = 0;
+  dropped_gap_m_ = std::numeric_limits<double>::infinity();
+  have_query_ = false;
+}
+
+ToolProxyStats ToolProxy::stats() const {
+  ToolProxyStats s;
+  s.updates = updates_.load(std::memory_order_relaxed);
+  s.contact_updates = contact_updates_.load(std::memory_order_relaxed);
+  s.unsolved = unsolved_.load(std::memory_order_relaxed);
+  s.capped_steps = capped_steps_.load(std::memory_order_relaxed);
+  s.max_constraints = max_constraints_.load(std::memory_order_relaxed);
+  s.deepest_m = deepest_m_.load(std::memory_order_relaxed);
+  s.solve_time = solve_time_.summary();
+  return s;
+}
+
+}  // namespace uh::controllers

@@ -1,0 +1,215 @@
+// The god-object holds thin walls: a handle driven through a packed plate of 2-3 mm, flat or tilted,
+// slowly or farther than the plate's thickness in one collision step, leaves the proxy on the side
+// it came from, and the spring to the proxy pushes the handle back. The reference is the plate's
+// true geometry (a box), not the packing or the solver: the ball's centre never comes nearer the
+// plate's mid-plane than its radius plus half the thickness, less the packing's surface gap and the
+// allowed penetration; and, checked by brute force over every pair of spheres, no tool sphere
+// overlaps a plate sphere by more than the allowed penetration.
+#include "uh/controllers/tool_proxy.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "scene_test_support.hpp"
+#include "uh/collette/collision_world.hpp"
+#include "uh/controllers/haptic_session.hpp"
+#include "uh/collette/mesh_import.hpp"
+#include "uh/collette/sphere_packing.hpp"
+#include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/forcecomp/virtual_coupling.hpp"
+
+namespace uh::controllers {
+namespace {
+
+collette::TriangleMesh box_mesh(const Vec3& size) {
+  collette::TriangleMesh m;
+  m.source_name = "box";
+  for (const Vec3& v : std::initializer_list<Vec3>{
+           {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}})
+    m.vertices.push_back(Vec3{(v.x - 0.5) * size.x, (v.y - 0.5) * size.y, (v.z - 0.5) * size.z});
+  m.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                 {3, 7, 6}, {3, 6, 2}, {0, 4, 7}, {0, 7, 3}, {1, 2, 6}, {1, 6, 5}};
+  return m;
+}
+
+struct Packed {
+  std::shared_ptr<const collette::SphereTree> tree;
+  double max_gap = 0.0;  // the packing's largest distance from the mesh surface to its spheres [m]
+};
+
+Packed pack(const collette::TriangleMesh& mesh, std::int64_t spheres) {
+  auto valid = collette::validate_mesh(mesh);
+  EXPECT_TRUE(valid) << valid.error().message;
+  auto packing = collette::pack_spheres(*valid, {.target_sphere_count = spheres});
+  EXPECT_TRUE(packing) << packing.error().message;
+  auto tree = collette::build_sphere_tree(packing->spheres);
+  EXPECT_TRUE(tree) << tree.error().message;
+  return {std::make_shared<const collette::SphereTree>(std::move(tree).value()), packing->report.max_gap};
+}
+
+// The deepest overlap of any tool sphere with any plate sphere, by brute force [m].
+double deepest_overlap(const collette::SphereTree& plate, const Pose& world_from_plate,
+                       const collette::SphereTree& tool, const Pose& world_from_tool) {
+  double deepest = 0.0;
+  for (const Sphere& b : tool.leaves()) {
+    const Vec3 cb = transform_point(world_from_tool, Vec3{b.x, b.y, b.z});
+    for (const Sphere& a : plate.leaves()) {
+      const Vec3 ca = transform_point(world_from_plate, Vec3{a.x, a.y, a.z});
+      deepest = std::max(deepest, static_cast<double>(a.radius + b.radius) - norm(cb - ca));
+    }
+  }
+  return deepest;
+}
+
+struct WallRun {
+  double closest_m = 1e9;     // nearest the ball's centre came to the plate's mid-plane (signed, + on its side)
+  double deepest_m = 0.0;     // deepest sphere overlap seen (brute force, sampled steps)
+  double final_push_n = 0.0;  // the spring force on the handle along the plate's normal at the end
+};
+
+// Drives the handle along the plate's normal from 2 cm in front of it to `through` behind it at
+// `step_per_tick` per collision step, then holds it there; one world step per target.
+WallRun drive(const Packed& plate, const Pose& world_from_plate, const Packed& ball, double step_per_tick, double through, const ToolProxyOptions& options) {
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = options.step_m});
+  const auto plate_id = world.add_object({.tree = plate.tree, .world_from_object = world_from_plate, .is_static = true, .name = "plate"});
+  const auto tool_id = world.add_object({.tree = ball.tree, .has_initial_pose = false, .name = "ball"});
+  EXPECT_TRUE(plate_id && tool_id);
+  EXPECT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball.tree, options, true);
+  proxy.watch(*plate_id);
+  proxy.bind();
+  const Vec3 normal = rotate(world_from_plate.rotation, Vec3{0, 0, 1});
+  const Vec3 centre = world_from_plate.position;
+  WallRun run;
+  Pose handle{};
+  handle.rotation = world_from_plate.rotation;
+  double along = 0.02;
+  ProxyState state{};
+  const forcecomp::VirtualCoupling spring({.stiffness = 1500.0});
+  for (int i = 0; i < 2000; ++i) {
+    along = std::max(along - step_per_tick, -through);
+    handle.position = centre + along * normal;
+    proxy.set_target(handle);
+    world.step(1e-3 * i);
+    if (const ProxyState* s = proxy.take()) state = *s;
+    const double height = dot(state.world_from_proxy.position - centre, normal);
+    run.closest_m = std::min(run.closest_m, height);
+    if (i % 97 == 0 || i == 1999)
+      run.deepest_m = std::max(run.deepest_m, deepest_overlap(*plate.tree, world_from_plate, *ball.tree,
+                                                              state.world_from_proxy));
+  }
+  const Pose slid = proxy.slide(state, handle);
+  run.final_push_n = dot(spring.stiffness() * (slid.position - handle.position), normal);
+  return run;
+}
+
+class ThinWall : public ::testing::TestWithParam<double> {};
+
+TEST_P(ThinWall, HoldsTheToolOnTheSideItCameFrom) {
+  const double thickness = GetParam();
+  const Packed plate = pack(box_mesh({0.06, 0.06, thickness}), 10000);
+  constexpr double kRadius = 0.005;  // a 1 cm ball, packed
+  // the ball as one sphere: a packing of a ball has it at its core, and its small spheres only add
+  const auto ball_tree = collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, static_cast<float>(kRadius)}});
+  ASSERT_TRUE(ball_tree);
+  const Packed ball{std::make_shared<const collette::SphereTree>(*ball_tree), 0.0};
+  const ToolProxyOptions options{.enabled = true, .step_m = 0.002, .penetration_m = 0.0001};
+  for (const double tilt_deg : {0.0, 35.0, 80.0}) {
+    Pose world_from_plate;
+    world_from_plate.position = {0.01, -0.02, 0.1};
+    world_from_plate.rotation = quat_from_axis_angle(normalized(Vec3{1, 0.3, 0}), tilt_deg * kPi / 180.0);
+    // a hand at 5 cm/s and one that moves 1 cm (more than the plate is thick) per step
+    for (const double per_step : {0.00005, 0.01}) {
+      const WallRun run = drive(plate, world_from_plate, ball, per_step, 0.03, options);
+      const double floor = thickness / 2 + kRadius - plate.max_gap - options.penetration_m - 1e-5;
+      EXPECT_GT(run.closest_m, floor) << thickness * 1e3 << " mm plate at " << tilt_deg << " deg, " << per_step
+                                      << " m per step: the ball's centre came within " << run.closest_m * 1e3
+                                      << " mm of the mid-plane";
+      EXPECT_LT(run.deepest_m, options.penetration_m + 1e-5) << thickness * 1e3 << " mm, " << tilt_deg << " deg";
+      // the handle is 3 cm behind the plate: the spring pushes it back out, far beyond a device's 8 N
+      EXPECT_GT(run.final_push_n, 8.0) << thickness * 1e3 << " mm, " << tilt_deg << " deg";
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(TwoAndThreeMillimetres, ThinWall, ::testing::Values(0.002, 0.003));
+
+TEST(ToolProxy, SlidesAlongAFaceItIsPressedInto) {
+  const Packed plate = pack(box_mesh({0.06, 0.06, 0.003}), 10000);
+  const auto ball_tree = collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}});
+  ASSERT_TRUE(ball_tree);
+  const auto ball = std::make_shared<const collette::SphereTree>(*ball_tree);
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  const auto plate_id = world.add_object({.tree = plate.tree, .is_static = true, .name = "plate"});
+  const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
+  ASSERT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball, {.enabled = true}, true);
+  proxy.watch(*plate_id);
+  proxy.bind();
+  Pose handle;
+  ProxyState state{};
+  // press 5 mm into the face, then slide 2 cm along it at 2 cm/s
+  for (int i = 0; i < 1500; ++i) {
+    const double x = i < 500 ? 0.0 : std::min(0.02, 0.00002 * (i - 500));
+    handle.position = {x - 0.01, 0.0, std::max(0.02 - 0.00005 * i, 0.0015)};
+    proxy.set_target(handle);
+    world.step(1e-3 * i);
+    if (const ProxyState* s = proxy.take()) state = *s;
+    EXPECT_GT(state.world_from_proxy.position.z, 0.0015 + 0.005 - plate.max_gap - 0.0002) << "step " << i;
+  }
+  // it followed the handle 2 cm along the face, held on it (within the packing's grain, which
+  // tilts the face the proxy rests on by a few degrees: issue 23's smoothing is not in yet)
+  EXPECT_NEAR(state.world_from_proxy.position.x, handle.position.x, 5e-4);
+  EXPECT_GT(state.active, 0);
+  EXPECT_GT(proxy.stats().contact_updates, 500u);
+  EXPECT_EQ(proxy.stats().unsolved, 0u);
+}
+
+// The whole session (scenes/thin_wall.json): a simulated hand pulls the 1 cm ball 3 cm through a
+// 3 mm plate tilted 20 degrees with up to 8 N. Through the proxy the ball stays on its side and the
+// hand is held with the hand's whole pull; the penalty path, run on the same scene, lets it through
+// (what the test would see if the proxy did not hold).
+struct ThinWallRun {
+  double closest_m = 1e9;  // the ball's centre nearest the plate's mid-plane, along its normal [m]
+  double handle_closest_m = 1e9;
+  double held_force_n = 0.0;  // the force along the normal from 2.5 to 2.9 s, smallest [N]
+};
+
+ThinWallRun run_thin_wall(bool proxy, const std::filesystem::path& cache) {
+  auto scene = load_scene(testing::test_assets().parent_path() / "scenes" / "thin_wall.json");
+  EXPECT_TRUE(scene) << scene.error().message;
+  scene->force.proxy.enabled = proxy;
+  SessionOptions options;
+  options.cache_dir = cache;
+  auto session = HapticSession::create(*scene, options);
+  EXPECT_TRUE(session) << session.error().message;
+  const Vec3 normal = rotate(scene->objects.front().pose.rotation, Vec3{0, 0, 1});
+  ThinWallRun run;
+  run.held_force_n = 1e9;
+  auto seen = (*session)->on_haptic_tick().connect([&](const SessionState& s) {
+    run.closest_m = std::min(run.closest_m, dot(s.tool_position_world, normal));
+    run.handle_closest_m = std::min(run.handle_closest_m, dot(s.handle_position_world, normal));
+    if (s.time_s > 2.5 && s.time_s < 2.9) run.held_force_n = std::min(run.held_force_n, dot(s.force_world, normal));
+  });
+  EXPECT_TRUE((*session)->run_stepped(3.0, 1).has_value());
+  return run;
+}
+
+TEST(ToolProxy, TheThinWallSceneHoldsTheHandWhereThePenaltyPathLetsItThrough) {
+  const std::filesystem::path cache = testing::fresh_cache("thin_wall");
+  const ThinWallRun held = run_thin_wall(true, cache);
+  // the ball (radius 5 mm) on the plate (half thickness 1.5 mm): its centre 6.5 mm from the
+  // mid-plane, less the packing's surface gap (under 1 mm at 10,000 spheres)
+  EXPECT_GT(held.closest_m, 0.0055);
+  EXPECT_LT(held.handle_closest_m, 0.004);  // the hand did push into the plate
+  EXPECT_GT(held.held_force_n, 6.0);        // and is held with its pull (up to the 8 N limit)
+  const ThinWallRun through = run_thin_wall(false, cache);
+  EXPECT_LT(through.closest_m, -0.02);  // the penalty path: the ball ends behind the plate
+  std::filesystem::remove_all(cache);
+}
+
+}  // namespace
+}  // namespace uh::controllers
