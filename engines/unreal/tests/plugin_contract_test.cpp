@@ -106,17 +106,14 @@ std::vector<std::filesystem::path> cached_cubes(const std::filesystem::path& cac
   return out;
 }
 
-void count_tick(void* user, const FUhTickState& state) {
-  if (state.HapticTicks > 0) static_cast<std::atomic<int>*>(user)->fetch_add(1, std::memory_order_relaxed);
-}
-
-// what AHapticManager's hook table does on the haptic thread
-struct Hooks {
-  std::atomic<int> ticks{0};
-  static void on_tick(void* user, const uh_state* state) {
-    FUhTickState converted;
-    UhToTickState(*state, converted);
-    count_tick(&static_cast<Hooks*>(user)->ticks, converted);
+// a native hook as a game's code adds it: counts the ticks it saw and keeps the newest tick count
+struct TickCounter {
+  std::atomic<int> calls{0};
+  std::atomic<uint64> newest_tick{0};
+  static void on_tick(void* user, const FUhTickState& state) {
+    auto& self = *static_cast<TickCounter*>(user);
+    self.calls.fetch_add(1, std::memory_order_relaxed);
+    self.newest_tick.store(state.HapticTicks, std::memory_order_relaxed);
   }
 };
 
@@ -144,13 +141,22 @@ TEST(UnrealPluginContract, BuildsStartsPollsAndStopsTheLevelsSession) {
   EXPECT_TRUE(build.ObjectNames.Contains("bunny"));
   EXPECT_TRUE(build.ObjectNames.Contains("cube"));
 
-  Hooks hooks;
+  // AddHapticTickHook twice: both hooks are called on the haptic thread through UhDispatchTick
+  TickCounter first_hook, second_hook;
+  FUhHapticHookTable table;
+  table.Fns[0] = &TickCounter::on_tick;
+  table.Users[0] = &first_hook;
+  table.Fns[1] = &TickCounter::on_tick;
+  table.Users[1] = &second_hook;
+  table.Count = 2;
   FString error;
-  ASSERT_TRUE(UhStartSession(uh, build.Session, &Hooks::on_tick, &hooks, error)) << *error;
+  ASSERT_TRUE(UhStartSession(uh, build.Session, &UhDispatchTick, &table, error)) << *error;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (hooks.ticks.load() < 100 && std::chrono::steady_clock::now() < deadline)
+  while (second_hook.calls.load() < 100 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  EXPECT_GE(hooks.ticks.load(), 100);
+  EXPECT_GE(first_hook.calls.load(), 100);
+  EXPECT_GE(second_hook.calls.load(), 100);
+  EXPECT_GT(second_hook.newest_tick.load(), 0u);
 
   // the manager's Tick: the newest state and the event queue
   uh_state state{};

@@ -23,24 +23,24 @@ public:
 	AColletteStaticMeshActor();
 
 	/** Unset: the level's first HapticManager. */
-	UPROPERTY(EditAnywhere, Category = "Collette") TObjectPtr<AHapticManager> HapticManager;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette") TObjectPtr<AHapticManager> HapticManager;
 	/** A prebuilt .ist file (uh pack) instead of the static mesh, relative to the project folder. */
-	UPROPERTY(EditAnywhere, Category = "Collette", meta = (FilePathFilter = "Inner Sphere Tree (*.ist)|*.ist", RelativeToGameDir))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette", meta = (FilePathFilter = "Inner Sphere Tree (*.ist)|*.ist", RelativeToGameDir))
 	FFilePath IstFile;
 	/** A closed mesh file libuh packs (cached) instead of the static mesh, relative to the project folder. */
-	UPROPERTY(EditAnywhere, Category = "Collette", meta = (FilePathFilter = "Mesh (*.obj;*.stl;*.ply;*.off)|*.obj;*.stl;*.ply;*.off", RelativeToGameDir))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette", meta = (FilePathFilter = "Mesh (*.obj;*.stl;*.ply;*.off)|*.obj;*.stl;*.ply;*.off", RelativeToGameDir))
 	FFilePath MeshFile;
 	/** The mesh file's length unit. */
-	UPROPERTY(EditAnywhere, Category = "Collette", meta = (ClampMin = "0.000001", Units = "m"))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette", meta = (ClampMin = "0.000001", Units = "m"))
 	double MeshMetersPerUnit = 0.01;
 	/** Leaf spheres when packing the static mesh or the mesh file. */
-	UPROPERTY(EditAnywhere, Category = "Collette", meta = (ClampMin = "100", ClampMax = "1000000", UIMax = "100000"))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette", meta = (ClampMin = "100", ClampMax = "1000000", UIMax = "100000"))
 	int64 Spheres = 10000;
 	/** Collides with the tool (pushes back, reports contacts); off: the tool passes through it
 	 *  unless a ColletteVolume watches it. */
-	UPROPERTY(EditAnywhere, Category = "Collette") bool bWatch = true;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette") bool bWatch = true;
 	/** Send the actor's pose while the session runs (the object moves in the haptic scene). */
-	UPROPERTY(EditAnywhere, Category = "Collette") bool bFollowActor = true;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette") bool bFollowActor = true;
 
 	/** The object's name in libuh: the actor's name (unique in its level). */
 	FString ObjectName() const { return GetName(); }

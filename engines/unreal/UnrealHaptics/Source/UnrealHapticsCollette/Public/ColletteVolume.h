@@ -41,11 +41,11 @@ public:
 	AColletteVolume();
 
 	/** Unset: the level's first HapticManager. */
-	UPROPERTY(EditAnywhere, Category = "Collette") TObjectPtr<AHapticManager> HapticManager;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette") TObjectPtr<AHapticManager> HapticManager;
 	/** The tool's actor, passed as B in OnCollision. */
-	UPROPERTY(EditAnywhere, Category = "Collette") TObjectPtr<AActor> Tool;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette") TObjectPtr<AActor> Tool;
 	/** Objects watched against the tool from the start (as AddCollisionWatcher(Object, Tool)). */
-	UPROPERTY(EditAnywhere, Category = "Collette") TArray<TObjectPtr<AColletteStaticMeshActor>> WatchedObjects;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Collette") TArray<TObjectPtr<AColletteStaticMeshActor>> WatchedObjects;
 
 	/** Watches A (a ColletteStaticMeshActor) against B (the tool; may be null). In BeginPlay of any
 	 *  actor (before the manager's first Tick); later calls are logged and ignored. */

@@ -29,11 +29,11 @@ public:
 	AUnrealHapticsDemo();
 
 	/** What stands for the stylus (default: the engine's sphere). */
-	UPROPERTY(EditAnywhere, Category = "Demo") TObjectPtr<UStaticMesh> StylusMesh;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Demo") TObjectPtr<UStaticMesh> StylusMesh;
 	/** The stylus' scale (the engine's sphere is 1 m across). */
-	UPROPERTY(EditAnywhere, Category = "Demo", meta = (ClampMin = "0.001")) float StylusScale = 0.01f;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Demo", meta = (ClampMin = "0.001")) float StylusScale = 0.01f;
 	/** Print the force and the collision events on screen. */
-	UPROPERTY(EditAnywhere, Category = "Demo") bool bPrintOnScreen = true;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Demo") bool bPrintOnScreen = true;
 
 protected:
 	virtual void BeginPlay() override;

@@ -17,9 +17,9 @@ class UNREALHAPTICSFORCECOMP_API ABridgingController : public AActor
 
 public:
 	/** Unset: the level's first HapticManager. */
-	UPROPERTY(EditAnywhere, Category = "Haptics") TObjectPtr<AHapticManager> HapticManager;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics") TObjectPtr<AHapticManager> HapticManager;
 	/** The actor that follows the device (the stylus). */
-	UPROPERTY(EditAnywhere, Category = "Haptics") TObjectPtr<AActor> ToolActor;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics") TObjectPtr<AActor> ToolActor;
 
 protected:
 	virtual void BeginPlay() override;

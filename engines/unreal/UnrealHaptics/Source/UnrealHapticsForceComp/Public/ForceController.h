@@ -21,9 +21,9 @@ class UNREALHAPTICSFORCECOMP_API AForceController : public AActor
 
 public:
 	/** Unset: the level's first HapticManager. */
-	UPROPERTY(EditAnywhere, Category = "Haptics") TObjectPtr<AHapticManager> HapticManager;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics") TObjectPtr<AHapticManager> HapticManager;
 	/** The tool actor, whose ForceComponent sets the tool (none: the scene's tool is kept). */
-	UPROPERTY(EditAnywhere, Category = "Haptics") TObjectPtr<AActor> ToolActor;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics") TObjectPtr<AActor> ToolActor;
 
 	UPROPERTY(BlueprintAssignable, Category = "Haptics") FUhForceRendered ForceOnHapticTick;
 

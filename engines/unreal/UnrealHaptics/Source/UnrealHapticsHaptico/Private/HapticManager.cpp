@@ -65,12 +65,14 @@ bool AHapticManager::AddHapticTickHook(FUhHapticHookFn Fn, void* User)
 	{
 		return false;
 	}
-	if (HookTable.Count == MaxHapticTickHooks)
+	if (HookTable.Count == FUhHapticHookTable::Capacity)
 	{
-		UE_LOG(LogUnrealHaptics, Error, TEXT("%s: more than %d haptic tick hooks: refused"), *GetName(), MaxHapticTickHooks);
+		UE_LOG(LogUnrealHaptics, Error, TEXT("%s: more than %d haptic tick hooks: refused"), *GetName(), FUhHapticHookTable::Capacity);
 		return false;
 	}
-	HookTable.Hooks[HookTable.Count++] = FHook{Fn, User};
+	HookTable.Fns[HookTable.Count] = Fn;
+	HookTable.Users[HookTable.Count] = User;
+	++HookTable.Count;
 	return true;
 }
 
@@ -169,7 +171,7 @@ void AHapticManager::FinishBuild(FUhSessionBuild& Build)
 	Session = Build.Session;
 	SessionObjectNames = Build.ObjectNames;
 	FString Error;
-	if (!UhStartSession(*FUhApi::Get(), Session, &AHapticManager::OnHapticTick, &HookTable, Error))
+	if (!UhStartSession(*FUhApi::Get(), Session, &UhDispatchTick, &HookTable, Error))
 	{
 		CloseSession();
 		Fail(Error);
@@ -189,22 +191,6 @@ void AHapticManager::Fail(const FString& Message)
 	OnSessionFailed.Broadcast(Message);
 }
 
-// The haptic thread, after every tick: the native hooks only (fixed before start, real-time code).
-void AHapticManager::OnHapticTick(void* User, const uh_state* TickState)
-{
-	const FHookTable& Table = *static_cast<const FHookTable*>(User);
-	if (Table.Count == 0)
-	{
-		return;
-	}
-	FUhTickState Converted;
-	UhToTickState(*TickState, Converted);
-	for (int32 I = 0; I < Table.Count; ++I)
-	{
-		Table.Hooks[I].Fn(Table.Hooks[I].User, Converted);
-	}
-}
-
 void AHapticManager::Tick(float DeltaSeconds)
 {
 	Super::Tick(DeltaSeconds);
@@ -215,7 +201,7 @@ void AHapticManager::Tick(float DeltaSeconds)
 	if (State == EUhSessionState::Building && PendingBuild.IsReady())
 	{
 		const TSharedPtr<FUhSessionBuild> Build = PendingBuild.Get();
-		PendingBuild = {};
+		PendingBuild = TFuture<TSharedPtr<FUhSessionBuild>>();
 		FinishBuild(*Build);
 	}
 	if (State == EUhSessionState::Running)
@@ -294,7 +280,7 @@ void AHapticManager::DiscardPendingBuild()
 	}
 	UE_LOG(LogUnrealHaptics, Log, TEXT("%s: stopped while the session was built: waiting for the packing to finish"), *GetName());
 	const TSharedPtr<FUhSessionBuild> Build = PendingBuild.Get();
-	PendingBuild = {};
+	PendingBuild = TFuture<TSharedPtr<FUhSessionBuild>>();
 	OnPackingFinished.Broadcast();
 	if (const FUhApi* Api = FUhApi::Get(); Api != nullptr && Build->Session != nullptr)
 	{

@@ -245,6 +245,21 @@ void UhToTickState(const uh_state& In, FUhTickState& Out)
 	Out.Buttons = In.buttons;
 }
 
+void UhDispatchTick(void* User, const uh_state* State)
+{
+	const FUhHapticHookTable& Table = *static_cast<const FUhHapticHookTable*>(User);
+	if (Table.Count == 0)
+	{
+		return;
+	}
+	FUhTickState Converted;
+	UhToTickState(*State, Converted);
+	for (int32 I = 0; I < Table.Count; ++I)
+	{
+		Table.Fns[I](Table.Users[I], Converted);
+	}
+}
+
 FUhContact UhToContact(const uh_contact_event& In, const TArray<FString>& ObjectNames)
 {
 	FUhContact Out;

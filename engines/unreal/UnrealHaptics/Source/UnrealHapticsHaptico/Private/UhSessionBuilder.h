@@ -45,5 +45,9 @@ bool UhStartSession(const FUhApi& Api, uh_session* Session, uh_tick_fn Fn, void*
 /** libuh's state as the hooks see it (haptic thread: copies only). */
 void UhToTickState(const uh_state& In, FUhTickState& Out);
 
+/** The tick function the session is started with: `User` is an FUhHapticHookTable; calls each hook
+ *  with the converted state (haptic thread, real-time: no allocation, no locks). */
+void UhDispatchTick(void* User, const uh_state* State);
+
 /** A contact event with its object's name (game thread). */
 FUhContact UhToContact(const uh_contact_event& In, const TArray<FString>& ObjectNames);

@@ -24,7 +24,6 @@
 
 struct FUhSessionBuild;
 struct uh_session;
-struct uh_state;
 
 /** The newest haptic state in Unreal's frame (centimetres; force in newtons). */
 USTRUCT(BlueprintType)
@@ -79,9 +78,6 @@ class UNREALHAPTICSHAPTICO_API AHapticManager : public AActor
 	GENERATED_BODY()
 
 public:
-	/** Native hooks a manager holds at most (a fixed array: the haptic thread never sees it change). */
-	static constexpr int32 MaxHapticTickHooks = 8;
-
 	/** Whether some manager builds its session (packing); the editor module shows a notification. */
 	static FSimpleMulticastDelegate OnPackingStarted;
 	static FSimpleMulticastDelegate OnPackingFinished;
@@ -96,25 +92,25 @@ public:
 
 	/** A scene file (docs/scenes.md), relative to the project folder; empty: libuh's default scene
 	 *  (the bunny, a stylus on a simulated device). */
-	UPROPERTY(EditAnywhere, Category = "Haptics", meta = (FilePathFilter = "Scene (*.json)|*.json", RelativeToGameDir))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics", meta = (FilePathFilter = "Scene (*.json)|*.json", RelativeToGameDir))
 	FFilePath SceneFile;
 	/** Objects of the scene file that the level's ColletteStaticMeshActors replace (removed after
 	 *  those are added; a name the file lacks is logged and ignored). The default scene's object is "bunny". */
-	UPROPERTY(EditAnywhere, Category = "Haptics") TArray<FString> SceneObjectsToRemove;
-	UPROPERTY(EditAnywhere, Category = "Haptics", meta = (InlineEditConditionToggle)) bool bOverrideHapticRate = false;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics") TArray<FString> SceneObjectsToRemove;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics", meta = (InlineEditConditionToggle)) bool bOverrideHapticRate = false;
 	/** Haptic rate; unchecked: the scene's (1 kHz in the default scene). */
-	UPROPERTY(EditAnywhere, Category = "Haptics", meta = (EditCondition = "bOverrideHapticRate", ClampMin = "1", ClampMax = "10000", Units = "Hz"))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics", meta = (EditCondition = "bOverrideHapticRate", ClampMin = "1", ClampMax = "10000", Units = "Hz"))
 	double HapticHz = 1000.0;
-	UPROPERTY(EditAnywhere, Category = "Haptics", meta = (InlineEditConditionToggle)) bool bOverrideCollisionRate = false;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics", meta = (InlineEditConditionToggle)) bool bOverrideCollisionRate = false;
 	/** Collision rate (0: free-running); unchecked: the scene's. */
-	UPROPERTY(EditAnywhere, Category = "Haptics", meta = (EditCondition = "bOverrideCollisionRate", ClampMin = "0", ClampMax = "10000", Units = "Hz"))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics", meta = (EditCondition = "bOverrideCollisionRate", ClampMin = "0", ClampMax = "10000", Units = "Hz"))
 	double CollisionHz = 1000.0;
 	/** Ask for real-time scheduling of libuh's threads (Linux: SCHED_FIFO, needs the right to). */
-	UPROPERTY(EditAnywhere, Category = "Haptics", AdvancedDisplay) bool bRaisePriority = false;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics", AdvancedDisplay) bool bRaisePriority = false;
 	/** Draw the tool, the force and the contact pairs each frame (development builds). */
-	UPROPERTY(EditAnywhere, Category = "Haptics|Debug") bool bDrawDebug = false;
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics|Debug") bool bDrawDebug = false;
 	/** Length of the drawn force arrow per newton. */
-	UPROPERTY(EditAnywhere, Category = "Haptics|Debug", meta = (EditCondition = "bDrawDebug", ClampMin = "0", Units = "cm"))
+	UPROPERTY(EditAnywhere, BlueprintReadWrite, Category = "Haptics|Debug", meta = (EditCondition = "bDrawDebug", ClampMin = "0", Units = "cm"))
 	float DebugCentimetersPerNewton = 2.0f;
 
 	/** Game thread, once per frame with the newest state. */
@@ -140,7 +136,8 @@ public:
 	UFUNCTION(BlueprintCallable, Category = "Haptics") FString StopHaptics();
 
 	/** Game thread, before the session is built: a function called on the haptic thread after every
-	 *  tick. False (logged) when called later, off the game thread or when the array is full. */
+	 *  tick (at most FUhHapticHookTable::Capacity). False (logged) when called later, off the game
+	 *  thread or when the array is full. */
 	bool AddHapticTickHook(FUhHapticHookFn Fn, void* User);
 
 	/** Game thread, in BeginPlay: the level's parts. False (logged) once the session is being built. */
@@ -158,18 +155,6 @@ protected:
 	virtual void BeginDestroy() override;
 
 private:
-	struct FHook
-	{
-		FUhHapticHookFn Fn = nullptr;
-		void* User = nullptr;
-	};
-	// What the haptic thread reads: filled before start, read-only while the session runs.
-	struct FHookTable
-	{
-		FHook Hooks[MaxHapticTickHooks];
-		int32 Count = 0;
-	};
-
 	bool AcceptsRegistration(const TCHAR* What, const FString& Name) const;
 	void BeginBuild();
 	void FinishBuild(FUhSessionBuild& Build);
@@ -179,13 +164,12 @@ private:
 	void PollEvents();
 	void DrawDebug() const;
 	void CloseSession();
-	static void OnHapticTick(void* User, const uh_state* TickState);
 
 	TArray<FUhObjectSpec> Objects;
 	FUhToolSpec Tool;
 	bool bHasTool = false;
 	TArray<FString> Watched;
-	FHookTable HookTable;
+	FUhHapticHookTable HookTable;
 	TArray<FString> SessionObjectNames;
 	TFuture<TSharedPtr<FUhSessionBuild>> PendingBuild;  // shared: FUhSessionBuild is private to this module
 	uh_session* Session = nullptr;

@@ -52,6 +52,16 @@ struct FUhTickState
  *  Real-time code only: no allocation, no locks, no logging, no UObject access. */
 using FUhHapticHookFn = void (*)(void* User, const FUhTickState& State);
 
+/** The hooks the haptic thread calls: a fixed array, filled on the game thread before the session
+ *  starts and read-only while it runs (the thread's start orders the writes before its reads). */
+struct FUhHapticHookTable
+{
+	static constexpr int32 Capacity = 8;
+	FUhHapticHookFn Fns[Capacity] = {};
+	void* Users[Capacity] = {};
+	int32 Count = 0;
+};
+
 /** A contact of the tool with a watched object began or ended (game thread, from the event queue). */
 struct FUhContact
 {
