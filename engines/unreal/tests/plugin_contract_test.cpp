@@ -201,6 +201,31 @@ TEST(UnrealPluginContract, CachesAStaticMeshsPackingAndRepacksADamagedOne) {
   EXPECT_GT(std::filesystem::file_size(cached[0]), 100u);  // packed again and saved over the damaged file
 }
 
+TEST(UnrealPluginContract, RemovesTheScenesObjectsTheLevelReplacesAndOverridesTheRate) {
+  const FUhApi& uh = api();
+  FUhSessionRequest request = level_request(cache_dir());
+  request.SceneObjectsToRemove = TArray<FString>{"bunny"};
+  request.HapticHz = 2000.0;  // the manager's override (0: the scene's 1000 Hz)
+  FUhSessionBuild build = UhBuildSession(uh, request);
+  ASSERT_NE(build.Session, nullptr) << *build.Error;
+  EXPECT_EQ(build.Warnings.Num(), 1);  // the tool without a mesh only
+  ASSERT_EQ(build.ObjectNames.Num(), 1);
+  EXPECT_TRUE(build.ObjectNames[0] == FString("cube"));
+  FUhHapticHookTable no_hooks;
+  FString error;
+  ASSERT_TRUE(UhStartSession(uh, build.Session, &UhDispatchTick, &no_hooks, error)) << *error;
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_EQ(uh.uh_session_stop(build.Session), UH_OK) << *uh.LastError();
+  const char* report = nullptr;
+  ASSERT_EQ(uh.uh_session_report_json(build.Session, &report), UH_OK);
+  std::string text;  // the report without its indentation
+  for (const char* c = report; *c != '\0'; ++c)
+    if (*c != ' ' && *c != '\n') text += *c;
+  // the haptic target rate (the collision one stays the scene's 1000 Hz)
+  EXPECT_NE(text.find("\"target_hz\":2000"), std::string::npos) << text;
+  uh.uh_session_close(build.Session);
+}
+
 TEST(UnrealPluginContract, AFailedBuildNamesTheCallAndTheFile) {
   FUhSessionRequest request;
   request.ScenePath = "/nonexistent/level-scene.json";
