@@ -63,7 +63,9 @@ const FUhApi& api() {
 
 // the packing cache, kept between runs (the default scene's meshes take seconds to pack)
 std::filesystem::path cache_dir() {
-  const std::filesystem::path dir = std::filesystem::path(std::getenv("UH_TEST_TMP")) / "cache";
+  const char* tmp = std::getenv("UH_TEST_TMP");  // set by ctest: the test's build folder
+  const std::filesystem::path dir =
+      (tmp != nullptr ? std::filesystem::path(tmp) : std::filesystem::temp_directory_path()) / "unreal-contract-cache";
   std::filesystem::create_directories(dir);
   return dir;
 }
