@@ -18,6 +18,7 @@ AHapticManager::AHapticManager()
 {
 	PrimaryActorTick.bCanEverTick = true;
 	PrimaryActorTick.TickGroup = TG_PrePhysics;
+	PrimaryActorTick.bTickEvenWhenPaused = true;  // libuh's threads run on while the game is paused
 }
 
 AHapticManager* AHapticManager::FindIn(UWorld* World)
