@@ -72,6 +72,7 @@ struct RunArgs {
   double coherence_skin = -1.0;
   bool held_forces = false;
   bool exact_tick = false;
+  std::string proxy;  // "on", "off" or "" (the scene's)
   bool check_model = false;
   bool stepped = false;
   int ticks_per_collision = 4;
@@ -98,12 +99,20 @@ void print_tool_summary(const controllers::ToolReport& r, bool stepped, const st
   std::printf(
       "  force     max %.2f N, torque max %.3f N m, largest tick-to-tick step %.3f N (%s), %llu non-finite\n",
       r.force_max_n, r.torque_max_nm, r.force_max_step_n,
-      !r.multi_rate ? "held forces" : (r.tick_force == "model" ? "local model" : "every pair re-evaluated"),
+      r.proxy ? "proxy" : !r.multi_rate ? "held forces" : (r.tick_force == "model" ? "local model" : "every pair re-evaluated"),
       static_cast<unsigned long long>(r.force_nonfinite));
   if (!stepped)
     std::printf("  tick      p50 %.1f us, p99 %.1f us, max %.1f us\n", r.tick_p50_us, r.tick_p99_us,
                 r.tick_max_us);
-  if (r.multi_rate && r.tick_force == "model")
+  if (r.proxy)
+    std::printf("  proxy     %llu updates, %llu in contact, %llu unsolved, up to %d constraints, solve p50 %.1f us, "
+                "p99 %.1f us, deepest %.3f mm, ended at (%.4f, %.4f, %.4f) m\n",
+                static_cast<unsigned long long>(r.proxy_stats.updates),
+                static_cast<unsigned long long>(r.proxy_stats.contact_updates),
+                static_cast<unsigned long long>(r.proxy_stats.unsolved), r.proxy_stats.max_constraints,
+                r.proxy_stats.solve_time.p50_ns * 1e-3, r.proxy_stats.solve_time.p99_ns * 1e-3,
+                r.proxy_stats.deepest_m * 1e3, r.proxy_position.x, r.proxy_position.y, r.proxy_position.z);
+  else if (r.multi_rate && r.tick_force == "model")
     std::printf("  model     %llu ticks beyond the trust range, %llu holding%s\n",
                 static_cast<unsigned long long>(r.model_clamped_ticks),
                 static_cast<unsigned long long>(r.model_held_ticks),
@@ -157,6 +166,7 @@ int run_session(const RunArgs& args) {
   if (args.coherence_skin >= 0.0) options.coherence_skin = args.coherence_skin;
   if (args.held_forces) options.multi_rate = false;
   if (args.exact_tick) options.tick_force = controllers::TickForce::kExact;
+  if (!args.proxy.empty()) options.proxy = args.proxy == "on";
   options.check_model = args.check_model;
   options.raise_priority = !args.no_realtime;
   options.cache_dir = cache;
@@ -250,6 +260,8 @@ void add_run_command(CLI::App& app, CommandRunner& runner) {
   r->add_option("--coherence-skin", args.coherence_skin,
                 "override the volume query's frame-to-frame coherence skin [m] (0 = traverse every step)")
       ->check(CLI::Range(0.0, 1.0));
+  r->add_option("--proxy", args.proxy, "render through the 6-DOF proxy (on) or the penalty path (off), whatever the scene says")
+      ->check(CLI::IsMember({"on", "off"}));
   auto* held_flag = r->add_flag("--held-forces", args.held_forces,
                                 "hold each collision frame's force until the next frame");
   auto* exact_flag =

@@ -100,6 +100,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
   if (options.tick_force) force_options.tick_force = *options.tick_force;
   force_options.check_model = options.check_model;
+  if (options.proxy) force_options.proxy.enabled = *options.proxy;
+  if (force_options.proxy.enabled) force_options.use_coupling = false;  // the proxy is the simulated tool
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
 
@@ -599,7 +601,10 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     t.model_error_max_n = fc.model_error_max_n;
     t.coupling = fcon.options().use_coupling;
     t.proxy = rig->proxy != nullptr;
-    if (rig->proxy) t.proxy_stats = rig->proxy->stats();
+    if (rig->proxy) {
+      t.proxy_stats = rig->proxy->stats();
+      t.proxy_position = rig->proxy->pose().position;
+    }
   }
   const collette::CollisionWorldStats ws = world_->stats();
   r.collision_target_hz = collision_hz_;
@@ -645,8 +650,10 @@ nlohmann::json proxy_report_json(const ToolReport& r) {
           {"contact_updates", p.contact_updates},
           {"unsolved", p.unsolved},
           {"capped_steps", p.capped_steps},
+          {"free_updates", p.free_updates},
           {"max_constraints", p.max_constraints},
           {"deepest_m", p.deepest_m},
+          {"position", {r.proxy_position.x, r.proxy_position.y, r.proxy_position.z}},
           {"solve_us", {{"p50", p.solve_time.p50_ns * 1e-3}, {"p99", p.solve_time.p99_ns * 1e-3},
                         {"max", p.solve_time.max_ns * 1e-3}}}};
 }

@@ -51,7 +51,10 @@ ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, c
     : world_(&world),
       tool_(tool),
       options_(options),
-      solver_({.radius_m = tool_radius(tool_tree), .rotate = rotate}),
+      solver_({.radius_m = tool_radius(tool_tree),
+               .rotate = rotate,
+               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16)}),
+      slide_solver_({.radius_m = tool_radius(tool_tree), .rotate = rotate, .max_constraints = 6}),
       constraints_(static_cast<std::size_t>(std::max<std::int32_t>(options.max_constraints, 16))) {}
 
 void ToolProxy::bind() {
@@ -86,12 +89,23 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
     const double rb = static_cast<double>(p.sphere_b_local.radius);
     const double gap =
         distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
-    if (constraint_count_ == capacity) {
+    const forcecomp::ProxyConstraint c{.normal = n, .lever = (b - rb * n) - section.world_from_b.position, .gap = gap};
+    // beyond the capacity the nearest pairs are kept (a heap on the gap, largest on top); the step
+    // shrinks to the smallest gap left out
+    const auto by_gap = [](const forcecomp::ProxyConstraint& x, const forcecomp::ProxyConstraint& y) {
+      return x.gap < y.gap;
+    };
+    if (constraint_count_ < capacity) {
+      constraints_[static_cast<std::size_t>(constraint_count_++)] = c;
+      std::push_heap(constraints_.begin(), constraints_.begin() + constraint_count_, by_gap);
+    } else if (gap < constraints_.front().gap) {
+      dropped_gap_m_ = std::min(dropped_gap_m_, constraints_.front().gap);
+      std::pop_heap(constraints_.begin(), constraints_.end(), by_gap);
+      constraints_.back() = c;
+      std::push_heap(constraints_.begin(), constraints_.end(), by_gap);
+    } else {
       dropped_gap_m_ = std::min(dropped_gap_m_, gap);
-      continue;
     }
-    constraints_[static_cast<std::size_t>(constraint_count_++)] = {
-        .normal = n, .lever = (b - rb * n) - section.world_from_b.position, .gap = gap};
   }
 }
 
@@ -107,13 +121,21 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   // a point at lever r turns on an arc: it falls short of the chord's tangent by at most
   // |w|^2 |r| / 2 <= |(t, R w)|^2 / (2 R)
   const double arc = squared_norm(w) > 0.0 ? std::min(length, limit) * std::min(length, limit) / (2.0 * radius) : 0.0;
-  const std::span<forcecomp::ProxyConstraint> rows{constraints_.data(), static_cast<std::size_t>(constraint_count_)};
+  // the step moves no point farther than sqrt(2) |(t, R w)| (a projection onto constraints that the
+  // step 0 meets is no longer than what it projects), so a pair with a larger gap cannot bind:
+  // only the others go to the solver (a hand moving slowly sees a few of the margin's pairs)
   double deepest = 0.0;
-  for (forcecomp::ProxyConstraint& c : rows) {
-    deepest = std::max(deepest, -c.gap);
-    c.gap -= arc;
-  }
+  for (std::int32_t k = 0; k < constraint_count_; ++k)
+    deepest = std::max(deepest, -constraints_[static_cast<std::size_t>(k)].gap);
   raise_max(deepest_m_, deepest);
+  const double moves = deepest > 0.0 ? reach : std::sqrt(2.0) * std::min(length, limit);
+  std::int32_t kept = 0;
+  for (std::int32_t k = 0; k < constraint_count_; ++k) {
+    forcecomp::ProxyConstraint c = constraints_[static_cast<std::size_t>(k)];
+    c.gap -= arc;
+    if (c.gap < moves) constraints_[static_cast<std::size_t>(kept++)] = c;
+  }
+  const std::span<forcecomp::ProxyConstraint> rows{constraints_.data(), static_cast<std::size_t>(kept)};
   forcecomp::ProxyStep step{.translation = t, .rotation = w};
   if (!rows.empty()) {
     const auto started = std::chrono::steady_clock::now();
@@ -147,11 +169,11 @@ double ToolProxy::wanted_step(const Pose& from, const Pose& target, double limit
   return wanted_step_of(from, target, solver_.options().radius_m, limit, t, w);
 }
 
-Pose ToolProxy::slide(const ProxyState& state, const Pose& world_from_handle_tool) const {
+Pose ToolProxy::slide(const ProxyState& state, const Pose& world_from_handle_tool) {
   Vec3 t, w;
   wanted_step(state.world_from_proxy, world_from_handle_tool, state.reach_m / std::sqrt(2.0), t, w);
   const forcecomp::ProxyStep step =
-      state.active > 0 ? solver_.solve({state.holding, static_cast<std::size_t>(state.active)}, t, w)
+      state.active > 0 ? slide_solver_.solve({state.holding, static_cast<std::size_t>(state.active)}, t, w)
                        : forcecomp::ProxyStep{.translation = t, .rotation = w};
   Pose out;
   out.position = state.world_from_proxy.position + step.translation;
@@ -168,10 +190,17 @@ void ToolProxy::on_step(double time_s) {
   ProxyState& out = state_.write_buffer();
   out.active = 0;
   out.reach_m = options_.step_m;
-  if (!placed_) {
-    proxy_ = target;  // the tool appears where the handle is, as without a proxy
+  // the tool appears where the handle is, as without a proxy; if that is inside an object it has no
+  // side to keep, so it follows the handle freely (zero force) until it is out of every object
+  bool inside = false;
+  for (std::int32_t k = 0; k < constraint_count_ && !seated_; ++k)
+    inside |= constraints_[static_cast<std::size_t>(k)].gap < 0.0;
+  if (!placed_ || (!seated_ && inside)) {
+    proxy_ = target;
+    if (placed_) free_updates_.fetch_add(1, std::memory_order_relaxed);
     placed_ = true;
   } else {
+    seated_ = true;
     proxy_ = advance(have_query_ ? queried_ : proxy_, target, out);
   }
   max_constraints_.store(std::max(max_constraints_.load(std::memory_order_relaxed), constraint_count_),
@@ -193,6 +222,7 @@ ToolProxyStats ToolProxy::stats() const {
   s.contact_updates = contact_updates_.load(std::memory_order_relaxed);
   s.unsolved = unsolved_.load(std::memory_order_relaxed);
   s.capped_steps = capped_steps_.load(std::memory_order_relaxed);
+  s.free_updates = free_updates_.load(std::memory_order_relaxed);
   s.max_constraints = max_constraints_.load(std::memory_order_relaxed);
   s.deepest_m = deepest_m_.load(std::memory_order_relaxed);
   s.solve_time = solve_time_.summary();

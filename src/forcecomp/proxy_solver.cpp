@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -89,18 +90,17 @@ struct ActiveSet {
   }
 };
 
-// The most violated constraint at y (by its distance, not its row's length), or -1.
-std::int32_t most_violated(std::span<const ProxyConstraint> constraints, const Scaled& scaled, const Vec6& y,
-                           double tolerance, const ActiveSet& active) {
+constexpr std::size_t kRowStride = 7;  // a scaled row: a (6, unit length) and its bound b
+
+// The most violated constraint at y (by its distance: the rows have unit length), or -1.
+std::int32_t most_violated(const double* rows, std::size_t count, int dim, const Vec6& y, double tolerance,
+                           const ActiveSet& active) {
   std::int32_t worst = -1;
   double worst_distance = -tolerance;
-  for (std::size_t k = 0; k < constraints.size(); ++k) {
-    Vec6 a;
-    double b;
-    scaled.row(constraints[k], a, b);
-    const double length = std::sqrt(dot(a, a, scaled.dim));
-    if (!(length > 0.0)) continue;
-    const double distance = (dot(a, y, scaled.dim) - b) / length;
+  for (std::size_t k = 0; k < count; ++k) {
+    const double* r = rows + k * kRowStride;
+    double distance = -r[6];
+    for (int d = 0; d < dim; ++d) distance += r[d] * y[static_cast<std::size_t>(d)];
     if (distance < worst_distance) {
       bool is_active = false;
       for (int i = 0; i < active.count; ++i) is_active |= active.index[static_cast<std::size_t>(i)] == static_cast<std::int32_t>(k);
@@ -114,8 +114,11 @@ std::int32_t most_violated(std::span<const ProxyConstraint> constraints, const S
 
 }  // namespace
 
+ProxySolver::ProxySolver(const ProxySolverOptions& options)
+    : options_(options), rows_(kRowStride * static_cast<std::size_t>(std::max<std::int32_t>(options.max_constraints, 1))) {}
+
 ProxyStep ProxySolver::solve(std::span<const ProxyConstraint> constraints, const Vec3& wanted_translation,
-                             const Vec3& wanted_rotation) const {
+                             const Vec3& wanted_rotation) {
   Scaled scaled;
   scaled.dim = options_.rotate ? 6 : 3;
   scaled.radius = options_.radius_m > 0.0 ? options_.radius_m : 1.0;
@@ -126,17 +129,31 @@ ProxyStep ProxySolver::solve(std::span<const ProxyConstraint> constraints, const
   ActiveSet active;
   ProxyStep out;
   const double tolerance = options_.tolerance_m;
+  // every row scaled once, to unit length, so that a scan is a dot product per row
+  assert(constraints.size() * kRowStride <= rows_.size() && "uh::forcecomp::ProxySolver::solve(): more constraints than max_constraints");
+  const std::size_t count = std::min(constraints.size(), rows_.size() / kRowStride);
+  for (std::size_t k = 0; k < count; ++k) {
+    Vec6 a;
+    double b;
+    scaled.row(constraints[k], a, b);
+    const double length = std::sqrt(dot(a, a, dim));
+    double* r = rows_.data() + k * kRowStride;
+    const double inverse = length > 0.0 ? 1.0 / length : 0.0;
+    for (int d = 0; d < kMaxDim; ++d) r[d] = a[static_cast<std::size_t>(d)] * inverse;
+    r[6] = length > 0.0 ? b * inverse : -kInfinity;  // a zero row is always met
+  }
 
-  std::int32_t p = most_violated(constraints, scaled, y, tolerance, active);
+  std::int32_t p = most_violated(rows_.data(), count, dim, y, tolerance, active);
   double multiplier_p = 0.0;
   while (p >= 0) {
     if (out.iterations++ >= options_.max_iterations) {
       out.converged = false;
       break;
     }
+    const double* row = rows_.data() + static_cast<std::size_t>(p) * kRowStride;
     Vec6 a;
-    double b;
-    scaled.row(constraints[static_cast<std::size_t>(p)], a, b);
+    for (int d = 0; d < kMaxDim; ++d) a[static_cast<std::size_t>(d)] = row[d];
+    const double b = row[6];
     // z: the part of a_p that the active rows leave free; r: how their multipliers trade against p's
     const auto r = active.solve_gram(a, dim);
     Vec6 z = a;
@@ -174,7 +191,7 @@ ProxyStep ProxySolver::solve(std::span<const ProxyConstraint> constraints, const
         active.factor(dim);
       }
       multiplier_p = 0.0;
-      p = most_violated(constraints, scaled, y, tolerance, active);
+      p = most_violated(rows_.data(), count, dim, y, tolerance, active);
     } else {
       active.drop(blocking, dim);  // its multiplier reached zero: it no longer holds the step
     }

@@ -78,7 +78,7 @@ TEST(ProxySolver, MatchesTheBruteForceActiveSetOnRandomProblems) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double radius = 0.01;
-  const ProxySolver solver({.radius_m = radius});
+  ProxySolver solver({.radius_m = radius});
   int constrained = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const int n = 1 + trial % 10;
@@ -111,7 +111,7 @@ TEST(ProxySolver, StartsFromTooDeepAndPushesOut) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double radius = 0.02;
-  const ProxySolver solver({.radius_m = radius});
+  ProxySolver solver({.radius_m = radius});
   for (int trial = 0; trial < 100; ++trial) {
     std::vector<ProxyConstraint> cs;
     for (int k = 0; k < 4; ++k)
@@ -138,7 +138,7 @@ TEST(ProxySolver, AFlatFloorStopsTheFallAndLetsItSlide) {
   for (int i = 0; i < 200; ++i)
     cs.push_back({.normal = {0, 0, 1}, .lever = {0.001 * (i % 10) - 0.005, 0.001 * (i / 10 % 10) - 0.005, -0.005},
                   .gap = 0.0002});
-  const ProxySolver solver({.radius_m = 0.005});
+  ProxySolver solver({.radius_m = 0.005});
   const ProxyStep step = solver.solve(cs, {0.001, -0.0005, -0.01}, {});
   ASSERT_TRUE(step.converged);
   EXPECT_NEAR(step.translation.z, -0.0002, 1e-12);
@@ -151,7 +151,7 @@ TEST(ProxySolver, AFlatFloorStopsTheFallAndLetsItSlide) {
 
 TEST(ProxySolver, FixedRotationConstrainsTheTranslationOnly) {
   const ProxyConstraint c{.normal = {0, 0, 1}, .lever = {0.01, 0, 0}, .gap = 0.0};
-  const ProxySolver solver({.radius_m = 0.01, .rotate = false});
+  ProxySolver solver({.radius_m = 0.01, .rotate = false});
   const Vec3 w{0, 0.1, 0};  // turning about y lowers the contact point at +x by 0.01 * 0.1
   const ProxyStep step = solver.solve({&c, 1}, {0, 0, 0}, w);
   EXPECT_EQ(step.rotation.y, 0.1);
@@ -162,7 +162,7 @@ TEST(ProxySolver, OpposedFacesTooDeepAreReportedNotSolved) {
   // pinched between two faces, each already 1 mm too deep: no step meets both
   const ProxyConstraint cs[2] = {{.normal = {0, 0, 1}, .lever = {}, .gap = -0.001},
                                  {.normal = {0, 0, -1}, .lever = {}, .gap = -0.001}};
-  const ProxySolver solver({.radius_m = 0.01, .rotate = false});
+  ProxySolver solver({.radius_m = 0.01, .rotate = false});
   const ProxyStep step = solver.solve(cs, {}, {});
   EXPECT_FALSE(step.converged);
   EXPECT_TRUE(is_finite(step.translation));
@@ -172,7 +172,7 @@ TEST(ProxySolver, SolveDoesNotAllocate) {
   std::vector<ProxyConstraint> cs;
   std::mt19937 rng(3);
   for (int i = 0; i < 500; ++i) cs.push_back({.normal = random_unit(rng), .lever = {0.001, 0.002, 0.0}, .gap = 0.001});
-  const ProxySolver solver({.radius_m = 0.01});
+  ProxySolver solver({.radius_m = 0.01});
   const test::AllocationCounter allocations;
   const ProxyStep step = solver.solve(cs, {0.01, 0.0, -0.01}, {0.1, 0.0, 0.0});
   EXPECT_EQ(allocations.count(), 0u);

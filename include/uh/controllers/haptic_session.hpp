@@ -39,6 +39,9 @@ struct SessionOptions {
   std::optional<double> collision_hz;    ///< collision rate [Hz]; 0 = free-running
   std::optional<bool> multi_rate;        ///< follow the tool between frames (else hold forces)
   std::optional<TickForce> tick_force;   ///< the multi-rate tick's wrench: the frame's model or every pair
+  /// Render through the 6-DOF proxy (true; the scene's force.coupling is then left out) or the
+  /// penalty path (false), whatever the scene's force.proxy says.
+  std::optional<bool> proxy;
   bool check_model = false;              ///< also run the exact re-evaluation and record the model's error
   std::optional<double> contact_margin;  ///< pairs delivered this far [m] before they touch
   std::optional<double> coherence_skin;  ///< volume-query coherence skin [m] (0 = off); default: the scene's
@@ -107,6 +110,7 @@ struct ToolReport {
   /// The god-object (ForceControllerOptions::proxy): whether it rendered, and ToolProxyStats.
   bool proxy = false;
   ToolProxyStats proxy_stats{};
+  Vec3 proxy_position{};  ///< where the proxy ended [m, world frame]
   std::vector<TimelineSample> timeline;
 };
 

@@ -12,7 +12,9 @@
 /// moves by more than `step_m` in a step, so a pair the step did not see cannot be reached. The
 /// rotation's curvature (a point moves on an arc, the constraint sees the chord's tangent) is taken
 /// off every gap. Pairs beyond the constraint capacity shrink the step to their smallest gap.
-/// Moving objects are taken at the poses of the step's query.
+/// Moving objects are taken at the poses of the step's query. A tool that appears inside an object
+/// (the handle's first pose is there) has no side to keep: it follows the handle freely, with zero
+/// force, until it is out of every object, and keeps its side from then on.
 ///
 /// Threads: construct, watch() and bind() on the controlling thread before the threads start;
 /// set_target() and take() on the haptic thread (the handle's side); on_collision() and on_step()
@@ -64,6 +66,7 @@ struct ToolProxyStats {
   std::uint64_t contact_updates = 0;   ///< of which with at least one constraint active
   std::uint64_t unsolved = 0;          ///< steps whose constraints contradicted each other
   std::uint64_t capped_steps = 0;      ///< steps shortened because pairs exceeded max_constraints
+  std::uint64_t free_updates = 0;      ///< steps it followed the handle freely, having begun inside an object
   std::int32_t max_constraints = 0;    ///< most constraints of one step
   double deepest_m = 0.0;              ///< deepest overlap of a constrained pair beyond penetration_m [m], >= 0
   LatencySummary solve_time;           ///< the solver's time per step with constraints [ns]
@@ -97,9 +100,11 @@ class ToolProxy {
   /// The proxy of `state` slid towards the handle along the constraints that hold it, by at most
   /// its reach: what the device renders against between collision steps, so that the force
   /// follows the handle at the haptic rate (zero in free space). Haptic thread; real-time safe.
-  Pose slide(const ProxyState& state, const Pose& world_from_handle_tool) const;
+  Pose slide(const ProxyState& state, const Pose& world_from_handle_tool);
 
   ToolProxyStats stats() const;
+  /// The proxy's pose. Only while the collision thread does not run (before start, after stop).
+  const Pose& pose() const { return proxy_; }
   const ToolProxyOptions& options() const { return options_; }
   /// The extent used to weigh rotation against translation [m].
   double radius_m() const { return solver_.options().radius_m; }
@@ -113,7 +118,8 @@ class ToolProxy {
   collette::CollisionWorld* world_;
   collette::ObjectId tool_;
   ToolProxyOptions options_;
-  forcecomp::ProxySolver solver_;
+  forcecomp::ProxySolver solver_;        // collision thread
+  forcecomp::ProxySolver slide_solver_;  // haptic thread (six constraints)
   std::vector<collette::ObjectId> watched_;
   ScopedConnection collision_connection_;
   ScopedConnection step_connection_;
@@ -125,6 +131,7 @@ class ToolProxy {
   std::int32_t constraint_count_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
+  bool seated_ = false;          // it has been out of every object: from then on it keeps its side
   Pose proxy_{};
   Pose queried_{};               // the tool pose this step's frames were queried at
   bool have_query_ = false;
@@ -133,6 +140,7 @@ class ToolProxy {
   std::atomic<std::uint64_t> contact_updates_{0};
   std::atomic<std::uint64_t> unsolved_{0};
   std::atomic<std::uint64_t> capped_steps_{0};
+  std::atomic<std::uint64_t> free_updates_{0};
   std::atomic<std::int32_t> max_constraints_{0};
   std::atomic<double> deepest_m_{0.0};
   LatencyHistogram solve_time_;

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <span>
 #include <type_traits>
+#include <vector>
 
 #include "uh/core/math.hpp"
 
@@ -42,6 +43,9 @@ struct ProxySolverOptions {
   bool rotate = true;         ///< false: the rotation is fixed at the wanted one (w = w*, constraints on t only)
   int max_iterations = 64;    ///< most constraint additions and drops per solve
   double tolerance_m = 1e-9;  ///< a constraint violated by less than this counts as met [m]
+  /// Most constraints one solve takes (its scratch is allocated for them at construction); a
+  /// longer span is an error of the caller (asserted), its rest ignored.
+  std::int32_t max_constraints = 4096;
 };
 
 /// The outcome of one solve. Plain data.
@@ -61,16 +65,18 @@ static_assert(std::is_trivially_copyable_v<ProxyStep>);
 /// Projects a wanted step onto the constraints (see the file comment).
 class ProxySolver {
  public:
-  explicit ProxySolver(const ProxySolverOptions& options = {}) : options_(options) {}
+  explicit ProxySolver(const ProxySolverOptions& options = {});
 
-  /// The step nearest to (t*, w*) that meets every constraint. Real-time safe.
+  /// The step nearest to (t*, w*) that meets every constraint. Real-time safe. Not thread-safe (it
+  /// works in its own scratch): one solver per thread.
   ProxyStep solve(std::span<const ProxyConstraint> constraints, const Vec3& wanted_translation,
-                  const Vec3& wanted_rotation) const;
+                  const Vec3& wanted_rotation);
 
   const ProxySolverOptions& options() const { return options_; }
 
  private:
   ProxySolverOptions options_;
+  std::vector<double> rows_;  // per constraint: its row scaled to unit length (6) and its bound
 };
 
 }  // namespace uh::forcecomp
