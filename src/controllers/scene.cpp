@@ -317,14 +317,20 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
   if (const auto it = j.find("proxy"); it != j.end()) {
     const std::string p = FieldReader::join(path, "proxy");
     UH_CHECK(r.require_object(*it, p));
-    UH_CHECK(r.check_keys(*it, p, {"enabled", "step_m", "penetration_m", "max_constraints"}));
+    UH_CHECK(r.check_keys(*it, p, {"enabled", "step_m", "penetration_m", "max_constraints", "smoothing_m"}));
     auto& x = o.proxy;
     UH_CHECK(r.boolean(*it, p, "enabled", x.enabled));
     UH_CHECK(r.number(*it, p, "step_m", x.step_m, 1e-5, 0.05));
     UH_CHECK(r.number(*it, p, "penetration_m", x.penetration_m, 0.0, 0.01));
+    UH_CHECK(r.number(*it, p, "smoothing_m", x.smoothing_m, 0.0, 0.01));
     double capacity = x.max_constraints;
     UH_CHECK(r.number(*it, p, "max_constraints", capacity, 16.0, 1e6));
     x.max_constraints = static_cast<std::int32_t>(capacity);
+    if (x.smoothing_m > x.step_m / 4)
+      return r.error(FieldReader::join(p, "smoothing_m"),
+                     fmt::format("{} m is more than a quarter of step_m ({} m): the pairs beyond the step are "
+                                 "not in the smoothing's sum, so it would jump as they come and go",
+                                 x.smoothing_m, x.step_m));
     if (x.enabled && o.use_coupling)
       return r.error(p, "the proxy and force.coupling (the simulated tool of the penalty path) exclude each other");
   }

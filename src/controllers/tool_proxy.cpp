@@ -53,9 +53,13 @@ ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, c
       options_(options),
       solver_({.radius_m = tool_radius(tool_tree),
                .rotate = rotate,
-               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16)}),
+               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16) + tool_tree.leaf_count()}),
       slide_solver_({.radius_m = tool_radius(tool_tree), .rotate = rotate, .max_constraints = 6}),
-      constraints_(static_cast<std::size_t>(std::max<std::int32_t>(options.max_constraints, 16))) {}
+      pair_capacity_(std::max<std::int32_t>(options.max_constraints, 16)),
+      constraints_(static_cast<std::size_t>(pair_capacity_ + tool_tree.leaf_count())),
+      smooth_(static_cast<std::size_t>(tool_tree.leaf_count())) {
+  touched_.reserve(static_cast<std::size_t>(tool_tree.leaf_count()));
+}
 
 void ToolProxy::bind() {
   collision_connection_ = world_->on_collision().connect<&ToolProxy::on_collision>(*this);
@@ -79,7 +83,8 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
   have_query_ = true;
   const auto pairs = frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
                                            static_cast<std::size_t>(section.pair_count));
-  const auto capacity = static_cast<std::int32_t>(constraints_.size());
+  const std::int32_t capacity = pair_capacity_;
+  const auto heap_end = constraints_.begin() + capacity;
   for (const SpherePairContact& p : pairs) {
     const Vec3 a = transform_point(section.world_from_a, centre(p.sphere_a_local));
     const Vec3 b = transform_point(section.world_from_b, centre(p.sphere_b_local));
@@ -90,6 +95,7 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
     const double gap =
         distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
     const forcecomp::ProxyConstraint c{.normal = n, .lever = (b - rb * n) - section.world_from_b.position, .gap = gap};
+    if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m);
     // beyond the capacity the nearest pairs are kept (a heap on the gap, largest on top); the step
     // shrinks to the smallest gap left out
     const auto by_gap = [](const forcecomp::ProxyConstraint& x, const forcecomp::ProxyConstraint& y) {
@@ -100,13 +106,48 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
       std::push_heap(constraints_.begin(), constraints_.begin() + constraint_count_, by_gap);
     } else if (gap < constraints_.front().gap) {
       dropped_gap_m_ = std::min(dropped_gap_m_, constraints_.front().gap);
-      std::pop_heap(constraints_.begin(), constraints_.end(), by_gap);
-      constraints_.back() = c;
-      std::push_heap(constraints_.begin(), constraints_.end(), by_gap);
+      std::pop_heap(constraints_.begin(), heap_end, by_gap);
+      *(heap_end - 1) = c;
+      std::push_heap(constraints_.begin(), heap_end, by_gap);
     } else {
       dropped_gap_m_ = std::min(dropped_gap_m_, gap);
     }
   }
+}
+
+// The soft minimum of a tool sphere's gaps to the object's spheres near it, -e log sum exp(-d_i / e)
+// (e = smoothing_m), is never more than the smallest gap and is smooth where the smallest one has
+// kinks (between the caps of a packed face): summed here pair by pair, a constraint per tool sphere.
+void ToolProxy::add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal,
+                              double gap) {
+  if (leaf < 0 || static_cast<std::size_t>(leaf) >= smooth_.size()) return;
+  SmoothLeaf& s = smooth_[static_cast<std::size_t>(leaf)];
+  if (s.weight == 0.0) {
+    touched_.push_back(leaf);  // reserved for every leaf: no allocation
+    s.centre = centre_world;
+    s.radius = radius;
+  }
+  const double w = std::exp(-gap / options_.smoothing_m);
+  s.weight += w;
+  s.gradient += w * normal;
+}
+
+// The smooth constraints, after the pairs' (the heap's order no longer matters).
+void ToolProxy::append_smooth(const Pose& proxy) {
+  for (const std::int32_t leaf : touched_) {
+    SmoothLeaf& s = smooth_[static_cast<std::size_t>(leaf)];
+    const Vec3 gradient = s.gradient / s.weight;  // d(soft gap)/d(position of the tool sphere)
+    const double length = norm(gradient);
+    const double soft_gap = -options_.smoothing_m * std::log(s.weight);
+    if (length > 1e-9 && constraint_count_ < static_cast<std::int32_t>(constraints_.size())) {
+      const Vec3 n = gradient / length;
+      constraints_[static_cast<std::size_t>(constraint_count_++)] = {
+          .normal = n, .lever = (s.centre - s.radius * n) - proxy.position,
+          .gap = (soft_gap + options_.penetration_m) / length};
+    }
+    s = {};
+  }
+  touched_.clear();
 }
 
 // One god-object step from `from` towards `target`: the wanted step, shortened so that no point of
@@ -185,7 +226,7 @@ void ToolProxy::on_step(double time_s) {
   const bool fresh = target_.update();
   if (!fresh && !placed_) return;
   const Pose& target = target_.read_buffer();
-  if (constraint_count_ == static_cast<std::int32_t>(constraints_.size()))
+  if (constraint_count_ == pair_capacity_)
     capped_steps_.fetch_add(1, std::memory_order_relaxed);
   ProxyState& out = state_.write_buffer();
   out.active = 0;
@@ -201,8 +242,12 @@ void ToolProxy::on_step(double time_s) {
     placed_ = true;
   } else {
     seated_ = true;
-    proxy_ = advance(have_query_ ? queried_ : proxy_, target, out);
+    const Pose from = have_query_ ? queried_ : proxy_;
+    append_smooth(from);
+    proxy_ = advance(from, target, out);
   }
+  for (const std::int32_t leaf : touched_) smooth_[static_cast<std::size_t>(leaf)] = {};
+  touched_.clear();
   max_constraints_.store(std::max(max_constraints_.load(std::memory_order_relaxed), constraint_count_),
                          std::memory_order_relaxed);
   out.world_from_proxy = proxy_;

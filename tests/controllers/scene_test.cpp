@@ -130,6 +130,28 @@ TEST(Scene, ReadsHowTheTickComputesTheForce) {
       << bad.error().message;
 }
 
+TEST(Scene, ReadsTheProxyAndNamesItsBadFields) {
+  const auto with = [](const char* proxy) {
+    return replaced(small_scene_json(), R"("force": { "multi_rate")",
+                    fmt::format(R"("force": {{ "proxy": {}, "multi_rate")", proxy));
+  };
+  const auto on = parse_scene(with(R"({ "enabled": true, "step_m": 0.003, "smoothing_m": 0.0005 })"), "small.json",
+                              test_assets());
+  ASSERT_TRUE(on.has_value()) << on.error().message;
+  EXPECT_TRUE(on->force.proxy.enabled);
+  EXPECT_EQ(on->force.proxy.step_m, 0.003);
+  EXPECT_EQ(on->force.proxy.smoothing_m, 0.0005);
+  const auto expect_error = [&](const char* proxy, const char* needle) {
+    const auto bad = parse_scene(with(proxy), "small.json", test_assets());
+    ASSERT_FALSE(bad.has_value()) << proxy;
+    EXPECT_NE(bad.error().message.find(needle), std::string::npos) << bad.error().message;
+  };
+  expect_error(R"({ "step_m": -1 })", "force.proxy.step_m");
+  expect_error(R"({ "enabled": "yes" })", "force.proxy.enabled");
+  expect_error(R"({ "smoothing_m": 0.001 })", "force.proxy.smoothing_m");  // more than step_m / 4
+  expect_error(R"({ "stiffness": 1 })", "force.proxy.stiffness");          // unknown field
+}
+
 TEST(Scene, ReadsTheSafetyLimitsAndTheRateLimit) {
   const auto defaults = parse_scene(small_scene_json(), "small.json", test_assets());
   ASSERT_TRUE(defaults.has_value()) << defaults.error().message;

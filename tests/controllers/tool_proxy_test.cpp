@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <vector>
 
@@ -166,6 +167,60 @@ TEST(ToolProxy, SlidesAlongAFaceItIsPressedInto) {
   EXPECT_GT(state.active, 0);
   EXPECT_GT(proxy.stats().contact_updates, 500u);
   EXPECT_EQ(proxy.stats().unsolved, 0u);
+}
+
+// Slides a 1 cm ball (one sphere) 4 cm along the top face (z = 0) of a packed slab, the handle held
+// `press_m` below the face's resting height; returns the RMS of the spring force's deviation from
+// its mean over the slide, relative to the mean normal force, and the mean normal force.
+struct Ripple {
+  double relative = 0.0;
+  double normal_n = 0.0;
+};
+Ripple slide_ripple(const Packed& slab, double smoothing_m, double press_m) {
+  const auto ball = std::make_shared<const collette::SphereTree>(
+      *collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}}));
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  const auto slab_id = world.add_object({.tree = slab.tree, .is_static = true, .name = "slab"});
+  const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
+  EXPECT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball, {.enabled = true, .smoothing_m = smoothing_m}, true);
+  proxy.watch(*slab_id);
+  proxy.bind();
+  const double stiffness = 1500.0;
+  Pose handle;
+  ProxyState state{};
+  std::vector<Vec3> forces;
+  for (int i = 0; i < 4000; ++i) {
+    // down onto the face at x = -2 cm, then along x at 2 cm/s
+    const double x = i < 1000 ? -0.02 : std::min(0.02, -0.02 + 0.00002 * (i - 1000));
+    handle.position = {x, 0.003, std::max(0.02 - 0.00005 * i, 0.005 - press_m)};
+    proxy.set_target(handle);
+    world.step(1e-3 * i);
+    if (const ProxyState* s = proxy.take()) state = *s;
+    if (i >= 1200 && i < 3000) forces.push_back(stiffness * (proxy.slide(state, handle).position - handle.position));
+  }
+  Vec3 mean{};
+  for (const Vec3& f : forces) mean += f / static_cast<double>(forces.size());
+  double sum = 0.0;
+  for (const Vec3& f : forces) sum += squared_norm(f - mean);
+  return {std::sqrt(sum / static_cast<double>(forces.size())) / mean.z, mean.z};
+}
+
+TEST(ToolProxy, SmoothingTakesPartOfTheGrainOutOfAPackedFace) {
+  // the issue's slab: 10 x 10 x 2 cm, 10,000 spheres of unbounded radius, the top face at z = 0
+  const Packed slab = [] {
+    collette::TriangleMesh m = box_mesh({0.1, 0.1, 0.02});
+    for (Vec3& v : m.vertices) v.z -= 0.01;
+    return pack(m, 10000);
+  }();
+  const Ripple raw = slide_ripple(slab, 0.0, 0.0015);
+  const Ripple smooth = slide_ripple(slab, ToolProxyOptions{}.smoothing_m, 0.0015);
+  std::printf("ripple on the union of spheres %.1f %%, smoothed over %.2f mm %.1f %% (normal force %.2f and %.2f N)\n",
+              100 * raw.relative, ToolProxyOptions{}.smoothing_m * 1e3, 100 * smooth.relative, raw.normal_n,
+              smooth.normal_n);
+  // measured: 19.0 % and 10.8 %; issue 23 asks for 1 %, which the soft minimum does not reach
+  EXPECT_LT(smooth.relative, 0.8 * raw.relative);
+  EXPECT_GT(smooth.normal_n, 1.5);  // pressed 1.5 mm with 1500 N/m: about 2.2 N
 }
 
 // The whole session (scenes/thin_wall.json): a simulated hand pulls the 1 cm ball 3 cm through a

@@ -43,9 +43,16 @@ struct ToolProxyOptions {
   double step_m = 0.002;
   /// How far the proxy's spheres may overlap the object's [m]: the proxy rests this deep.
   double penetration_m = 0.0001;
-  /// Most constraints a step holds (the nearest pairs first is not guaranteed: the rest shrink
-  /// the step instead).
+  /// Most sphere pairs a step takes as constraints (the nearest; the rest shrink the step).
   std::int32_t max_constraints = 4096;
+  /// The length over which the packed surface is smoothed [m] (0: the spheres' union as it is):
+  /// each tool sphere near the object also gets a constraint on the soft minimum of its gaps,
+  /// -e log sum exp(-gap_i / e), which lies above the caps of a packed face by at most
+  /// e log(count) and rounds the kinks between them, so a tool sliding on it does not ride over
+  /// the packing's grain. It only adds constraints: the pairs' own still hold. Keep it well below
+  /// step_m (the pairs beyond the margin are not in the sum). A ball sliding on a face packed with
+  /// 10,000 spheres ripples 19 % of its normal force on the spheres' union, 11 % at 0.2 mm.
+  double smoothing_m = 0.0002;
 };
 
 /// The proxy as the haptic thread reads it. Plain data.
@@ -111,6 +118,8 @@ class ToolProxy {
 
  private:
   bool is_watched(std::int32_t object) const;
+  void add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal, double gap);
+  void append_smooth(const Pose& proxy);
   void add_section(const ContactFrame& frame, const ContactSection& section);
   Pose advance(const Pose& from, const Pose& target, ProxyState& out);
   double wanted_step(const Pose& from, const Pose& target, double limit, Vec3& t, Vec3& w) const;
@@ -127,7 +136,18 @@ class ToolProxy {
   LatestValue<ProxyState> state_;  // collision thread -> haptic thread
 
   // collision thread
-  std::vector<forcecomp::ProxyConstraint> constraints_;  // capacity max_constraints, fixed
+  // the pairs' constraints (a heap on the gap, pair_capacity_ of them at most), then the smooth ones
+  std::int32_t pair_capacity_;
+  std::vector<forcecomp::ProxyConstraint> constraints_;
+  // the soft minimum's sums per tool sphere (SphereTree::leaves() order) and the spheres touched
+  struct SmoothLeaf {
+    double weight = 0.0;  // sum exp(-gap_i / e)
+    Vec3 gradient{};      // sum exp(-gap_i / e) n_i
+    Vec3 centre{};        // the tool sphere's centre, world frame [m]
+    double radius = 0.0;
+  };
+  std::vector<SmoothLeaf> smooth_;
+  std::vector<std::int32_t> touched_;
   std::int32_t constraint_count_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
