@@ -27,6 +27,7 @@ json state_json(const controllers::SessionState& s) {
       {"clock_s", steady_seconds()},
       {"tool",
        {{"position", vec3_json(s.tool_position_world)}, {"orientation", json::array({q.w, q.x, q.y, q.z})}}},
+      {"handle", {{"position", vec3_json(s.handle_position_world)}}},
       {"force", vec3_json(s.force_world)},
       {"torque", vec3_json(s.torque_world)},
       {"contact_pairs", s.contact_pairs},

@@ -45,6 +45,12 @@ scene.add(objectsGroup);
 const toolMaterial = new THREE.MeshStandardMaterial({ color: 0x88c0d0, metalness: 0.2, roughness: 0.5 });
 let tool = new THREE.Group();  // replaced by the tool's mesh once it arrived
 scene.add(tool);
+// where the device's handle holds the tool: apart from it when the 6-DOF proxy keeps the tool on a
+// surface the handle has pushed into
+const handleMarker = new THREE.Mesh(new THREE.SphereGeometry(0.002, 12, 8),
+                                    new THREE.MeshBasicMaterial({ color: 0xbf616a, wireframe: true }));
+handleMarker.visible = false;
+scene.add(handleMarker);
 const forceArrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.0001, 0xff2a55);
 forceArrow.visible = false;
 // drawn over the meshes: the force often points along the tool, which would hide it
@@ -128,6 +134,11 @@ function showState(s) {
   live.states++;
   live.toolPosition = s.tool.position;
   applyPose(tool, { position: s.tool.position, rotation: s.tool.orientation });
+  if (s.handle) {
+    handleMarker.position.fromArray(s.handle.position);
+    handleMarker.visible = handleMarker.position.distanceTo(new THREE.Vector3().fromArray(s.tool.position)) > 5e-4;
+    live.handlePosition = s.handle.position;
+  }
   const force = new THREE.Vector3().fromArray(s.force);
   const newtons = force.length();
   live.forceN = newtons;
