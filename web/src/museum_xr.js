@@ -422,7 +422,7 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
       if (!gamepad) continue;
       const actuator = gamepad.hapticActuators && gamepad.hapticActuators[0];
       if (actuator && actuator.pulse) actuator.pulse(strength, ms);
-      else if (gamepad.vibrationActuator) gamepad.vibrationActuator.playEffect('dual-rumble', { duration: ms, strongMagnitude: strength, weakMagnitude: strength });
+      else if (gamepad.vibrationActuator && typeof gamepad.vibrationActuator.playEffect === 'function') gamepad.vibrationActuator.playEffect('dual-rumble', { duration: ms, strongMagnitude: strength, weakMagnitude: strength });
     }
   }
   function onEvent(e) {
