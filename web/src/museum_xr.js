@@ -144,8 +144,8 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
   let placed = false;
   let teleportWalk = null;  // {to, until}: the body walks to a teleport's landing; no leash meanwhile
   let blinkUntil = 0;
-  let lastHeadLocal = null;
-  let headSpeed = 0;        // the head's own speed over the floor, smoothed [m/s]
+  let lastHead = null;      // the head over the floor last frame; null after a jump (a teleport)
+  let headSpeed = 0;        // the head's speed over the floor, the player's steps and the stick together, smoothed [m/s]
   let calibrateNext = true;
 
   // ---- entering and leaving ----------------------------------------------------------------------
@@ -175,6 +175,7 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
     await renderer.xr.setSession(session);
     xr.presenting = true;
     placed = false;
+    lastHead = null;
     calibrateNext = true;
   }
   function leave() {
@@ -305,6 +306,7 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
       return;
     }
     putHeadAt(local, land);
+    lastHead = null;
     xr.teleports++;
     xr.lastTeleport = { from: [...from], to: land };
     teleportWalk = { to: land, until: performance.now() / 1000 + Math.hypot(land[0] - from[0], land[1] - from[1]) / game.rules().walk_speed + 1 };
@@ -356,13 +358,6 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
       putHeadAt(local, body);
       placed = true;
     }
-    // the head's own speed (the player walking in the room), whichever way the rig is turned
-    if (lastHeadLocal && dt > 0) {
-      const moved = Math.hypot(local.x - lastHeadLocal[0], local.z - lastHeadLocal[1]) / dt;
-      headSpeed += (moved - headSpeed) * Math.min(1, dt / 0.2);
-    }
-    lastHeadLocal = [local.x, local.z];
-
     const s = game.snapshot();
     const playing = !!s && s.phase === 'playing';
     const left = hands.left || hands.none, right = hands.right;
@@ -381,6 +376,10 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
 
     // the body chases the head; the leash brings the head back to a body that cannot follow
     let head = toLevel(headWorld(local));
+    if (lastHead && dt > 0) {
+      const moved = Math.hypot(head[0] - lastHead[0], head[1] - lastHead[1]) / dt;
+      headSpeed += (moved - headSpeed) * Math.min(1, dt / 0.2);
+    }
     let gap = [head[0] - body[0], head[1] - body[1]];
     let distance = Math.hypot(...gap);
     if (teleportWalk && (distance < 0.1 || now > teleportWalk.until)) teleportWalk = null;
@@ -391,6 +390,7 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
       gap = [0, 0];
       distance = 0;
     }
+    lastHead = head;
     const rules = game.rules();
     const run = playing && !teleportWalk && (walking.run || headSpeed > rules.walk_speed * 1.1);
     const speed = run ? rules.run_speed : rules.walk_speed;
