@@ -1013,6 +1013,8 @@ const xr = createXR({
     yaw: () => yaw,
     setYaw: (radians) => { yaw = radians; },
     panel: panelView,
+    floorToWorld,
+    wallHeight: kWallHeight,
   },
 });
 

@@ -6,7 +6,8 @@
 // Where Vive is: the view always follows the head (no forced camera motion). Her body, what the
 // server moves, what guards see and what reaches the cases, chases the head at the rules' speeds:
 // the page asks for the move that closes the gap, at walking speed, or running (heard by the
-// guards) while the player runs with the stick or physically moves faster than walking. A head
+// guards) while the player runs with the stick or the head (the player's steps and the stick
+// together) moves faster than walking. A head
 // that leaves the floor (into a wall) or outruns the body by more than a metre is brought back to
 // the body with a blink.
 //
@@ -29,7 +30,6 @@ const kTeleportLaunch = 7;       // the arc's launch speed [m/s]
 const kGravity = 9.81;
 const kArcPoints = 48;
 const kArcStepS = 0.05;
-const kWallHeightM = 3.0;        // as museum.js draws the walls
 const kClearStepM = 0.05;        // a teleport's straight line is sampled this often
 const kSeatedEyeM = 1.6;         // a seated player's eyes are put at this height [m]
 const kBlinkS = 0.25;
@@ -37,8 +37,7 @@ const kPanelHz = 5;
 const kButtonX = 4, kButtonY = 5, kButtonStick = 3;
 const kModeStorage = 'uh-museum-vr-mode';
 
-// a floor point (level frame: x east, y north) and the scene's (y up, z south)
-const toWorld = (x, y, height = 0) => new THREE.Vector3(x, height, -y);
+// a point of the scene (y up) over the floor, in the level's frame (museum.js's floorToWorld backwards)
 const toLevel = (v) => [v.x, -v.z];
 
 // the comfort vignette: black outside a clear disc around the view's centre, in front of the eyes
@@ -91,11 +90,13 @@ function addControllerLooks(ray, grip) {
 }
 
 // Creates the VR mode. `game` gives what museum.js knows: level(), rules(), snapshot(),
-// walkable(x, y), body() (the predicted position of Vive's body), usable() (the prompt's action),
-// act(allowed) (sends it when allowed), want(x, y, run) (the wanted move), panel() (what the wrist
-// panel shows). Returns the state the page reads (and the tests), update() for each XR frame and
-// onEvent() for the server's events.
+// walkable(x, y), body() (the predicted position of Vive's body), act(allowed) (sends the prompt's
+// action when allowed), want(x, y, run) (the wanted move), yaw() and setYaw() (where Vive looks),
+// panel() (what the wrist panel shows), floorToWorld(x, y, height) and wallHeight (how the scene is
+// drawn). Fills `state` (what the page shows, for the tests); returns update() for each XR frame,
+// onEvent() for the server's events and presenting().
 export function createXR({ renderer, scene, camera, rig, colours, game, state }) {
+  const toWorld = game.floorToWorld;
   renderer.xr.enabled = true;
   renderer.xr.setReferenceSpaceType('local-floor');
   renderer.xr.cameraAutoUpdate = false;  // updated after the rig moves, so what rides on the camera keeps up
@@ -242,7 +243,7 @@ export function createXR({ renderer, scene, camera, rig, colours, game, state })
       velocity.y -= kGravity * kArcStepS;
       if (next.y <= 0) p.lerp(next, p.y / (p.y - next.y));  // down to the floor between two samples
       else p.copy(next);
-      hitWall = p.y < kWallHeightM && !game.walkable(...toLevel(p));  // the arc ends where it meets a wall
+      hitWall = p.y < game.wallHeight && !game.walkable(...toLevel(p));  // the arc ends where it meets a wall
     }
     arc.line.geometry.setDrawRange(0, Math.min(kArcPoints, count + 1));
     arc.line.geometry.attributes.position.needsUpdate = true;
