@@ -7,8 +7,10 @@
 // (walk or run, sliding along walls) so the view answers the keys at once, and pulled towards
 // what the server says (reconciliation); everything else is drawn a little in the past,
 // interpolated between the two snapshots around that moment. Bundled with three.js at build
-// time; it fetches nothing but the server's own files.
+// time; it fetches nothing but the server's own files. Where the browser offers WebXR's
+// `immersive-vr`, an "Enter VR" button puts Vive in virtual reality (museum_xr.js).
 import * as THREE from 'three';
+import { createXR } from './museum_xr.js';
 
 // Okabe-Ito: told apart with the common colour-vision deficiencies
 const Colour = {
@@ -66,6 +68,7 @@ const museum = {
   welcome: null,
   snapshot: null,        // the newest snapshot
   snapshots: 0,          // snapshots received
+  runningSnapshots: 0,   // snapshots with Vive running
   summary: null,
   events: [],            // events received, oldest first
   errors: [],            // error messages from the server
@@ -81,6 +84,8 @@ const museum = {
   autopilot: null,
   ringsDrawn: 0,         // noise rings drawn (not counting the one around Vive while she runs)
   running: false,        // whether Vive runs now (the red ring around her shows)
+  captions: [],          // the last captions shown, oldest first
+  xr: {},                // the VR mode's state (museum_xr.js)
 };
 window.uhMuseum = museum;
 
@@ -100,6 +105,11 @@ const scene = new THREE.Scene();
 scene.fog = new THREE.Fog(0x1b1f27, 12, 40);
 const camera = new THREE.PerspectiveCamera(70, window.innerWidth / window.innerHeight, 0.05, 80);
 camera.rotation.order = 'YXZ';
+// the camera rides on a rig: still on the desktop; in VR the rig is where the player's floor is in
+// the museum and the headset moves the camera on it
+const rig = new THREE.Group();
+rig.add(camera);
+scene.add(rig);
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404650, 1.4));
 const sun = new THREE.DirectionalLight(0xffffff, 1.2);
 sun.position.set(5, 20, 8);
@@ -362,6 +372,8 @@ function caption(text, kind = '') {
   line.textContent = text;
   if (kind === 'bad') line.style.color = 'var(--vermillion)';
   if (kind === 'warn') line.style.color = 'var(--yellow)';
+  museum.captions.push(text);
+  if (museum.captions.length > 5) museum.captions.shift();
   const box = $('captions');
   box.appendChild(line);
   while (box.children.length > 5) box.removeChild(box.firstChild);
@@ -527,12 +539,12 @@ window.addEventListener('keydown', (event) => {
   held.add(event.code);
   if (keys.settings.includes(event.code)) toggleSettings();
   else if (keys.use.includes(event.code)) useNearest();
-  if (level && !museum.summary && $('settings').style.display !== 'block') readInput(0);  // so does a start
+  if (level && !museum.summary && !xr.presenting() && $('settings').style.display !== 'block') readInput(0);  // so does a start
   if (Object.values(keys).some((codes) => codes.includes(event.code))) event.preventDefault();
 });
 window.addEventListener('keyup', (event) => {
   held.delete(event.code);
-  if (level && !museum.summary) readInput(0);  // a stop goes out at once
+  if (level && !museum.summary && !xr.presenting()) readInput(0);  // a stop goes out at once
 });
 window.addEventListener('blur', () => held.clear());
 
@@ -579,13 +591,13 @@ function usableAction() {
   if (s.vive.carried.length >= rules.max_carried) return { action: null, text: `hands full (${rules.max_carried} pieces)` };
   return { action: 'take', case: best, text: `take the ${s.cases[best].item.kind}` };
 }
-function useNearest() {
+function useNearest(allowed = null) {
   const use = usableAction();
-  if (use && use.action) {
+  if (use && use.action && (!allowed || allowed.includes(use.action))) {
     send({ type: 'action', action: use.action });
     if (use.case !== undefined) sentActions.set(`${use.action} ${use.case}`, performance.now() / 1000);
   }
-  return use ? use.action : null;
+  return use && use.action && (!allowed || allowed.includes(use.action)) ? use.action : null;
 }
 museum.use = useNearest;  // what the use key does, for scripts: the action sent, or null
 
@@ -605,6 +617,7 @@ function onEvent(e) {
   museum.events.push(e);
   const text = kEventText[e.event];
   if (text) caption(...text(e));
+  xr.onEvent(e);
   if (e.event === 'case_broken') addRing(e.pos, e.radius, Colour.purple, 2.0);
   if (e.event === 'guard_heard') addRing(e.pos, 0.6, Colour.vermillion, 1.5);
 }
@@ -699,6 +712,7 @@ function onSnapshot(s) {
   const now = performance.now() / 1000;
   museum.snapshot = s;
   museum.snapshots++;
+  if (s.vive.running) museum.runningSnapshots++;
   const t = s.tick * rules.tick_s;
   if (museum.trace) museum.trace.push({ snapshot: s.guards.map((g) => [...g.pos]) });
   buffer.push({ t, snap: s });
@@ -871,6 +885,12 @@ function readInput(dt) {
     n = Math.hypot(x, y);
     run = museum.autopilot.run;
   }
+  want(x, y, run);
+}
+
+// the move Vive wants now (a direction, longer than 1 counts as 1), sent when it changes
+function want(x, y, run) {
+  const n = Math.hypot(x, y);
   wanted = [x, y];
   running = run && n > 0;
   museum.running = running;
@@ -924,18 +944,20 @@ function placeGuards(guards) {
 }
 
 let lastFrameS = performance.now() / 1000;
-function frame() {
+function frame(time, xrFrame) {
   const now = performance.now() / 1000;
   const dt = Math.min(0.25, now - lastFrameS);
   lastFrameS = now;
+  const inVR = xr.presenting();
   if (level) {
-    if (!museum.summary && $('settings').style.display !== 'block') readInput(dt);
+    if (inVR) xr.update(dt, museum.summary ? null : xrFrame);
+    else if (!museum.summary && $('settings').style.display !== 'block') readInput(dt);
     predict(dt);
     const guards = clockOffsetS === null ? [] : guardsAt(now - clockOffsetS - kInterpolationDelayS);
     placeGuards(guards);
     if (museum.predicted) {
       const [x, y] = museum.predicted;
-      camera.position.copy(floorToWorld(x, y, kEyeHeight));
+      if (!inVR) camera.position.copy(floorToWorld(x, y, kEyeHeight));
       runRing.visible = running && museum.snapshot && museum.snapshot.phase === 'playing';
       runRing.position.copy(floorToWorld(x, y, 0.03));
       runRing.scale.setScalar(rules.run_hear_radius);
@@ -947,18 +969,55 @@ function frame() {
     drawMinimap(museum.predicted, guards);
     if (museum.trace) museum.trace.push({ drawn: museum.guardsDrawn.map((p) => [...p]) });
   }
-  camera.rotation.set(pitch, yaw - Math.PI / 2, 0);
+  if (!inVR) camera.rotation.set(pitch, yaw - Math.PI / 2, 0);
+  else if (!level || museum.summary) renderer.xr.updateCamera(camera);
   renderer.render(scene, camera);
   museum.frames++;
-  requestAnimationFrame(frame);
 }
 
 window.addEventListener('resize', () => {
+  if (xr.presenting()) return;  // the headset sizes its own views
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
   renderer.setSize(window.innerWidth, window.innerHeight);
 });
 
+// what the wrist panel shows in VR: the HUD's lines
+function panelView() {
+  const s = museum.snapshot;
+  const use = usableAction();
+  const button = { break: 'trigger', take: 'grip', deliver: 'grip' };
+  return {
+    timer: s ? formatTime(s.time_left_s) : '--:--',
+    low: !!s && s.time_left_s <= 30,
+    status: museum.summary ? `round over: ${museum.summary.score.points} points` : $('status').textContent,
+    caught: s ? s.vive.times_caught : 0,
+    table: s ? s.table.length : 0,
+    targets: (museum.welcome ? museum.welcome.targets : []).map((kind) => ({ kind, picture: pictureOf(kind) })),
+    carried: s ? s.vive.carried.map((item) => item.kind) : [],
+    prompt: use ? (use.action ? `${button[use.action]}: ${use.text}` : use.text) : '',
+    captions: museum.captions,
+  };
+}
+
+const xr = createXR({
+  renderer, scene, camera, rig, colours: Colour, state: museum.xr,
+  game: {
+    level: () => level,
+    rules: () => rules,
+    snapshot: () => museum.snapshot,
+    walkable: (x, y) => walkable(x, y),
+    body: () => museum.predicted,
+    act: useNearest,
+    want,
+    yaw: () => yaw,
+    setYaw: (radians) => { yaw = radians; },
+    panel: panelView,
+    floorToWorld,
+    wallHeight: kWallHeight,
+  },
+});
+
 showCarried([]);
 connect();
-frame();
+renderer.setAnimationLoop(frame);

@@ -5,6 +5,33 @@ import { spawn } from 'node:child_process';
 import { chromium } from 'playwright-core';
 
 const failures = [];
+
+// Runs in the page (`page.evaluate(pixelStats, {selector, from, to})`): for each element matching
+// `selector` (a canvas or an image), over its columns from `from` to `to` (shares of its width: one
+// eye of a stereo canvas), the share of the pixels that differ from their commonest colour (the
+// background) and the standard deviation of their brightness
+export function pixelStats({ selector, from = 0, to = 1 }) {
+  return [...document.querySelectorAll(selector)].map((element) => {
+    const width = element.naturalWidth || element.width;
+    const copy = document.createElement('canvas');
+    copy.width = Math.max(1, Math.floor(width * (to - from)));
+    copy.height = element.naturalHeight || element.height;
+    const context = copy.getContext('2d');
+    context.drawImage(element, -Math.floor(width * from), 0);
+    const { data } = context.getImageData(0, 0, copy.width, copy.height);
+    const counts = new Map();
+    let sum = 0, sumSquares = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      const brightness = (data[i] + data[i + 1] + data[i + 2]) / 3;
+      sum += brightness;
+      sumSquares += brightness * brightness;
+      const key = (data[i] >> 3) << 15 | (data[i + 1] >> 3) << 10 | (data[i + 2] >> 3) << 5 | (data[i + 3] >> 3);
+      counts.set(key, (counts.get(key) || 0) + 1);
+    }
+    const n = data.length / 4;
+    return { variety: 1 - Math.max(...counts.values()) / n, deviation: Math.sqrt(Math.max(0, sumSquares / n - (sum / n) ** 2)) };
+  });
+}
 export function check(condition, what) {
   console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
   if (!condition) failures.push(what);

@@ -12,7 +12,7 @@
 //   node museum_test.mjs UH_BINARY OUT_DIR
 import { spawn } from 'node:child_process';
 import path from 'node:path';
-import { check, runBrowserTest, startServer } from './browser_harness.mjs';
+import { check, pixelStats, runBrowserTest, startServer } from './browser_harness.mjs';
 
 const [uhBinary, outDir] = process.argv.slice(2);
 if (!uhBinary || !outDir) {
@@ -27,30 +27,6 @@ const kPhantomPatience = 150000;
 const server = await startServer(uhBinary, ['museum', 'serve', '--port', '0', '--seed', '2', '--minutes', String(kRoundMinutes)],
                                  /Vive plays in a browser at (http:\/\/127\.0\.0\.1:\d+\/)/);
 const url = server.url;
-
-// For each element matching `selector` (a canvas or an image): the share of its pixels that differ
-// from its commonest colour (the background) and the standard deviation of their brightness
-function pixelStats(selector) {
-  return [...document.querySelectorAll(selector)].map((element) => {
-    const copy = document.createElement('canvas');
-    copy.width = element.naturalWidth || element.width;
-    copy.height = element.naturalHeight || element.height;
-    const context = copy.getContext('2d');
-    context.drawImage(element, 0, 0);
-    const { data } = context.getImageData(0, 0, copy.width, copy.height);
-    const counts = new Map();
-    let sum = 0, sumSquares = 0;
-    for (let i = 0; i < data.length; i += 4) {
-      const brightness = (data[i] + data[i + 1] + data[i + 2]) / 3;
-      sum += brightness;
-      sumSquares += brightness * brightness;
-      const key = (data[i] >> 3) << 15 | (data[i + 1] >> 3) << 10 | (data[i + 2] >> 3) << 5 | (data[i + 3] >> 3);
-      counts.set(key, (counts.get(key) || 0) + 1);
-    }
-    const n = data.length / 4;
-    return { variety: 1 - Math.max(...counts.values()) / n, deviation: Math.sqrt(Math.max(0, sumSquares / n - (sum / n) ** 2)) };
-  });
-}
 
 await runBrowserTest('museum browser test', server, { width: 800, height: 500 }, async ({ page, browser }) => {
   await page.goto(url);
@@ -90,7 +66,7 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
   // Falcon's pictures: one per target, rendered (not a flat square)
   await page.waitForFunction((n) => Object.keys(window.uhMuseum.pictures).length >= n &&
     [...document.querySelectorAll('#targets img')].every((img) => img.complete && img.naturalWidth > 0), round.targets.length, { timeout: 15000 });
-  const pictures = (await page.evaluate(pixelStats, '#targets img')).map((stats) => stats.variety);
+  const pictures = (await page.evaluate(pixelStats, { selector: '#targets img' })).map((stats) => stats.variety);
   check(pictures.length === round.targets.length && pictures.every((share) => share > 0.05 && share < 0.9),
         `Falcon shows a picture of each target (${round.targets.join(', ')}: ${pictures.map((p) => `${(100 * p).toFixed(0)} %`).join(', ')} of each picture is the piece)`);
 
@@ -246,7 +222,7 @@ await runBrowserTest('museum browser test', server, { width: 800, height: 500 },
   // facing east again, through the dock door into the great hall
   await page.evaluate(() => { window.uhMuseum.autopilot = { path: [[3.6, 3.2]], run: false }; });
   await waitFor('the turn to the east', () => window.uhMuseum.autopilot === null, null, 10000);
-  const [look] = await page.evaluate(pixelStats, '#view canvas');
+  const [look] = await page.evaluate(pixelStats, { selector: '#view canvas' });
   check(look.variety > 0.2 && look.deviation > 10,
         `the canvas is not blank (${(100 * look.variety).toFixed(0)} % of pixels away from the commonest colour, brightness varies by ${look.deviation.toFixed(0)} of 255)`);
   await page.screenshot({ path: path.join(outDir, 'museum_vive.png') });
