@@ -64,8 +64,8 @@ for mm in (1, 2, 3):
                     print(f"| {mm} mm | {tilt} deg | {hand} | {pull} N | {label} | {height:+.1f} ({side}) | {force:.2f} |")
 
 print()
-print("| session | path | collision step median / p99 [us] | haptic tick p99 [us] | proxy solve p50 / p99 [us] | constraints (most) |")
-print("|---|---|---|---|---|---|")
+print("| session | path | collision rate median / min [Hz] | collision step median / p99 [us] | haptic tick p99 [us] | proxy solve p50 / p99 [us] | constraints (most) |")
+print("|---|---|---|---|---|---|---|")
 for label, scene in (("default (bunny sweep)", []), ("room of objects", [f"{root}/scenes/museum_room.json"])):
     for path in ("off", "on"):
         r = json.loads(subprocess.run([uh, "run", *scene, "--json", "--seconds", seconds, "--proxy", path],
@@ -74,6 +74,8 @@ for label, scene in (("default (bunny sweep)", []), ("room of objects", [f"{root
         p = r["force"]["proxy"]
         solve = f"{p['solve_us']['p50']:.1f} / {p['solve_us']['p99']:.1f}" if p else "-"
         most = str(p["max_constraints"]) if p else f"{r['collision'].get('max_pairs', '-')} pairs"
-        print(f"| {label} | {'proxy' if path == 'on' else 'penalty'} | {c['median']:.0f} / {c['p99']:.0f} | "
+        rate = r["collision"]["rate_hz"]
+        print(f"| {label} | {'proxy' if path == 'on' else 'penalty'} | {rate['median']:.0f} / {rate['min']:.0f} | "
+              f"{c['median']:.0f} / {c['p99']:.0f} | "
               f"{h['p99']:.1f} | {solve} | {most} |")
 EOF

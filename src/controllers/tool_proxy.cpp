@@ -86,6 +86,10 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
   const std::int32_t capacity = pair_capacity_;
   const auto heap_end = constraints_.begin() + capacity;
   for (const SpherePairContact& p : pairs) {
+    if (!seated_ && p.volume > 0.f) {
+      inside_ = true;  // begun inside: no side to keep yet, the constraints are not needed
+      return;
+    }
     const Vec3 a = transform_point(section.world_from_a, centre(p.sphere_a_local));
     const Vec3 b = transform_point(section.world_from_b, centre(p.sphere_b_local));
     const double distance = norm(b - a);
@@ -233,9 +237,8 @@ void ToolProxy::on_step(double time_s) {
   out.reach_m = options_.step_m;
   // the tool appears where the handle is, as without a proxy; if that is inside an object it has no
   // side to keep, so it follows the handle freely (zero force) until it is out of every object
-  bool inside = false;
-  for (std::int32_t k = 0; k < constraint_count_ && !seated_; ++k)
-    inside |= constraints_[static_cast<std::size_t>(k)].gap < 0.0;
+  const bool inside = inside_;
+  inside_ = false;
   if (!placed_ || (!seated_ && inside)) {
     proxy_ = target;
     if (placed_) free_updates_.fetch_add(1, std::memory_order_relaxed);

@@ -152,6 +152,7 @@ class ToolProxy {
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
   bool seated_ = false;          // it has been out of every object: from then on it keeps its side
+  bool inside_ = false;          // before it is seated: this step's query found it overlapping
   Pose proxy_{};
   Pose queried_{};               // the tool pose this step's frames were queried at
   bool have_query_ = false;
