@@ -187,6 +187,27 @@ TEST(HapticSessionThreaded, TwoSecondSessionRunsAllThreadsAndEndsWithZeroForce) 
   std::filesystem::remove_all(cache);
 }
 
+// The 6-DOF proxy on its threads: the collision thread moves the tool, the haptic thread renders
+// the spring to it; the small scene's stylus is pressed into the bunny and kept out of it.
+TEST(HapticSessionThreaded, TheProxyRunsOnTheCollisionThreadAndEndsWithZeroForce) {
+  const auto cache = testing::fresh_cache("threaded_proxy");
+  auto scene = parse_scene(testing::small_scene_json(), "small.json", testing::test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  SessionOptions options;
+  options.cache_dir = cache;
+  options.proxy = true;
+  auto session = HapticSession::create(*scene, options);
+  ASSERT_TRUE(session.has_value()) << session.error().message;
+  ASSERT_TRUE((*session)->run(1.5, [](const SessionState&) {}).has_value());
+  const SessionReport& r = (*session)->report();
+  EXPECT_TRUE(r.proxy);
+  EXPECT_GT(r.proxy_stats.updates, 30u) << "a loose bound for sanitizer builds";
+  EXPECT_EQ(r.force_nonfinite, 0u);
+  EXPECT_LE(r.force_max_n, 6.0 + 1e-9);
+  EXPECT_FALSE((*session)->world().running());
+  std::filesystem::remove_all(cache);
+}
+
 // The non-blocking lifecycle: the owner polls the newest state and the contact events while the
 // haptic and collision threads run, then stops; a second thread reads the state at the same time.
 TEST(HapticSessionThreaded, StartPollStopReadsContactAndForceAndEndsAtZero) {
