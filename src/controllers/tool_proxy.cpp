@@ -40,6 +40,42 @@ double wanted_step_of(const Pose& from, const Pose& target, double radius, doubl
   return length;
 }
 
+// Coulomb friction on the proxy's translation (the god-object's friction cone). `from` is where the
+// proxy was, `free` the translation the constraints allow towards the handle without friction, `n`
+// the surface's normal. The proxy keeps its place along the surface (it takes only the normal part
+// of the step) while the handle pulls it sideways by at most mu_s (mu_d once sliding) times how deep
+// the handle presses; beyond, it slides until the pull is mu_d times the depth. The result is moved
+// back towards `free` as far as a constraint needs (each is linear in it, and `free` meets them).
+Vec3 friction_step(const Vec3& from, const Vec3& free, const Vec3& handle, const Vec3& n, double mu_s, double mu_d,
+                   bool& sliding, std::span<const forcecomp::ProxyConstraint> rows, const Vec3& w) {
+  const Vec3 normal_part = dot(free, n) * n;
+  const Vec3 e = handle - (from + normal_part);
+  const double depth = -dot(e, n);
+  if (!(depth > 0.0)) {
+    sliding = false;
+    return free;
+  }
+  const Vec3 pull = e + depth * n;  // the handle's offset along the surface
+  const double pull_length = norm(pull);
+  Vec3 t = normal_part;
+  sliding = pull_length > (sliding ? mu_d : mu_s) * depth;
+  if (sliding) {
+    Vec3 move = pull * (1.0 - mu_d * depth / pull_length);
+    const double cap = norm(free - normal_part);  // no farther than the frictionless step
+    if (norm(move) > cap) move = move * (cap / norm(move));
+    t += move;
+  }
+  double back = 0.0;
+  for (const forcecomp::ProxyConstraint& c : rows) {
+    const double turn = dot(cross(c.lever, c.normal), w) + c.gap;
+    const double at_t = dot(c.normal, t) + turn;
+    if (at_t >= -1e-12) continue;  // met, up to rounding (an active row is met exactly)
+    const double at_free = dot(c.normal, free) + turn;
+    back = at_free > at_t ? std::max(back, -at_t / (at_free - at_t)) : 1.0;
+  }
+  return t + std::min(back, 1.0) * (free - t);
+}
+
 void raise_max(std::atomic<double>& max, double value) {
   if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
 }
@@ -66,14 +102,16 @@ void ToolProxy::bind() {
   step_connection_ = world_->on_step().connect<&ToolProxy::on_step>(*this);
 }
 
-bool ToolProxy::is_watched(std::int32_t object) const {
-  return std::find(watched_.begin(), watched_.end(), object) != watched_.end();
+std::int32_t ToolProxy::watched_index(std::int32_t object) const {
+  for (std::size_t i = 0; i < watched_.size(); ++i)
+    if (watched_[i].id == object) return static_cast<std::int32_t>(i);
+  return -1;
 }
 
 void ToolProxy::on_collision(collette::ObjectId, collette::ObjectId b, const ContactFrame& frame) {
   if (b != tool_) return;
   for (const ContactSection& section : frame.sections())
-    if (is_watched(section.object_a)) add_section(frame, section);
+    if (watched_index(section.object_a) >= 0) add_section(frame, section);
 }
 
 // Each leaf pair of the section becomes a constraint: the gap between its spheres (less what the
@@ -98,8 +136,11 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
     const double rb = static_cast<double>(p.sphere_b_local.radius);
     const double gap =
         distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
-    const forcecomp::ProxyConstraint c{.normal = n, .lever = (b - rb * n) - section.world_from_b.position, .gap = gap};
-    if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m);
+    const forcecomp::ProxyConstraint c{.normal = n,
+                                       .lever = (b - rb * n) - section.world_from_b.position,
+                                       .gap = gap,
+                                       .tag = watched_index(section.object_a)};
+    if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m, c.tag);
     // beyond the capacity the nearest pairs are kept (a heap on the gap, largest on top); the step
     // shrinks to the smallest gap left out
     const auto by_gap = [](const forcecomp::ProxyConstraint& x, const forcecomp::ProxyConstraint& y) {
@@ -123,13 +164,14 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
 // (e = smoothing_m), is never more than the smallest gap and is smooth where the smallest one has
 // kinks (between the caps of a packed face): summed here pair by pair, a constraint per tool sphere.
 void ToolProxy::add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal,
-                              double gap) {
+                              double gap, std::int32_t tag) {
   if (leaf < 0 || static_cast<std::size_t>(leaf) >= smooth_.size()) return;
   SmoothLeaf& s = smooth_[static_cast<std::size_t>(leaf)];
   if (s.weight == 0.0) {
     touched_.push_back(leaf);  // reserved for every leaf: no allocation
     s.centre = centre_world;
     s.radius = radius;
+    s.tag = tag;
   }
   const double w = std::exp(-gap / options_.smoothing_m);
   s.weight += w;
@@ -147,11 +189,39 @@ void ToolProxy::append_smooth(const Pose& proxy) {
       const Vec3 n = gradient / length;
       constraints_[static_cast<std::size_t>(constraint_count_++)] = {
           .normal = n, .lever = (s.centre - s.radius * n) - proxy.position,
-          .gap = (soft_gap + options_.penetration_m) / length};
+          .gap = (soft_gap + options_.penetration_m) / length,
+          .tag = s.tag};
     }
     s = {};
   }
   touched_.clear();
+}
+
+// The contact's normal and friction from the constraints holding the proxy (the largest
+// coefficients of the objects they are with); `active` indexes `rows`, or null: the first `count`.
+ToolProxy::HoldingFriction ToolProxy::holding_friction(std::span<const forcecomp::ProxyConstraint> rows,
+                                                       const std::int32_t* active, std::int32_t count) const {
+  HoldingFriction h;
+  Vec3 sum{};
+  for (std::int32_t i = 0; i < count; ++i) {
+    const forcecomp::ProxyConstraint& c = rows[static_cast<std::size_t>(active != nullptr ? active[i] : i)];
+    sum += c.normal;
+    if (c.tag >= 0 && static_cast<std::size_t>(c.tag) < watched_.size()) {
+      h.friction_static = std::max(h.friction_static, watched_[static_cast<std::size_t>(c.tag)].friction_static);
+      h.friction_dynamic = std::max(h.friction_dynamic, watched_[static_cast<std::size_t>(c.tag)].friction_dynamic);
+    }
+  }
+  h.normal = norm(sum) > 0.0 ? normalized(sum) : Vec3{};
+  return h;
+}
+
+// The mean normal of the pairs in contact (within a tenth of a millimetre of their allowed depth),
+// for the friction cone; `holding` when there are none.
+Vec3 ToolProxy::contact_normal(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& holding) const {
+  Vec3 sum{};
+  for (const forcecomp::ProxyConstraint& c : rows)
+    if (c.gap < 1e-4) sum += c.normal;
+  return norm(sum) > 0.0 ? normalized(sum) : holding;
 }
 
 // One god-object step from `from` towards `target`: the wanted step, shortened so that no point of
@@ -196,6 +266,18 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
       step.rotation = step.rotation * (limit / moved);
     }
   }
+  HoldingFriction held = holding_friction(rows, step.active_index, rows.empty() ? 0 : step.active);
+  out.friction_static = held.friction_static;
+  out.friction_dynamic = held.friction_dynamic;
+  if (held.friction_static > 0.0) held.normal = contact_normal(rows, held.normal);
+  out.contact_normal = held.normal;
+  if (step.active > 0 && held.friction_static > 0.0 && norm(held.normal) > 0.0)
+    step.translation = friction_step(from.position, step.translation, target.position, held.normal,
+                                     held.friction_static, held.friction_dynamic, sliding_, rows,
+                                     turns ? step.rotation : w);
+  else
+    sliding_ = false;
+  out.sliding = sliding_;
   const Quat turn = quat_from_rotation_vector(turns ? step.rotation : w);
   Pose next;
   next.position = from.position + step.translation;
@@ -217,9 +299,16 @@ double ToolProxy::wanted_step(const Pose& from, const Pose& target, double limit
 Pose ToolProxy::slide(const ProxyState& state, const Pose& world_from_handle_tool) {
   Vec3 t, w;
   wanted_step(state.world_from_proxy, world_from_handle_tool, state.reach_m / std::sqrt(2.0), t, w);
-  const forcecomp::ProxyStep step =
-      state.active > 0 ? slide_solver_.solve({state.holding, static_cast<std::size_t>(state.active)}, t, w)
-                       : forcecomp::ProxyStep{.translation = t, .rotation = w};
+  const std::span<const forcecomp::ProxyConstraint> holding{state.holding, static_cast<std::size_t>(state.active)};
+  forcecomp::ProxyStep step = state.active > 0 ? slide_solver_.solve(holding, t, w)
+                                               : forcecomp::ProxyStep{.translation = t, .rotation = w};
+  if (state.active > 0 && state.friction_static > 0.0) {
+    bool sliding = state.sliding;
+    if (norm(state.contact_normal) > 0.0)
+      step.translation = friction_step(state.world_from_proxy.position, step.translation,
+                                       world_from_handle_tool.position, state.contact_normal, state.friction_static,
+                                       state.friction_dynamic, sliding, holding, step.rotation);
+  }
   Pose out;
   out.position = state.world_from_proxy.position + step.translation;
   out.rotation = normalized(quat_from_rotation_vector(step.rotation) * state.world_from_proxy.rotation);

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -221,6 +222,62 @@ TEST(ToolProxy, SmoothingTakesPartOfTheGrainOutOfAPackedFace) {
   // measured: 19.0 % and 10.8 %; issue 23 asks for 1 %, which the soft minimum does not reach
   EXPECT_LT(smooth.relative, 0.8 * raw.relative);
   EXPECT_GT(smooth.normal_n, 1.5);  // pressed 1.5 mm with 1500 N/m: about 2.2 N
+}
+
+// Friction as a cone on the proxy: a ball pressed into a packed face with about 2 N and pulled
+// sideways sticks until the sideways force is mu_s times the normal force, then slides at mu_d.
+// The reference is Coulomb's law on the spring force the device would feel.
+TEST(ToolProxy, FrictionSticksUntilMuStaticThenSlidesAtMuDynamic) {
+  const Packed slab = [] {
+    collette::TriangleMesh m = box_mesh({0.1, 0.1, 0.02});
+    for (Vec3& v : m.vertices) v.z -= 0.01;
+    return pack(m, 10000);
+  }();
+  const auto ball = std::make_shared<const collette::SphereTree>(
+      *collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}}));
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  const auto slab_id = world.add_object({.tree = slab.tree, .is_static = true, .name = "slab"});
+  const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
+  ASSERT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball, {.enabled = true}, true);
+  proxy.watch(*slab_id, 0.6, 0.4);
+  proxy.bind();
+  const double stiffness = 1500.0;
+  Pose handle;
+  ProxyState state{};
+  double peak_ratio = 0.0;           // the largest sideways / normal force before the proxy first slid
+  double break_ratio = 0.0;          // that ratio at the tick before it first slid
+  bool slid = false;
+  std::vector<double> sliding_ratios;  // while it slides, after the breakaway
+  double last_ratio = 0.0;
+  for (int i = 0; i < 4000; ++i) {
+    // down onto the face, then the handle moves sideways at 1 cm/s
+    const double x = i < 1000 ? -0.01 : -0.01 + 0.00001 * (i - 1000);
+    handle.position = {x, 0.0, std::max(0.02 - 0.00005 * i, 0.005 - 0.0015)};
+    proxy.set_target(handle);
+    world.step(1e-3 * i);
+    if (const ProxyState* st = proxy.take()) state = *st;
+    if (i < 1100) continue;
+    const Vec3 f = stiffness * (proxy.slide(state, handle).position - handle.position);
+    const double ratio = std::hypot(f.x, f.y) / f.z;
+    if (!slid && state.sliding) break_ratio = peak_ratio > 0.0 ? last_ratio : ratio;
+    slid |= state.sliding;
+    if (!slid) peak_ratio = std::max(peak_ratio, ratio);
+    last_ratio = ratio;
+    if (state.sliding && i > 2000) sliding_ratios.push_back(ratio);
+  }
+  ASSERT_TRUE(slid) << "the handle moved 3 cm sideways: the proxy must have broken away";
+  // the breakaway: the pull reaches mu_s times the normal force about the contact's normal, which
+  // the packing's grain tilts by a few degrees from the face's (measured 0.71 for 0.6 on this slab,
+  // 18 % high; the sliding force is within 2 %)
+  EXPECT_NEAR(break_ratio, 0.6, 0.15);
+  EXPECT_LT(peak_ratio, 0.6 + 0.2);
+  ASSERT_GT(sliding_ratios.size(), 500u);
+  std::sort(sliding_ratios.begin(), sliding_ratios.end());
+  const double median = sliding_ratios[sliding_ratios.size() / 2];
+  std::printf("friction on the proxy: breakaway at %.3f (mu_s 0.6; largest before it %.3f), sliding median %.3f (mu_d 0.4)\n",
+              break_ratio, peak_ratio, median);
+  EXPECT_NEAR(median, 0.4, 0.04);
 }
 
 // The whole session (scenes/thin_wall.json): a simulated hand pulls the 1 cm ball 3 cm through a

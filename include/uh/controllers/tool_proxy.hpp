@@ -24,6 +24,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "uh/collette/collision_world.hpp"
@@ -65,6 +66,15 @@ struct ProxyState {
   std::int32_t active = 0;
   forcecomp::ProxyConstraint holding[6] = {};
   double reach_m = 0.0;          ///< how far a point may move from the proxy before the next step [m]
+  /// Coulomb friction of the contact holding it (the object's and the tool's materials combined):
+  /// the proxy keeps its place along the surface until the handle pulls it sideways by more than
+  /// friction_static times how deep it presses, then trails it at friction_dynamic.
+  double friction_static = 0.0;
+  double friction_dynamic = 0.0;
+  bool sliding = false;          ///< broke away (the dynamic coefficient holds) or sticking
+  /// The surface's normal the friction cone is about: the mean of the normals of every pair in
+  /// contact, not only the few holding it, so that the packing's grain tilts it less [unit, world].
+  Vec3 contact_normal{};
 };
 
 /// What the proxy did so far. Plain data.
@@ -90,7 +100,11 @@ class ToolProxy {
 
   /// Pairs with `object` constrain the proxy (others, such as other tools, pass through).
   /// Controlling thread, before bind().
-  void watch(collette::ObjectId object) { watched_.push_back(object); }
+  /// With the Coulomb friction of the pair (forcecomp::combine_materials), rendered on the proxy
+  /// as a friction cone (a stick point, breakaway at `friction_static`, sliding at `friction_dynamic`).
+  void watch(collette::ObjectId object, double friction_static = 0.0, double friction_dynamic = 0.0) {
+    watched_.push_back({object, friction_static, friction_dynamic});
+  }
   /// Connects to the world's OnCollision and OnStep. Controlling thread, before the threads start.
   void bind();
 
@@ -117,8 +131,17 @@ class ToolProxy {
   double radius_m() const { return solver_.options().radius_m; }
 
  private:
-  bool is_watched(std::int32_t object) const;
-  void add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal, double gap);
+  std::int32_t watched_index(std::int32_t object) const;  // -1: not watched
+  struct HoldingFriction {
+    Vec3 normal{};
+    double friction_static = 0.0;
+    double friction_dynamic = 0.0;
+  };
+  Vec3 contact_normal(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& holding) const;
+  HoldingFriction holding_friction(std::span<const forcecomp::ProxyConstraint> rows, const std::int32_t* active,
+                                   std::int32_t count) const;
+  void add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal, double gap,
+                     std::int32_t tag);
   void append_smooth(const Pose& proxy);
   void add_section(const ContactFrame& frame, const ContactSection& section);
   Pose advance(const Pose& from, const Pose& target, ProxyState& out);
@@ -129,7 +152,13 @@ class ToolProxy {
   ToolProxyOptions options_;
   forcecomp::ProxySolver solver_;        // collision thread
   forcecomp::ProxySolver slide_solver_;  // haptic thread (six constraints)
-  std::vector<collette::ObjectId> watched_;
+  struct WatchedObject {
+    collette::ObjectId id;
+    double friction_static;
+    double friction_dynamic;
+  };
+  std::vector<WatchedObject> watched_;
+  bool sliding_ = false;  // collision thread: the proxy broke away from its stick point
   ScopedConnection collision_connection_;
   ScopedConnection step_connection_;
   LatestValue<Pose> target_;       // haptic thread -> collision thread
@@ -145,6 +174,7 @@ class ToolProxy {
     Vec3 gradient{};      // sum exp(-gap_i / e) n_i
     Vec3 centre{};        // the tool sphere's centre, world frame [m]
     double radius = 0.0;
+    std::int32_t tag = -1;
   };
   std::vector<SmoothLeaf> smooth_;
   std::vector<std::int32_t> touched_;

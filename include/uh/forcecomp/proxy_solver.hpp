@@ -34,6 +34,7 @@ struct ProxyConstraint {
   Vec3 normal{};  ///< unit, world frame: the direction that moves the tool out of the object
   Vec3 lever{};   ///< contact point minus the proxy's origin, world frame [m]
   double gap = 0.0;  ///< how far the contact may still close along `normal` [m]; < 0: too deep already
+  std::int32_t tag = -1;  ///< the caller's (which object it is with); the solver does not read it
 };
 static_assert(std::is_trivially_copyable_v<ProxyConstraint>);
 
