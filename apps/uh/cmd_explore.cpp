@@ -25,6 +25,7 @@ struct ExploreArgs {
   std::uint64_t seed = 1;
   double haptic_hz = 0.0;
   int ticks_per_collision = 1;
+  std::string proxy;  // "on", "off" or "" (the scene's)
 };
 
 nlohmann::json optional_number(const std::optional<double>& v) {
@@ -44,6 +45,7 @@ int explore(const ExploreArgs& args) {
   options.ticks_per_collision_step = args.ticks_per_collision;
   controllers::SessionOptions session;
   session.cache_dir = controllers::default_cache_dir();
+  if (!args.proxy.empty()) session.proxy = args.proxy == "on";
   std::unique_ptr<ProgressBar> bar;
   std::string bar_label;
   session.build_progress = [&](const std::string& what, double fraction) {
@@ -133,6 +135,8 @@ void add_explore_command(CLI::App& app, CommandRunner& runner) {
   e->add_option("--seed", args.seed, "where on each object and in which directions to stroke (default 1)");
   e->add_option("--haptic-hz", args.haptic_hz, "override the haptic rate [Hz]")
       ->check(CLI::Range(1.0, 10000.0));
+  e->add_option("--proxy", args.proxy, "explore through the 6-DOF proxy (on) or the penalty path (off), whatever the scene says")
+      ->check(CLI::IsMember({"on", "off"}));
   e->add_option("--ticks-per-collision", args.ticks_per_collision,
                 "haptic ticks per collision step (default 1)")
       ->check(CLI::Range(1, 1000));
