@@ -208,7 +208,9 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       const forcecomp::ContactMaterial material =
           forcecomp::combine_materials(scene.objects[i].material, tool.material, tool.force);
       rig->force_controller->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage, &material);
-      if (rig->proxy) rig->proxy->watch(object_ids[i], material.friction_static, material.friction_dynamic);
+      if (rig->proxy)
+        rig->proxy->watch(object_ids[i], material.friction_static, material.friction_dynamic, material.object_texture,
+                          material.tool_texture);
     }
     if (rig->proxy) rig->proxy->bind();
     rig->bridging_controller = std::make_unique<BridgingController>(world, rig->tool_id, tool.workspace,

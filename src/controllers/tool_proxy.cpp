@@ -119,6 +119,12 @@ void ToolProxy::on_collision(collette::ObjectId, collette::ObjectId b, const Con
 void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& section) {
   queried_ = section.world_from_b;
   have_query_ = true;
+  const std::int32_t tag = watched_index(section.object_a);
+  const WatchedObject& watched = watched_[static_cast<std::size_t>(tag)];
+  const bool textured = watched.object_texture.kind != forcecomp::TextureKind::kNone ||
+                        watched.tool_texture.kind != forcecomp::TextureKind::kNone;
+  const Pose object_from_world = inverse(section.world_from_a);
+  const Pose tool_from_world = inverse(section.world_from_b);
   const auto pairs = frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
                                            static_cast<std::size_t>(section.pair_count));
   const std::int32_t capacity = pair_capacity_;
@@ -134,12 +140,17 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
     const Vec3 n = distance > 1e-12 ? (b - a) / distance
                                     : Vec3{p.normal_world[0], p.normal_world[1], p.normal_world[2]};
     const double rb = static_cast<double>(p.sphere_b_local.radius);
-    const double gap =
-        distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
+    double gap = distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
+    if (textured) {
+      // the relief where the pair touches, on the object's sphere and on the tool's
+      const Vec3 on_object = a + static_cast<double>(p.sphere_a_local.radius) * n;
+      gap -= forcecomp::texture_height(watched.object_texture, transform_point(object_from_world, on_object)) +
+             forcecomp::texture_height(watched.tool_texture, transform_point(tool_from_world, b - rb * n));
+    }
     const forcecomp::ProxyConstraint c{.normal = n,
                                        .lever = (b - rb * n) - section.world_from_b.position,
                                        .gap = gap,
-                                       .tag = watched_index(section.object_a)};
+                                       .tag = tag};
     if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m, c.tag);
     // beyond the capacity the nearest pairs are kept (a heap on the gap, largest on top); the step
     // shrinks to the smallest gap left out

@@ -32,6 +32,7 @@
 #include "uh/core/delegator.hpp"
 #include "uh/core/latency_histogram.hpp"
 #include "uh/core/latest_value.hpp"
+#include "uh/forcecomp/material.hpp"
 #include "uh/forcecomp/proxy_solver.hpp"
 
 namespace uh::controllers {
@@ -102,8 +103,12 @@ class ToolProxy {
   /// Controlling thread, before bind().
   /// With the Coulomb friction of the pair (forcecomp::combine_materials), rendered on the proxy
   /// as a friction cone (a stick point, breakaway at `friction_static`, sliding at `friction_dynamic`).
-  void watch(collette::ObjectId object, double friction_static = 0.0, double friction_dynamic = 0.0) {
-    watched_.push_back({object, friction_static, friction_dynamic});
+  /// With the textures of the pair (`object_texture` in the object's frame, `tool_texture` in the
+  /// tool's, forcecomp::texture_height): each raises the surface the proxy rests on by its height
+  /// where a pair touches, so the proxy rides over the texture's relief.
+  void watch(collette::ObjectId object, double friction_static = 0.0, double friction_dynamic = 0.0,
+             const forcecomp::Texture& object_texture = {}, const forcecomp::Texture& tool_texture = {}) {
+    watched_.push_back({object, friction_static, friction_dynamic, object_texture, tool_texture});
   }
   /// Connects to the world's OnCollision and OnStep. Controlling thread, before the threads start.
   void bind();
@@ -156,6 +161,8 @@ class ToolProxy {
     collette::ObjectId id;
     double friction_static;
     double friction_dynamic;
+    forcecomp::Texture object_texture;
+    forcecomp::Texture tool_texture;
   };
   std::vector<WatchedObject> watched_;
   bool sliding_ = false;  // collision thread: the proxy broke away from its stick point
