@@ -621,7 +621,8 @@ Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, co
 
 Result<std::string> read_scene_file(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return Error{fmt::format("{}: cannot open the scene file", path.string())};
+  if (!std::filesystem::exists(path, ec))
+    return Error{fmt::format("{}: cannot open the scene file", path.string())};
   return read_regular_file(path, kMaxSceneFileBytes);
 }
 

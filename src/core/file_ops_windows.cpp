@@ -90,7 +90,7 @@ std::error_code open_for_reading(const std::filesystem::path& path, int& fd, Fil
     return error;
   }
   const auto type = st.st_mode & _S_IFMT;
-  kind = type == _S_IFREG ? FileKind::kRegular
+  kind = type == _S_IFREG   ? FileKind::kRegular
          : type == _S_IFCHR ? FileKind::kDevice
          : type == _S_IFIFO ? FileKind::kFifo
                             : FileKind::kOther;

@@ -40,7 +40,8 @@ class OpenFile {
 };
 
 // Opens `path` and checks its kind and size: the size, or the error naming the path.
-Result<std::uint64_t> open_checked(const std::filesystem::path& path, std::uint64_t max_bytes, OpenFile& file) {
+Result<std::uint64_t> open_checked(const std::filesystem::path& path, std::uint64_t max_bytes,
+                                   OpenFile& file) {
   detail::FileKind kind = detail::FileKind::kOther;
   std::uint64_t size = 0;
   if (const std::error_code ec = detail::open_for_reading(path, file.fd, kind, size))
@@ -68,7 +69,8 @@ Result<std::string> read_regular_file(const std::filesystem::path& path, std::ui
       bytes.resize(std::min<std::uint64_t>(max_bytes + 1, total + (std::uint64_t{1} << 16)));
     }
     std::size_t got = 0;
-    if (const std::error_code ec = detail::read_some(file.fd, bytes.data() + total, bytes.size() - total, got))
+    if (const std::error_code ec =
+            detail::read_some(file.fd, bytes.data() + total, bytes.size() - total, got))
       return Error{fmt::format("{}: read error: {}", path.string(), ec.message())};
     if (got == 0) break;
     total += got;

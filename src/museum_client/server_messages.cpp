@@ -140,7 +140,8 @@ Result<ServerMessage> parse_welcome(const json& m, Reader& r) {
     for (const json& t : *targets)
       if (t.is_string()) w.targets.push_back(t.get<std::string>());
   }
-  if (const auto key = m.find("seat_key"); key != m.end() && key->is_string()) w.seat_key = key->get<std::string>();
+  if (const auto key = m.find("seat_key"); key != m.end() && key->is_string())
+    w.seat_key = key->get<std::string>();
   if (!r.error.empty()) return Error{r.error};
   return ServerMessage{std::move(w)};
 }

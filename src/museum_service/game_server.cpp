@@ -95,13 +95,16 @@ constexpr int kMaxCatchUpTicks = 5;
 class GameHub final : public service::Endpoint {
  public:
   GameHub(asio::io_context& io, const museum::Level& level, std::uint64_t seed, std::string token,
-          int snapshot_every, double speed, double resume_delay_s)
+          int snapshot_every, double speed, double resume_delay_s, double seat_hold_s)
       : level_(level),
-        resume_delay_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(resume_delay_s))),
+        resume_delay_(
+            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(resume_delay_s))),
+        seat_hold_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seat_hold_s))),
         state_(museum::new_game(level, seed)),
         token_(std::move(token)),
         snapshot_every_(snapshot_every),
-        tick_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(level.rules.tick_s / speed))),
+        tick_(std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double>(level.rules.tick_s / speed))),
         timer_(io) {
     state_.paused = true;
     next_tick_ = Clock::now();
@@ -147,6 +150,7 @@ class GameHub final : public service::Endpoint {
       move_ = {};
       actions_.clear();
     }
+    if (role == Role::phantom) phantom_left_at_ = Clock::now();
     if (role == Role::vive || role == Role::phantom) {
       log_players("{} dropped out; the round pauses until it reconnects", to_string(role));
       update_pause();
@@ -177,9 +181,10 @@ class GameHub final : public service::Endpoint {
     ++refused_;
     // a few per client, and those escaped: a client cannot flood the log nor forge its lines
     if (++c.refusals <= kLoggedRefusalsPerClient)
-      log::warn("museum: client {} ({}): refused {}: {}{}", id, c.peer->address(),
-                type.empty() ? std::string("a message") : loggable(type), loggable(message),
-                c.refusals == kLoggedRefusalsPerClient ? " (further refusals of this client are not logged)" : "");
+      log::warn(
+          "museum: client {} ({}): refused {}: {}{}", id, c.peer->address(),
+          type.empty() ? std::string("a message") : loggable(type), loggable(message),
+          c.refusals == kLoggedRefusalsPerClient ? " (further refusals of this client are not logged)" : "");
     c.peer->send(error_message(req_id, type, message).dump());
   }
 
@@ -233,18 +238,22 @@ class GameHub final : public service::Endpoint {
                     fmt::format("protocol {} is not supported; this server speaks {}", h.protocol,
                                 kGameProtocolVersion));
     if (!token_.empty() && !service::same_token(h.token, token_))
-      return refuse_hello(id, c, req_id, h.token.empty() ? "this server needs a token" : "the token is wrong");
+      return refuse_hello(id, c, req_id,
+                          h.token.empty() ? "this server needs a token" : "the token is wrong");
     if (h.role != Role::watcher && role_connected(h.role))
       return refuse(id, c, req_id, type,
                     fmt::format("the {} role is taken by another client", to_string(h.role)));
-    // Phantom's seat is its station's: once taken, only the holder of its key takes it again
-    if (h.role == Role::phantom && !phantom_seat_key_.empty() && !service::same_token(h.seat_key, phantom_seat_key_))
-      return refuse_hello(id, c, req_id,
-                          h.seat_key.empty()
-                              ? "the phantom seat is held for the station that took it: a reconnect sends the "
-                                "seat_key of its first welcome"
-                              : "the seat_key is wrong");
-    if (h.role == Role::phantom && phantom_seat_key_.empty()) phantom_seat_key_ = make_seat_key();
+    // Phantom's seat is its station's: while it is held, only the holder of its key takes it again
+    const bool same_station =
+        !phantom_seat_key_.empty() && service::same_token(h.seat_key, phantom_seat_key_);
+    if (h.role == Role::phantom && seat_held() && !same_station)
+      return refuse_hello(
+          id, c, req_id,
+          h.seat_key.empty() ? "the phantom seat is held for the station that took it: a reconnect sends the "
+                               "seat_key of its first welcome"
+                             : "the seat_key is wrong");
+    // a new station (the first, or one after the hold) gets a new key
+    if (h.role == Role::phantom && !same_station) phantom_seat_key_ = make_seat_key();
     c.greeted = true;
     c.role = h.role;
     json targets = json::array();
@@ -252,8 +261,12 @@ class GameHub final : public service::Endpoint {
       targets.push_back(
           level_.artifact_kinds[static_cast<std::size_t>(state_.target_kinds[static_cast<std::size_t>(t)])]);
     // no seed: a client given it could deal the round itself and know every genuine piece
-    json welcome = {{"type", "welcome"},         {"id", req_id},          {"protocol", kGameProtocolVersion},
-                    {"role", to_string(h.role)}, {"level", level_json(level_)}, {"targets", targets}};
+    json welcome = {{"type", "welcome"},
+                    {"id", req_id},
+                    {"protocol", kGameProtocolVersion},
+                    {"role", to_string(h.role)},
+                    {"level", level_json(level_)},
+                    {"targets", targets}};
     if (h.role == Role::phantom) welcome["seat_key"] = phantom_seat_key_;
     c.peer->send(welcome.dump());
     if (h.role == Role::vive || h.role == Role::phantom) {
@@ -300,6 +313,12 @@ class GameHub final : public service::Endpoint {
   // the round plays while both players are connected; after a pause it resumes resume_delay_ after
   // both are back (play_tick() lifts the pause then), the first start at once: a player who
   // reconnects over and over never moves the paused round
+  // Phantom's seat is held for its station on a server with a token (where token holders must not
+  // take it) for seat_hold_ after the station dropped out; then another may sit down
+  bool seat_held() const {
+    return !token_.empty() && phantom_left_at_ && Clock::now() - *phantom_left_at_ < seat_hold_;
+  }
+
   void update_pause() {
     const bool both = role_connected(Role::vive) && role_connected(Role::phantom);
     if (!both) {
@@ -393,6 +412,7 @@ class GameHub final : public service::Endpoint {
 
   museum::Level level_;
   Clock::duration resume_delay_;
+  Clock::duration seat_hold_;
   museum::GameState state_;
   std::string token_;
   int snapshot_every_;
@@ -408,8 +428,9 @@ class GameHub final : public service::Endpoint {
   std::optional<museum::Verdict> verdict_;  // for the first item on the table, at the next tick
   museum::Events events_;
   bool started_ = false;
-  std::optional<Clock::time_point> resume_at_;  // when a paused round plays again
-  std::string phantom_seat_key_;                // given in Phantom's first welcome
+  std::optional<Clock::time_point> resume_at_;        // when a paused round plays again
+  std::string phantom_seat_key_;                      // given in Phantom's first welcome
+  std::optional<Clock::time_point> phantom_left_at_;  // when Phantom's station last dropped out
   Clock::time_point failed_hellos_second_{};
   int failed_hellos_this_second_ = 0;
   LogBudget player_log_{20, std::chrono::minutes(1)};
@@ -438,6 +459,8 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
     return Error{fmt::format("speed {} is not within 0.1..20 (game seconds per second)", options.speed)};
   if (!(options.resume_delay_s >= 0.0 && options.resume_delay_s <= 600.0))
     return Error{fmt::format("resume delay {} s is not within 0..600 s", options.resume_delay_s)};
+  if (!(options.seat_hold_s >= 0.0 && options.seat_hold_s <= 3600.0))
+    return Error{fmt::format("seat hold {} s is not within 0..3600 s", options.seat_hold_s)};
   // snapshots every n rule ticks: the rate within 20..30 Hz nearest the one asked for
   const double tick_hz = 1.0 / options.level.rules.tick_s;
   const int every = std::max(1, static_cast<int>(std::lround(tick_hz / options.snapshot_hz)));
@@ -453,7 +476,7 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
        .program = "uh museum serve"},
       [&](asio::io_context& io) {
         auto made = std::make_unique<GameHub>(io, options.level, options.seed, options.token, every,
-                                              options.speed, options.resume_delay_s);
+                                              options.speed, options.resume_delay_s, options.seat_hold_s);
         hub = made.get();
         return made;
       });

@@ -177,12 +177,13 @@ std::string Hub::on_mesh_frame(ClientId id, const Client::PendingMesh& pending,
   // when done
   meshing_ = true;
   if (mesher_.joinable()) mesher_.join();
-  mesher_ = std::jthread([this, id, pending, generation = generation_, frame = std::vector<std::byte>(
-                                                                            bytes.begin(), bytes.end()),
+  mesher_ = std::jthread([this, id, pending, generation = generation_,
+                          frame = std::vector<std::byte>(bytes.begin(), bytes.end()),
                           mesh_dir = options_.cache_dir / "inline-meshes"] {
     auto decoded = decode_mesh_binary(frame, *pending.add->mesh_binary, add_object_label(*pending.add));
-    auto written = std::make_shared<Result<InlineMesh>>(
-        decoded ? write_inline_mesh(std::move(decoded).value(), mesh_dir) : Result<InlineMesh>(decoded.error()));
+    auto written =
+        std::make_shared<Result<InlineMesh>>(decoded ? write_inline_mesh(std::move(decoded).value(), mesh_dir)
+                                                     : Result<InlineMesh>(decoded.error()));
     boost::asio::post(io_, [this, id, pending, generation, written] {
       mesh_written(generation, id, pending, std::move(*written));
     });
@@ -273,9 +274,10 @@ void Hub::handle(ClientId id, Client& c, const json& req_id, const std::string& 
 std::string Hub::on_get_mesh(ClientId, Client& c, const json& req_id, const GetMesh& g) {
   if (!slot_) return "no scene is open";
   if (c.peer->queued_bytes() > kMaxQueuedBytesForMesh)
-    return fmt::format("{} bytes of replies wait to be sent to this connection; read them before asking for "
-                       "another mesh",
-                       c.peer->queued_bytes());
+    return fmt::format(
+        "{} bytes of replies wait to be sent to this connection; read them before asking for "
+        "another mesh",
+        c.peer->queued_bytes());
   auto made = slot_->mesh_replies.find(g.object);
   if (made == slot_->mesh_replies.end()) {
     auto mesh = scene_mesh(slot_->scene(), g.object);

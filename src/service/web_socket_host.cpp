@@ -274,9 +274,8 @@ struct WebSocketHost::Impl {
   // 503) without reading its request, and closed
   asio::awaitable<void> refuse(tcp::socket socket) {
     ++refusing;
-    const std::string body =
-        fmt::format("{}: too many connections (the limit is {}); try again later\n", options.program,
-                    options.max_connections);
+    const std::string body = fmt::format("{}: too many connections (the limit is {}); try again later\n",
+                                         options.program, options.max_connections);
     const std::string response = fmt::format(
         "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: "
         "{}\r\nConnection: close\r\n\r\n{}",

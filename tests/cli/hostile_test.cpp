@@ -44,9 +44,9 @@ class HostileTest : public ::testing::Test {
 
   std::unique_ptr<ChildProcess> uh(std::vector<std::string> args, const std::string& name) {
     args.insert(args.begin(), UH_CLI_PATH);
-    return std::make_unique<ChildProcess>(args,
-                                          std::vector<std::string>{"UH_CACHE_DIR=" + std::string(UH_TEST_CACHE_DIR), "CI=1"},
-                                          dir_ / (name + ".out"), dir_ / (name + ".err"));
+    return std::make_unique<ChildProcess>(
+        args, std::vector<std::string>{"UH_CACHE_DIR=" + std::string(UH_TEST_CACHE_DIR), "CI=1"},
+        dir_ / (name + ".out"), dir_ / (name + ".err"));
   }
 
   // The port a server printed after `prefix` ("...ws://127.0.0.1:PORT/ws"); 0 if it never did.
@@ -94,8 +94,9 @@ TEST_F(HostileTest, RunRefusesPathsThatAreNotRegularFiles) {
   auto finished = run->wait(120s);
   ASSERT_TRUE(finished.exited) << run->err();
   EXPECT_EQ(finished.code, 1) << run->err();
-  EXPECT_NE(run->err().find(fmt::format("field 'objects[0].mesh': {}: is a directory, not a file", dir_.string())),
-            std::string::npos)
+  EXPECT_NE(
+      run->err().find(fmt::format("field 'objects[0].mesh': {}: is a directory, not a file", dir_.string())),
+      std::string::npos)
       << run->err();
   auto zero = uh({"run", "/dev/zero", "--no-realtime"}, "zero");
   finished = zero->wait(120s);
@@ -118,7 +119,8 @@ TEST_F(HostileTest, ServeStopsItsSessionAndClosesClientsOnSighup) {
   ASSERT_TRUE(serve->signal(SIGHUP));
   test_support::beast::error_code ended;
   bool closed = false;
-  while (auto m = c.read(&ended)) closed = closed || ((*m)["type"] == "session" && (*m)["status"] == "closed");
+  while (auto m = c.read(&ended))
+    closed = closed || ((*m)["type"] == "session" && (*m)["status"] == "closed");
   EXPECT_TRUE(closed) << "the session was stopped and closed before the connection";
   EXPECT_EQ(c.close_reason().code, test_support::websocket::close_code::going_away) << ended.message();
   EXPECT_EQ(c.close_reason().reason, "the service is stopping");

@@ -16,8 +16,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
-#include <memory>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -302,29 +302,25 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   fs::remove_all(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest,
-                         ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false},
-                                           Interrupt{SIGINT, true}, Interrupt{SIGTERM, true},
-                                           Interrupt{SIGINT, false, true}, Interrupt{SIGTERM, false, true},
-                                           Interrupt{SIGINT, false, false, true},
-                                           Interrupt{SIGTERM, false, false, true},
-                                           Interrupt{SIGINT, false, false, false, true},
-                                           Interrupt{SIGTERM, false, false, false, true},
-                                           Interrupt{SIGINT, false, false, false, false, true},
-                                           Interrupt{SIGTERM, false, false, false, false, true},
-                                           Interrupt{SIGHUP, false}, Interrupt{SIGPIPE, false},
-                                           Interrupt{SIGQUIT, false}, Interrupt{SIGHUP, true},
-                                           Interrupt{SIGHUP, false, false, true}),
-                         [](const ::testing::TestParamInfo<Interrupt>& p) {
-                           std::string name = signal_name(p.param.signal_number);
-                           for (std::size_t i = 1; i < name.size(); ++i)
-                             name[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[i])));
-                           return name +
-                                  (p.param.view ? "WithView" : "") +
-                                  (p.param.force_dimension ? "OnForceDimension" : "") +
-                                  (p.param.open_haptics ? "OnOpenHaptics" : "") + (p.param.haply ? "OnHaply" : "") +
-                                  (p.param.two_devices ? "OnTwoDevices" : "");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Signals, RunSignalTest,
+    ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false}, Interrupt{SIGINT, true},
+                      Interrupt{SIGTERM, true}, Interrupt{SIGINT, false, true},
+                      Interrupt{SIGTERM, false, true}, Interrupt{SIGINT, false, false, true},
+                      Interrupt{SIGTERM, false, false, true}, Interrupt{SIGINT, false, false, false, true},
+                      Interrupt{SIGTERM, false, false, false, true},
+                      Interrupt{SIGINT, false, false, false, false, true},
+                      Interrupt{SIGTERM, false, false, false, false, true}, Interrupt{SIGHUP, false},
+                      Interrupt{SIGPIPE, false}, Interrupt{SIGQUIT, false}, Interrupt{SIGHUP, true},
+                      Interrupt{SIGHUP, false, false, true}),
+    [](const ::testing::TestParamInfo<Interrupt>& p) {
+      std::string name = signal_name(p.param.signal_number);
+      for (std::size_t i = 1; i < name.size(); ++i)
+        name[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[i])));
+      return name + (p.param.view ? "WithView" : "") + (p.param.force_dimension ? "OnForceDimension" : "") +
+             (p.param.open_haptics ? "OnOpenHaptics" : "") + (p.param.haply ? "OnHaply" : "") +
+             (p.param.two_devices ? "OnTwoDevices" : "");
+    });
 
 }  // namespace
 }  // namespace uh

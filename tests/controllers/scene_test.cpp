@@ -264,11 +264,12 @@ TEST(Scene, RefusesMeshesAndScenesThatAreNotRegularFiles) {
   const Case cases[] = {
       {dir.string(), fmt::format("field 'objects[0].mesh': {}: is a directory, not a file", dir.string())},
       {"/dev/zero", "field 'objects[0].mesh': /dev/zero: is a device, not a file"},
-      {fifo.string(), fmt::format("field 'objects[0].mesh': {}: is a FIFO (named pipe), not a file", fifo.string())},
+      {fifo.string(),
+       fmt::format("field 'objects[0].mesh': {}: is a FIFO (named pipe), not a file", fifo.string())},
   };
   for (const Case& c : cases) {
-    const auto scene =
-        parse_scene(replaced(good, R"("meshes/bunny_npm_3674.obj")", "\"" + c.mesh + "\""), "test.json", test_assets());
+    const auto scene = parse_scene(replaced(good, R"("meshes/bunny_npm_3674.obj")", "\"" + c.mesh + "\""),
+                                   "test.json", test_assets());
     ASSERT_FALSE(scene.has_value()) << c.mesh;
     EXPECT_NE(scene.error().message.find(c.expected), std::string::npos) << scene.error().message;
   }

@@ -318,8 +318,8 @@ TEST_F(SceneDocumentTest, AnInlineMeshIsCheckedLikeAFileAndStoredByContent) {
   const json object = {{"name", "inline"}, {"spheres", 200}, {"meters_per_unit", 0.01}};
   const auto mesh_dir = dir_ / "inline-meshes";
   // as the service does it: the mesh checked and written (off its network thread), then added
-  const auto add_inline_object = [&](const json& o, const collette::TriangleMesh& mesh)
-      -> Result<collette::MeshReport> {
+  const auto add_inline_object = [&](const json& o,
+                                     const collette::TriangleMesh& mesh) -> Result<collette::MeshReport> {
     auto written = write_inline_mesh(mesh, mesh_dir);
     if (!written) return written.error();
     if (auto added = doc_->add_inline_object(o, written->file); !added) return added.error();

@@ -173,7 +173,8 @@ TEST_F(ServerTest, PathsThatAreNotRegularFilesAreRefusedWithoutStoppingOthers) {
   Client other(port());
   other.hello();
   const json from_fifo = c.request({{"type", "open"}, {"scene", fifo.string()}}, "error");
-  EXPECT_NE(from_fifo["message"].get<std::string>().find("is a FIFO (named pipe), not a file"), std::string::npos)
+  EXPECT_NE(from_fifo["message"].get<std::string>().find("is a FIFO (named pipe), not a file"),
+            std::string::npos)
       << from_fifo;
   other.request({{"type", "ping"}}, "pong");
   const json from_zero = c.request({{"type", "open"}, {"scene", "/dev/zero"}}, "error");
@@ -182,7 +183,8 @@ TEST_F(ServerTest, PathsThatAreNotRegularFilesAreRefusedWithoutStoppingOthers) {
   EXPECT_NE(from_dir["message"].get<std::string>().find("is a directory, not a file"), std::string::npos);
   c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
   for (const std::string& mesh : {dir_.string(), std::string("/dev/zero"), fifo.string()}) {
-    const json e = c.request({{"type", "add_object"}, {"object", {{"name", "bad"}, {"mesh", mesh}}}}, "error");
+    const json e =
+        c.request({{"type", "add_object"}, {"object", {{"name", "bad"}, {"mesh", mesh}}}}, "error");
     EXPECT_NE(e["message"].get<std::string>().find("field 'objects[1].mesh': " + mesh + ": is a"),
               std::string::npos)
         << e;

@@ -41,6 +41,9 @@ struct GameServerOptions {
   /// A paused round plays again this long [s, wall clock] after both players are back (its first
   /// start is at once): a player who reconnects over and over never moves it. 0..600.
   double resume_delay_s = 1.0;
+  /// With a token: Phantom's seat is held this long [s] after its station dropped out; meanwhile
+  /// only a hello with the station's `seat_key` takes it (token holders cannot). 0..3600.
+  double seat_hold_s = 60.0;
   std::vector<service::StaticFile> files{};  ///< the browser client's files, if any
 };
 
