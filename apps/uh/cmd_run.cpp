@@ -9,6 +9,8 @@
 #include <optional>
 #include <string>
 
+#include <iterator>
+
 #include <fmt/format.h>
 
 #include "commands.hpp"
@@ -25,19 +27,32 @@
 namespace uh::cli {
 namespace {
 
-// SIGINT / SIGTERM during a run: the handler only records the signal and asks the session to stop
-// (a sig_atomic_t store and one lock-free atomic store, both async-signal-safe); the run then ends
-// as if its time were up: zero force, threads joined, summary printed, exit status 128 + signal.
+// Every way a terminal, a shell or a pipe ends a run: SIGINT (Ctrl-C), SIGTERM, SIGHUP (the
+// terminal or SSH session closed), SIGQUIT and SIGPIPE (the reader of stdout went away). The handler
+// only records the signal and asks the session to stop (a sig_atomic_t store and one lock-free
+// atomic store, both async-signal-safe); the run then ends as if its time were up: zero force,
+// threads joined, trace renamed into place, summary printed, exit status 128 + signal.
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE};
+
 volatile std::sig_atomic_t g_stop_signal = 0;
 std::atomic<controllers::HapticSession*> g_running_session{nullptr};
 static_assert(std::atomic<controllers::HapticSession*>::is_always_lock_free);
 
 extern "C" void on_stop_signal(int signal_number) {
-  g_stop_signal = signal_number;
+  // the first signal names the stop; a SIGPIPE from printing after it does not rename it
+  if (g_stop_signal == 0) g_stop_signal = signal_number;
   if (controllers::HapticSession* session = g_running_session.load()) session->request_stop();
 }
 
-// Routes SIGINT and SIGTERM to `session` while it lives; restores the previous handlers after.
+// "SIGHUP" for SIGHUP (glibc's abbreviation, as the kernel's headers name it)
+std::string signal_name(int signal_number) {
+  const char* abbreviation = sigabbrev_np(signal_number);
+  return abbreviation != nullptr ? std::string("SIG") + abbreviation : std::string("a signal");
+}
+
+// Routes the stop signals to `session` while it lives; restores the previous handlers after,
+// except SIGPIPE, which stays ignored: the summary written to a closed pipe fails quietly instead of
+// ending the program before its exit status.
 class StopOnSignals {
  public:
   explicit StopOnSignals(controllers::HapticSession& session) {
@@ -45,20 +60,21 @@ class StopOnSignals {
     struct sigaction action {};
     action.sa_handler = &on_stop_signal;
     sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &previous_int_);
-    sigaction(SIGTERM, &action, &previous_term_);
+    for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
+      sigaction(kStopSignals[i], &action, &previous_[i]);
   }
   ~StopOnSignals() {
-    sigaction(SIGINT, &previous_int_, nullptr);
-    sigaction(SIGTERM, &previous_term_, nullptr);
+    for (std::size_t i = 0; i < std::size(kStopSignals); ++i) {
+      if (kStopSignals[i] == SIGPIPE) previous_[i].sa_handler = SIG_IGN;
+      sigaction(kStopSignals[i], &previous_[i], nullptr);
+    }
     g_running_session.store(nullptr);
   }
   StopOnSignals(const StopOnSignals&) = delete;
   StopOnSignals& operator=(const StopOnSignals&) = delete;
 
  private:
-  struct sigaction previous_int_ {};
-  struct sigaction previous_term_ {};
+  struct sigaction previous_[std::size(kStopSignals)]{};
 };
 
 struct RunArgs {
@@ -239,7 +255,7 @@ int run_session(const RunArgs& args) {
     const int signal_number = g_stop_signal;
     std::fflush(stdout);
     std::fprintf(stderr, "uh: stopped by %s after %.2f s; the device was sent zero force\n",
-                 signal_number == SIGINT ? "SIGINT" : "SIGTERM", report.seconds);
+                 signal_name(signal_number).c_str(), report.seconds);
     return 128 + signal_number;
   }
   return 0;

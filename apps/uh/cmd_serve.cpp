@@ -46,8 +46,10 @@ int serve(const ServeArgs& args) {
 sigset_t block_stop_signals() {
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
+  // a closed terminal or SSH session (SIGHUP) and SIGQUIT stop as Ctrl-C does; a client gone
+  // away is a write error on its socket, never a SIGPIPE that ends the program
+  for (const int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&stop_signals, s);
+  std::signal(SIGPIPE, SIG_IGN);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   return stop_signals;
 }

@@ -30,10 +30,11 @@ void add_museum_station_command(CLI::App& museum, CommandRunner& runner);
 /// One piece of the blind player's evidence as `uh museum judge --json` and `uh museum play` print it.
 nlohmann::json evidence_json(const museum_players::FeatureDifference& f);
 
-/// Blocks SIGINT and SIGTERM in the calling thread, before a server's threads start (they inherit
-/// the mask, so no thread is interrupted by them); wait_for_stop_signal() then takes them.
+/// Blocks SIGINT, SIGTERM, SIGHUP and SIGQUIT (and ignores SIGPIPE) in the calling thread, before a server's
+/// threads start (they inherit the mask, so no thread is interrupted by them); wait_for_stop_signal() then
+/// takes them.
 sigset_t block_stop_signals();
-/// Waits for SIGINT or SIGTERM (blocked by block_stop_signals()); returns which came.
+/// Waits for SIGINT, SIGTERM, SIGHUP or SIGQUIT (blocked by block_stop_signals()); returns which came.
 int wait_for_stop_signal(const sigset_t& stop_signals);
 
 /// Prints "uh: <message>" to stderr and returns 1.

@@ -8,14 +8,14 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/regular_file.hpp"
+
 namespace uh::collette {
 
 Result<std::uint64_t> hash_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{fmt::format("{}: cannot open the file", path.string())};
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return Error{fmt::format("{}: read error", path.string())};
-  return ist_hash_bytes(std::as_bytes(std::span<const char>(bytes)));
+  auto bytes = read_regular_file(path, kMaxMeshFileBytes);
+  if (!bytes) return bytes.error();
+  return ist_hash_bytes(std::as_bytes(std::span<const char>(*bytes)));
 }
 
 SphereTree scale_sphere_tree(const SphereTree& tree, double factor) {

@@ -7,13 +7,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <tuple>
 
 #include "uh/core/atomic_file_writer.hpp"
+#include "uh/core/regular_file.hpp"
 
 namespace uh::collette {
 namespace {
@@ -337,19 +337,10 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
 
 Result<IstAsset> load_ist(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) return Error{name + ": cannot open .ist file: " + ec.message()};
-  if (size > kMaxFileBytes)
-    return Error{name + ": " + std::to_string(size) + " bytes is too large for a .ist file"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{name + ": cannot open .ist file for reading"};
-  std::vector<std::byte> bytes(static_cast<std::size_t>(size));
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size)
-    return Error{name + ": read error (got " + std::to_string(in.gcount()) + " of " + std::to_string(size) +
-                 " bytes)"};
-  return load_ist_from_memory(bytes, name);
+  // a regular file within the limit, read without blocking on a FIFO or a device
+  auto bytes = read_regular_file(path, kMaxFileBytes);
+  if (!bytes) return bytes.error();
+  return load_ist_from_memory(std::as_bytes(std::span<const char>(*bytes)), name);
 }
 
 Status save_ist(const std::filesystem::path& path, const IstAsset& asset) {

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "mesh_file_reader.hpp"
+#include "uh/core/regular_file.hpp"
 
 namespace uh::collette {
 namespace {
@@ -322,10 +323,11 @@ Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoad
   if (!std::filesystem::exists(path, ec)) {
     return Error{fmt::format("{}: file not found (looked for '{}')", name, path.string())};
   }
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    return Error{fmt::format("{}: not a regular file ('{}')", name, path.string())};
-  }
-  if (std::filesystem::file_size(path, ec) == 0) {
+  // a directory, FIFO or device is refused before the mesh library opens it (one would block or
+  // never end), and so is a file above the limit
+  const auto size = check_regular_file(path, kMaxMeshFileBytes);
+  if (!size) return size.error();
+  if (*size == 0) {
     return Error{fmt::format("{}: file is empty, no mesh to read", name)};
   }
   auto mesh = read_mesh_file(path);

@@ -9,13 +9,13 @@
 #include <charconv>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "mesh_file_reader.hpp"
 #include "uh/collette/mesh_import.hpp"
+#include "uh/core/regular_file.hpp"
 
 namespace uh::collette {
 namespace {
@@ -245,15 +245,11 @@ Result<TriangleMesh> parse_obj_or_stl(std::string_view bytes, const std::string&
 Result<TriangleMesh> read_obj_or_stl(const std::filesystem::path& path) {
   const std::string name = path.filename().string();
   if (!is_obj_or_stl(path)) return parse_obj_or_stl({}, name);  // the error naming the formats
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{fmt::format("{}: cannot open the mesh file", name)};
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  in.seekg(0, std::ios::beg);
-  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)), '\0');
-  if (size < 0 || !in.read(bytes.data(), size))
-    return Error{fmt::format("{}: cannot read the mesh file", name)};
-  return parse_obj_or_stl(bytes, name);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return Error{fmt::format("{}: cannot open the mesh file", name)};
+  auto bytes = read_regular_file(path, kMaxMeshFileBytes);
+  if (!bytes) return bytes.error();
+  return parse_obj_or_stl(*bytes, name);
 }
 
 std::string obj_text(const TriangleMesh& mesh, std::string_view comment) {

@@ -14,6 +14,8 @@
 #include "uh/collette/ist_file.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/core/atomic_file_writer.hpp"
+#include "uh/core/json_nesting.hpp"
+#include "uh/core/regular_file.hpp"
 
 namespace uh::controllers {
 namespace {
@@ -157,14 +159,21 @@ Status read_shape(const FieldReader& r, const json& j, const std::string& path, 
     const std::filesystem::path fp(p);
     return fp.is_absolute() ? fp : (base_dir / fp).lexically_normal();
   };
+  // a directory, FIFO or device is refused here, when the scene is read, not when it is packed
+  const auto check_file = [&](const std::filesystem::path& file, const char* key) -> Status {
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec))
+      return r.error(FieldReader::join(path, key), fmt::format("file not found: {}", file.string()));
+    if (auto checked = check_regular_file(file, kMaxMeshFileBytes); !checked)
+      return r.error(FieldReader::join(path, key), checked.error().message);
+    return Ok{};
+  };
   if (!mesh.empty()) {
     shape.mesh = resolve(mesh);
-    if (!std::filesystem::exists(shape.mesh))
-      return r.error(FieldReader::join(path, "mesh"), fmt::format("file not found: {}", shape.mesh.string()));
+    UH_CHECK(check_file(shape.mesh, "mesh"));
   } else {
     shape.ist = resolve(ist);
-    if (!std::filesystem::exists(shape.ist))
-      return r.error(FieldReader::join(path, "ist"), fmt::format("file not found: {}", shape.ist.string()));
+    UH_CHECK(check_file(shape.ist, "ist"));
   }
   UH_CHECK(r.integer(j, path, "spheres", shape.spheres, 1, 2'000'000));
   UH_CHECK(r.number(j, path, "meters_per_unit", shape.meters_per_unit, 1e-9, 1e6));
@@ -513,6 +522,9 @@ Status read_tools(const FieldReader& r, const json& root, const std::filesystem:
 }
 
 Result<json> parse_json(std::string_view json_text, const std::string& source) {
+  // the same guard as the service's messages: nothing below recurses deeply on a file's text
+  if (json_nesting_depth(json_text) > kMaxJsonNesting)
+    return Error{fmt::format("{}: the JSON is nested deeper than {} levels", source, kMaxJsonNesting)};
   try {
     return json::parse(json_text);
   } catch (const json::exception& e) {
@@ -607,12 +619,17 @@ Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, co
   return config;
 }
 
+Result<std::string> read_scene_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    return Error{fmt::format("{}: cannot open the scene file", path.string())};
+  return read_regular_file(path, kMaxSceneFileBytes);
+}
+
 Result<Scene> load_scene(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{fmt::format("{}: cannot open the scene file", path.string())};
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), path.string(), path.parent_path());
+  auto text = read_scene_file(path);
+  if (!text) return text.error();
+  return parse_scene(*text, path.string(), path.parent_path());
 }
 
 std::filesystem::path default_cache_dir() {

@@ -5,6 +5,7 @@
 // (std::generic_category), so that messages read the same everywhere.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <system_error>
 
@@ -24,6 +25,14 @@ std::error_code replace_file(const std::filesystem::path& from, const std::files
 std::error_code sync_directory(const std::filesystem::path& dir);
 /// Removes a file; errors are ignored (used to clean up).
 void remove_file(const std::filesystem::path& path);
+/// What a path names, from the descriptor opened on it.
+enum class FileKind { kRegular, kDirectory, kFifo, kDevice, kSocket, kOther };
+/// Opens `path` for reading without ever blocking (POSIX: O_NONBLOCK, so that a FIFO without a
+/// writer opens at once) and tells its kind and size from the open descriptor. Not inherited.
+std::error_code open_for_reading(const std::filesystem::path& path, int& fd, FileKind& kind,
+                                 std::uint64_t& size);
+/// Reads up to `size` bytes into `data` (retrying interrupted reads); `got` is 0 at the end.
+std::error_code read_some(int fd, char* data, std::size_t size, std::size_t& got);
 /// This process's id, for names no other process uses at the same time.
 long process_id();
 

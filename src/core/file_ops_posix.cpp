@@ -1,4 +1,5 @@
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -49,6 +50,38 @@ std::error_code sync_directory(const std::filesystem::path& dir) {
 }
 
 void remove_file(const std::filesystem::path& path) { ::unlink(path.c_str()); }
+
+std::error_code open_for_reading(const std::filesystem::path& path, int& fd, FileKind& kind,
+                                 std::uint64_t& size) {
+  fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) return last_error();
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const std::error_code error = last_error();
+    ::close(fd);
+    fd = -1;
+    return error;
+  }
+  kind = S_ISREG(st.st_mode)                          ? FileKind::kRegular
+         : S_ISDIR(st.st_mode)                        ? FileKind::kDirectory
+         : S_ISFIFO(st.st_mode)                       ? FileKind::kFifo
+         : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? FileKind::kDevice
+         : S_ISSOCK(st.st_mode)                       ? FileKind::kSocket
+                                                      : FileKind::kOther;
+  size = st.st_size > 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+  return {};
+}
+
+std::error_code read_some(int fd, char* data, std::size_t size, std::size_t& got) {
+  for (;;) {
+    const ssize_t r = ::read(fd, data, size);
+    if (r >= 0) {
+      got = static_cast<std::size_t>(r);
+      return {};
+    }
+    if (errno != EINTR) return last_error();
+  }
+}
 
 long process_id() { return static_cast<long>(::getpid()); }
 

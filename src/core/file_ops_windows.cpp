@@ -70,6 +70,42 @@ std::error_code sync_directory(const std::filesystem::path&) { return {}; }
 
 void remove_file(const std::filesystem::path& path) { ::_wunlink(path.c_str()); }
 
+// the CRT cannot open a folder: it is named as one rather than as a refused open
+std::error_code open_for_reading(const std::filesystem::path& path, int& fd, FileKind& kind,
+                                 std::uint64_t& size) {
+  std::error_code status_error;
+  if (std::filesystem::is_directory(path, status_error)) {
+    fd = -1;
+    kind = FileKind::kDirectory;
+    size = 0;
+    return {};
+  }
+  fd = ::_wopen(path.c_str(), _O_RDONLY | _O_BINARY | _O_NOINHERIT);
+  if (fd < 0) return last_error();
+  struct _stat64 st {};
+  if (::_fstat64(fd, &st) != 0) {
+    const std::error_code error = last_error();
+    ::_close(fd);
+    fd = -1;
+    return error;
+  }
+  const auto type = st.st_mode & _S_IFMT;
+  kind = type == _S_IFREG   ? FileKind::kRegular
+         : type == _S_IFCHR ? FileKind::kDevice
+         : type == _S_IFIFO ? FileKind::kFifo
+                            : FileKind::kOther;
+  size = st.st_size > 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+  return {};
+}
+
+std::error_code read_some(int fd, char* data, std::size_t size, std::size_t& got) {
+  const unsigned chunk = size > INT_MAX ? INT_MAX : static_cast<unsigned>(size);
+  const int r = ::_read(fd, data, chunk);
+  if (r < 0) return last_error();
+  got = static_cast<std::size_t>(r);
+  return {};
+}
+
 long process_id() { return static_cast<long>(::_getpid()); }
 
 }  // namespace uh::detail

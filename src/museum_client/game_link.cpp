@@ -66,6 +66,7 @@ struct GameLink::Impl {
   bool write_busy = false;
   bool ever_connected = false;
   bool told_dropped = false;
+  std::string seat_key;  // the network thread's: from the first welcome (Phantom's seat)
 
   SpscQueue<LinkNote> inbox{kQueueCapacity};      // network thread -> owner
   SpscQueue<std::string> outbox{kQueueCapacity};  // owner -> network thread
@@ -114,7 +115,7 @@ struct GameLink::Impl {
     writing.clear();
     write_busy = false;
     ws->text(true);
-    write(hello_text(options.role, options.token));
+    write(hello_text(options.role, options.token, seat_key));
     read();
   }
 
@@ -124,6 +125,10 @@ struct GameLink::Impl {
       std::string text = beast::buffers_to_string(buffer.data());
       buffer.consume(buffer.size());
       auto parsed = parse_server_message(text);
+      // the seat this link took is taken again with its key after a dropped connection
+      if (parsed)
+        if (const auto* w = std::get_if<Welcome>(&*parsed); w != nullptr && !w->seat_key.empty())
+          seat_key = w->seat_key;
       if (parsed) {
         note({.kind = LinkNote::Kind::message, .message = std::move(*parsed), .text = std::move(text)});
       } else {

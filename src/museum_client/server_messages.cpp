@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "uh/core/json_nesting.hpp"
+
 namespace uh::museum_client {
 namespace {
 
@@ -138,6 +140,8 @@ Result<ServerMessage> parse_welcome(const json& m, Reader& r) {
     for (const json& t : *targets)
       if (t.is_string()) w.targets.push_back(t.get<std::string>());
   }
+  if (const auto key = m.find("seat_key"); key != m.end() && key->is_string())
+    w.seat_key = key->get<std::string>();
   if (!r.error.empty()) return Error{r.error};
   return ServerMessage{std::move(w)};
 }
@@ -268,6 +272,8 @@ Result<ServerMessage> parse_summary(const json& m, Reader& r) {
 }  // namespace
 
 Result<ServerMessage> parse_server_message(std::string_view text) {
+  if (json_nesting_depth(text) > kMaxJsonNesting)
+    return Error{fmt::format("the message is nested deeper than {} levels", kMaxJsonNesting)};
   const json m = json::parse(text, nullptr, false);
   if (m.is_discarded()) return Error{"the message is not JSON"};
   if (!m.is_object()) return Error{"the message is not a JSON object"};
@@ -291,9 +297,10 @@ Result<ServerMessage> parse_server_message(std::string_view text) {
   return Error{fmt::format("'type' is '{}', which this client does not know", type)};
 }
 
-std::string hello_text(std::string_view role, std::string_view token) {
+std::string hello_text(std::string_view role, std::string_view token, std::string_view seat_key) {
   json hello = {{"type", "hello"}, {"protocol", 1}, {"role", std::string(role)}};
   if (!token.empty()) hello["token"] = std::string(token);
+  if (!seat_key.empty()) hello["seat_key"] = std::string(seat_key);
   return hello.dump();
 }
 

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/json_nesting.hpp"
 #include "uh/museum_service/game_server.hpp"
 
 namespace uh::museum_service {
@@ -67,6 +68,10 @@ std::string parse_body(const json& m, const std::string& type, std::optional<Cli
       if (!t->is_string()) return "'token' must be a string";
       h.token = t->get<std::string>();
     }
+    if (const auto k = m.find("seat_key"); k != m.end()) {
+      if (!k->is_string()) return "'seat_key' must be a string";
+      h.seat_key = k->get<std::string>();
+    }
     body = h;
   } else if (type == "move") {
     MoveMessage mv;
@@ -116,6 +121,10 @@ std::string parse_body(const json& m, const std::string& type, std::optional<Cli
 
 ParsedMessage parse_message(std::string_view text) {
   ParsedMessage out;
+  if (json_nesting_depth(text) > kMaxJsonNesting) {
+    out.error = fmt::format("the message is nested deeper than {} levels", kMaxJsonNesting);
+    return out;
+  }
   const json m = json::parse(text, nullptr, false);
   if (m.is_discarded()) {
     out.error = "the message is not JSON";

@@ -21,7 +21,8 @@ const char* to_string(Role role);
 struct HelloMessage {
   int protocol = 0;
   Role role = Role::none;
-  std::string token{};  // empty when absent
+  std::string token{};     // empty when absent
+  std::string seat_key{};  // Phantom's reconnect: the key its first welcome gave; empty when absent
 };
 /// Vive's wanted direction and pace; held until the next move.
 struct MoveMessage {

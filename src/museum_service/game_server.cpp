@@ -4,6 +4,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <random>
 #include <utility>
 
 #include <fmt/format.h>
@@ -23,6 +24,69 @@ using Clock = std::chrono::steady_clock;
 
 // clients send small messages; anything larger is closed with 1009
 constexpr std::size_t kMaxMessageBytes = 64 * 1024;
+// A client may fail its hello (a wrong or missing token, Phantom's seat without its key) this
+// many times; then it is closed. Across all clients, failed hellos beyond kMaxFailedHellosPerSecond
+// close the connection without a check, so that guessing by many connections is as slow.
+constexpr int kMaxFailedHellos = 3;
+constexpr int kMaxFailedHellosPerSecond = 10;
+// Refusals logged per client; the rest are counted (refused_messages()) but not logged.
+constexpr int kLoggedRefusalsPerClient = 5;
+
+// 128 random bits in hex: Phantom's seat key.
+std::string make_seat_key() {
+  std::random_device random;
+  std::string key;
+  for (int i = 0; i < 4; ++i) key += fmt::format("{:08x}", static_cast<std::uint32_t>(random()));
+  return key;
+}
+
+// Client text as it may appear in the operator's log: control bytes and anything beyond ASCII
+// escaped (no forged lines, no terminal escape sequences), at most `limit` characters.
+std::string loggable(std::string_view text, std::size_t limit = 160) {
+  std::string out;
+  for (const char ch : text) {
+    if (out.size() >= limit) {
+      out += "...";
+      break;
+    }
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f && c != '\\')
+      out.push_back(ch);
+    else
+      out += fmt::format("\\x{:02x}", c);
+  }
+  return out;
+}
+
+// At most `lines` log lines per `window`; the ones beyond are counted and reported with the next
+// line allowed.
+class LogBudget {
+ public:
+  LogBudget(int lines, Clock::duration window) : lines_(lines), window_(window) {}
+  // whether a line may be logged now; `skipped` gets how many were not since the last one
+  bool allow(std::uint64_t& skipped) {
+    const auto now = Clock::now();
+    if (now - window_start_ >= window_) {
+      window_start_ = now;
+      used_ = 0;
+    }
+    if (used_ >= lines_) {
+      ++skipped_;
+      return false;
+    }
+    ++used_;
+    skipped = std::exchange(skipped_, 0);
+    return true;
+  }
+
+ private:
+  int lines_;
+  Clock::duration window_;
+  Clock::time_point window_start_{};
+  int used_ = 0;
+  std::uint64_t skipped_ = 0;
+};
+
 // the rules catch up at most this many ticks after a stall, then drop the rest (the round's
 // time is game time: a stalled server does not eat the players' time)
 constexpr int kMaxCatchUpTicks = 5;
@@ -31,12 +95,16 @@ constexpr int kMaxCatchUpTicks = 5;
 class GameHub final : public service::Endpoint {
  public:
   GameHub(asio::io_context& io, const museum::Level& level, std::uint64_t seed, std::string token,
-          int snapshot_every, double speed)
+          int snapshot_every, double speed, double resume_delay_s, double seat_hold_s)
       : level_(level),
+        resume_delay_(
+            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(resume_delay_s))),
+        seat_hold_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seat_hold_s))),
         state_(museum::new_game(level, seed)),
         token_(std::move(token)),
         snapshot_every_(snapshot_every),
-        tick_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(level.rules.tick_s / speed))),
+        tick_(std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double>(level.rules.tick_s / speed))),
         timer_(io) {
     state_.paused = true;
     next_tick_ = Clock::now();
@@ -53,6 +121,7 @@ class GameHub final : public service::Endpoint {
     const auto it = clients_.find(id);
     if (it == clients_.end() || shut_down_) return;
     Client& c = it->second;
+    if (c.failed_hellos >= kMaxFailedHellos) return;  // being closed
     const ParsedMessage m = parse_message(text);
     if (!m.body) return refuse(id, c, m.id, m.type, m.error);
     if (!c.greeted && !std::holds_alternative<HelloMessage>(*m.body)) {
@@ -81,8 +150,9 @@ class GameHub final : public service::Endpoint {
       move_ = {};
       actions_.clear();
     }
+    if (role == Role::phantom) phantom_left_at_ = Clock::now();
     if (role == Role::vive || role == Role::phantom) {
-      log::info("museum: {} dropped out; the round pauses until it reconnects", to_string(role));
+      log_players("{} dropped out; the round pauses until it reconnects", to_string(role));
       update_pause();
       broadcast_snapshot();
     }
@@ -103,13 +173,54 @@ class GameHub final : public service::Endpoint {
     Peer* peer = nullptr;
     bool greeted = false;
     Role role = Role::none;
+    int refusals = 0;
+    int failed_hellos = 0;
   };
 
   void refuse(ClientId id, Client& c, const json& req_id, std::string_view type, const std::string& message) {
     ++refused_;
-    log::warn("museum: client {}: refused {}: {}", id, type.empty() ? "a message" : std::string(type),
-              message);
+    // a few per client, and those escaped: a client cannot flood the log nor forge its lines
+    if (++c.refusals <= kLoggedRefusalsPerClient)
+      log::warn(
+          "museum: client {} ({}): refused {}: {}{}", id, c.peer->address(),
+          type.empty() ? std::string("a message") : loggable(type), loggable(message),
+          c.refusals == kLoggedRefusalsPerClient ? " (further refusals of this client are not logged)" : "");
     c.peer->send(error_message(req_id, type, message).dump());
+  }
+
+  // a failed hello: refused, and the client closed after a few (or at once when many clients fail)
+  void refuse_hello(ClientId id, Client& c, const json& req_id, const std::string& message) {
+    refuse(id, c, req_id, "hello", message);
+    ++c.failed_hellos;
+    ++failed_hellos_this_second_;
+    if (c.failed_hellos >= kMaxFailedHellos) c.peer->close(1008, "too many failed hellos");
+  }
+
+  // whether hellos are checked now: not for a client being closed after its failures, and not
+  // while the second's failures across all clients are used up (the client is closed then)
+  bool may_try_hello(Client& c) {
+    if (c.failed_hellos >= kMaxFailedHellos) return false;
+    const auto now = Clock::now();
+    if (now - failed_hellos_second_ >= std::chrono::seconds(1)) {
+      failed_hellos_second_ = now;
+      failed_hellos_this_second_ = 0;
+    }
+    if (failed_hellos_this_second_ < kMaxFailedHellosPerSecond) return true;
+    c.failed_hellos = kMaxFailedHellos;
+    c.peer->close(1008, "too many failed hellos on this server; try again later");
+    return false;
+  }
+
+  // the join and drop-out lines, bounded however often players reconnect
+  template <typename... Args>
+  void log_players(fmt::format_string<Args...> format, Args&&... args) {
+    std::uint64_t skipped = 0;
+    if (!player_log_.allow(skipped)) return;
+    const std::string line = fmt::format(format, std::forward<Args>(args)...);
+    if (skipped > 0)
+      log::info("museum: {} ({} more joins and drop-outs were not logged)", line, skipped);
+    else
+      log::info("museum: {}", line);
   }
 
   bool role_connected(Role role) const {
@@ -119,6 +230,7 @@ class GameHub final : public service::Endpoint {
   }
 
   void handle(ClientId id, Client& c, const json& req_id, const std::string& type, const HelloMessage& h) {
+    if (!c.greeted && !may_try_hello(c)) return;
     if (c.greeted)
       return refuse(id, c, req_id, type, fmt::format("already greeted as {}", to_string(c.role)));
     if (h.protocol != kGameProtocolVersion)
@@ -126,11 +238,22 @@ class GameHub final : public service::Endpoint {
                     fmt::format("protocol {} is not supported; this server speaks {}", h.protocol,
                                 kGameProtocolVersion));
     if (!token_.empty() && !service::same_token(h.token, token_))
-      return refuse(id, c, req_id, type,
-                    h.token.empty() ? "this server needs a token" : "the token is wrong");
+      return refuse_hello(id, c, req_id,
+                          h.token.empty() ? "this server needs a token" : "the token is wrong");
     if (h.role != Role::watcher && role_connected(h.role))
       return refuse(id, c, req_id, type,
                     fmt::format("the {} role is taken by another client", to_string(h.role)));
+    // Phantom's seat is its station's: while it is held, only the holder of its key takes it again
+    const bool same_station =
+        !phantom_seat_key_.empty() && service::same_token(h.seat_key, phantom_seat_key_);
+    if (h.role == Role::phantom && seat_held() && !same_station)
+      return refuse_hello(
+          id, c, req_id,
+          h.seat_key.empty() ? "the phantom seat is held for the station that took it: a reconnect sends the "
+                               "seat_key of its first welcome"
+                             : "the seat_key is wrong");
+    // a new station (the first, or one after the hold) gets a new key
+    if (h.role == Role::phantom && !same_station) phantom_seat_key_ = make_seat_key();
     c.greeted = true;
     c.role = h.role;
     json targets = json::array();
@@ -138,16 +261,16 @@ class GameHub final : public service::Endpoint {
       targets.push_back(
           level_.artifact_kinds[static_cast<std::size_t>(state_.target_kinds[static_cast<std::size_t>(t)])]);
     // no seed: a client given it could deal the round itself and know every genuine piece
-    c.peer->send(json{
-        {"type", "welcome"},
-        {"id", req_id},
-        {"protocol", kGameProtocolVersion},
-        {"role", to_string(h.role)},
-        {"level", level_json(level_)},
-        {"targets",
-         targets}}.dump());
+    json welcome = {{"type", "welcome"},
+                    {"id", req_id},
+                    {"protocol", kGameProtocolVersion},
+                    {"role", to_string(h.role)},
+                    {"level", level_json(level_)},
+                    {"targets", targets}};
+    if (h.role == Role::phantom) welcome["seat_key"] = phantom_seat_key_;
+    c.peer->send(welcome.dump());
     if (h.role == Role::vive || h.role == Role::phantom) {
-      log::info("museum: {} joined", to_string(h.role));
+      log_players("{} joined ({})", to_string(h.role), c.peer->address());
       update_pause();
     }
     c.peer->send(snapshot().dump());
@@ -187,10 +310,28 @@ class GameHub final : public service::Endpoint {
     c.peer->send(json{{"type", "pong"}, {"id", req_id}, {"tick", state_.tick}}.dump());
   }
 
+  // the round plays while both players are connected; after a pause it resumes resume_delay_ after
+  // both are back (play_tick() lifts the pause then), the first start at once: a player who
+  // reconnects over and over never moves the paused round
+  // Phantom's seat is held for its station on a server with a token (where token holders must not
+  // take it) for seat_hold_ after the station dropped out; then another may sit down
+  bool seat_held() const {
+    return !token_.empty() && phantom_left_at_ && Clock::now() - *phantom_left_at_ < seat_hold_;
+  }
+
   void update_pause() {
     const bool both = role_connected(Role::vive) && role_connected(Role::phantom);
-    if (both) started_ = true;
-    state_.paused = !both;
+    if (!both) {
+      state_.paused = true;
+      resume_at_.reset();
+      return;
+    }
+    if (!started_) {
+      started_ = true;
+      state_.paused = false;
+      return;
+    }
+    if (state_.paused && !resume_at_) resume_at_ = Clock::now() + resume_delay_;
   }
 
   std::string phase() const {
@@ -226,6 +367,10 @@ class GameHub final : public service::Endpoint {
   }
 
   void play_tick() {
+    if (resume_at_ && Clock::now() >= *resume_at_) {
+      resume_at_.reset();
+      state_.paused = false;
+    }
     museum::TickInput input;
     if (!state_.paused) {
       input.vive.move = move_.move;
@@ -266,6 +411,8 @@ class GameHub final : public service::Endpoint {
   }
 
   museum::Level level_;
+  Clock::duration resume_delay_;
+  Clock::duration seat_hold_;
   museum::GameState state_;
   std::string token_;
   int snapshot_every_;
@@ -281,6 +428,12 @@ class GameHub final : public service::Endpoint {
   std::optional<museum::Verdict> verdict_;  // for the first item on the table, at the next tick
   museum::Events events_;
   bool started_ = false;
+  std::optional<Clock::time_point> resume_at_;        // when a paused round plays again
+  std::string phantom_seat_key_;                      // given in Phantom's first welcome
+  std::optional<Clock::time_point> phantom_left_at_;  // when Phantom's station last dropped out
+  Clock::time_point failed_hellos_second_{};
+  int failed_hellos_this_second_ = 0;
+  LogBudget player_log_{20, std::chrono::minutes(1)};
   bool summary_sent_ = false;
   bool shut_down_ = false;
   std::uint64_t refused_ = 0;
@@ -304,6 +457,10 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
     return Error{fmt::format("snapshot rate {} Hz is not within 20..30 Hz", options.snapshot_hz)};
   if (!(options.speed >= 0.1 && options.speed <= 20.0))
     return Error{fmt::format("speed {} is not within 0.1..20 (game seconds per second)", options.speed)};
+  if (!(options.resume_delay_s >= 0.0 && options.resume_delay_s <= 600.0))
+    return Error{fmt::format("resume delay {} s is not within 0..600 s", options.resume_delay_s)};
+  if (!(options.seat_hold_s >= 0.0 && options.seat_hold_s <= 3600.0))
+    return Error{fmt::format("seat hold {} s is not within 0..3600 s", options.seat_hold_s)};
   // snapshots every n rule ticks: the rate within 20..30 Hz nearest the one asked for
   const double tick_hz = 1.0 / options.level.rules.tick_s;
   const int every = std::max(1, static_cast<int>(std::lround(tick_hz / options.snapshot_hz)));
@@ -319,7 +476,7 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
        .program = "uh museum serve"},
       [&](asio::io_context& io) {
         auto made = std::make_unique<GameHub>(io, options.level, options.seed, options.token, every,
-                                              options.speed);
+                                              options.speed, options.resume_delay_s, options.seat_hold_s);
         hub = made.get();
         return made;
       });

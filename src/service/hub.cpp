@@ -8,6 +8,7 @@
 #include <boost/asio/post.hpp>
 
 #include "mesh_binary.hpp"
+#include "uh/core/log.hpp"
 
 namespace uh::service {
 namespace {
@@ -62,6 +63,13 @@ std::string add_object_label(const AddObject& add) {
              : std::string("add_object");
 }
 
+// Before a successful hello a client may send only small messages, and only a few.
+constexpr std::size_t kMaxMessageBytesBeforeHello = 64 * 1024;
+constexpr int kMaxMessagesBeforeHello = 16;
+// get_mesh is refused while this much already waits to be sent to the client: one client's flood
+// of large replies neither grows without bound nor keeps the network thread from the others.
+constexpr std::size_t kMaxQueuedBytesForMesh = 8u << 20;
+
 }  // namespace
 
 Hub::Hub(boost::asio::io_context& io, HubOptions options)
@@ -83,6 +91,7 @@ void Hub::receive(ClientId id, std::string_view text) {
   const auto it = clients_.find(id);
   if (it == clients_.end() || shut_down_) return;
   Client& c = it->second;
+  if (c.closing) return;
   if (c.pending_mesh) {
     // the announced frame did not come: that add_object fails, this message is read as usual
     const auto pending = std::exchange(c.pending_mesh, std::nullopt);
@@ -92,6 +101,11 @@ void Hub::receive(ClientId id, std::string_view text) {
                       fmt::format("{}: its mesh_binary frame ({} bytes) must be the next message, but "
                                   "a text message came; the object was not added",
                                   add_object_label(*pending->add), pending->add->mesh_binary->bytes())));
+  }
+  if (!c.greeted && ++c.messages_before_hello > kMaxMessagesBeforeHello) {
+    c.closing = true;
+    c.peer->close(1008, "too many messages before hello");
+    return;
   }
   ParsedRequest req = parse_request(text);
   if (req.announces_binary) {
@@ -113,17 +127,22 @@ void Hub::receive(ClientId id, std::string_view text) {
 
 std::size_t Hub::message_limit(ClientId id) const {
   const auto it = clients_.find(id);
-  if (it == clients_.end() || !it->second.pending_mesh) return kMaxMessageBytes;
+  if (it == clients_.end()) return kMaxMessageBytes;
+  // the limit rises only for a client that said hello (with the token): nobody else makes the
+  // service hold a large buffer
+  if (!it->second.greeted) return kMaxMessageBytesBeforeHello;
+  if (!it->second.pending_mesh) return kMaxMessageBytes;
   const auto& pending = *it->second.pending_mesh;
   return std::max(kMaxMessageBytes, pending.add ? pending.add->mesh_binary->bytes() : kMaxMeshBinaryBytes);
 }
 
 std::string Hub::on_announce_mesh(ClientId id, Client& c, const ParsedRequest& req) {
+  // before hello nothing is held for the frame (it comes under the small limit and is refused)
+  if (!c.greeted)
+    return fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{}}}", kProtocolVersion);
   // whatever happens to the request, the frame that follows it is its own
   c.pending_mesh.emplace(Client::PendingMesh{req.id, std::nullopt});
   if (!req.body) return req.error;
-  if (!c.greeted)
-    return fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{}}}", kProtocolVersion);
   if (auto e = check_control(id, true); !e.empty()) return e;
   if (slot_->phase != Phase::kOpen) return "the session is running; stop it before editing the scene";
   c.pending_mesh->add = std::get<AddObject>(*req.body);
@@ -134,6 +153,7 @@ void Hub::receive_binary(ClientId id, std::span<const std::byte> bytes) {
   const auto it = clients_.find(id);
   if (it == clients_.end() || shut_down_) return;
   Client& c = it->second;
+  if (c.closing) return;
   if (!c.pending_mesh) {
     c.peer->send(error_reply(nullptr, "",
                              "a binary frame must follow an add_object that announces it with "
@@ -152,25 +172,64 @@ std::string Hub::on_mesh_frame(ClientId id, const Client::PendingMesh& pending,
   // it sent nothing in between), but the slot's state is checked again rather than assumed
   if (auto e = check_control(id, true); !e.empty()) return e;
   if (slot_->phase != Phase::kOpen) return "the session is running; stop it before editing the scene";
-  const AddObject& add = *pending.add;
-  const std::string label = add_object_label(add);
-  auto mesh = decode_mesh_binary(bytes, *add.mesh_binary, label);
-  if (!mesh) return mesh.error().message;
-  SceneDocument& doc = *slot_->document;
-  auto report =
-      doc.add_inline_object(add.object, std::move(mesh).value(), options_.cache_dir / "inline-meshes");
-  if (!report) return report.error().message;
-  send_to(id, reply("object_added", pending.req_id,
-                    {{"name", doc.scene().objects.back().name},
-                     {"mesh",
-                      {{"vertices", report->vertex_count},
-                       {"triangles", report->triangle_count},
-                       {"welded_vertices", report->welded_vertices},
-                       {"degenerate_faces", report->degenerate_faces},
-                       {"duplicate_faces", report->duplicate_faces},
-                       {"winding_flipped", report->winding_flipped}}}}));
-  broadcast_session("edited");
+  if (meshing_) return "another inline mesh is being checked; send this one after its reply";
+  // decoding, welding and checking a large mesh takes seconds: off the network thread, answered
+  // when done
+  meshing_ = true;
+  if (mesher_.joinable()) mesher_.join();
+  mesher_ = std::jthread([this, id, pending, generation = generation_,
+                          frame = std::vector<std::byte>(bytes.begin(), bytes.end()),
+                          mesh_dir = options_.cache_dir / "inline-meshes"] {
+    auto decoded = decode_mesh_binary(frame, *pending.add->mesh_binary, add_object_label(*pending.add));
+    auto written =
+        std::make_shared<Result<InlineMesh>>(decoded ? write_inline_mesh(std::move(decoded).value(), mesh_dir)
+                                                     : Result<InlineMesh>(decoded.error()));
+    boost::asio::post(io_, [this, id, pending, generation, written] {
+      mesh_written(generation, id, pending, std::move(*written));
+    });
+  });
   return {};
+}
+
+void Hub::mesh_written(std::uint64_t generation, ClientId id, const Client::PendingMesh& pending,
+                       Result<InlineMesh> written) {
+  meshing_ = false;
+  if (shut_down_) {
+    if (written) remove_inline_mesh(written->file, options_.cache_dir);
+    return;
+  }
+  if (!written) {
+    send_to(id, error_reply(pending.req_id, "add_object", written.error().message));
+    return;
+  }
+  // the slot was closed or replaced, or the session started, while the mesh was checked
+  std::string refused = generation != generation_ ? "the scene was closed while its inline mesh was checked"
+                                                  : check_control(id, true);
+  if (refused.empty() && slot_->phase != Phase::kOpen)
+    refused = "the session started while the inline mesh was checked; stop it before editing the scene";
+  if (refused.empty()) {
+    slot_->inline_meshes.push_back(written->file);
+    slot_->mesh_replies.clear();
+    if (auto added = slot_->document->add_inline_object(pending.add->object, written->file); !added)
+      refused = added.error().message;
+  } else {
+    remove_inline_mesh(written->file, options_.cache_dir);
+  }
+  if (!refused.empty()) {
+    send_to(id, error_reply(pending.req_id, "add_object", refused));
+    return;
+  }
+  const collette::MeshReport& report = written->report;
+  send_to(id, reply("object_added", pending.req_id,
+                    {{"name", slot_->scene().objects.back().name},
+                     {"mesh",
+                      {{"vertices", report.vertex_count},
+                       {"triangles", report.triangle_count},
+                       {"welded_vertices", report.welded_vertices},
+                       {"degenerate_faces", report.degenerate_faces},
+                       {"duplicate_faces", report.duplicate_faces},
+                       {"winding_flipped", report.winding_flipped}}}}));
+  broadcast_session("edited");
 }
 
 void Hub::handle(ClientId id, Client& c, const json& req_id, const std::string& type,
@@ -205,19 +264,34 @@ void Hub::handle(ClientId id, Client& c, const json& req_id, const std::string& 
                                                                         : "open"},
                           {"controlled_here", slot_->controller == id}}));
   } else if (const auto* g = std::get_if<GetMesh>(&body)) {
-    if (!slot_) {
-      error = "no scene is open";
-    } else {
-      auto mesh = scene_mesh(slot_->scene(), g->object);
-      if (!mesh)
-        error = mesh.error().message;
-      else
-        c.peer->send(reply("mesh", req_id, std::move(mesh).value()));
-    }
+    error = on_get_mesh(id, c, req_id, *g);
   } else {
     error = on_edit(id, req_id, type, body);
   }
   if (!error.empty()) c.peer->send(error_reply(req_id, type, error));
+}
+
+std::string Hub::on_get_mesh(ClientId, Client& c, const json& req_id, const GetMesh& g) {
+  if (!slot_) return "no scene is open";
+  if (c.peer->queued_bytes() > kMaxQueuedBytesForMesh)
+    return fmt::format(
+        "{} bytes of replies wait to be sent to this connection; read them before asking for "
+        "another mesh",
+        c.peer->queued_bytes());
+  auto made = slot_->mesh_replies.find(g.object);
+  if (made == slot_->mesh_replies.end()) {
+    auto mesh = scene_mesh(slot_->scene(), g.object);
+    if (!mesh) return mesh.error().message;
+    // the reply without its id, which each request sets
+    made = slot_->mesh_replies.emplace(g.object, reply("mesh", nullptr, std::move(mesh).value())).first;
+  }
+  if (req_id.is_null()) {
+    c.peer->send(made->second);
+  } else {
+    // the made reply, an object with fields, with the request's id as its first field
+    c.peer->send(fmt::format("{{\"id\":{},{}", req_id.dump(), std::string_view(made->second).substr(1)));
+  }
+  return {};
 }
 
 std::string Hub::on_hello(ClientId, Client& c, const json& req_id, const Hello& h) {
@@ -226,9 +300,13 @@ std::string Hub::on_hello(ClientId, Client& c, const json& req_id, const Hello& 
     return fmt::format("protocol {} is not supported (this service speaks protocol {})", h.protocol,
                        kProtocolVersion);
   if (!options_.token.empty() && !same_token(h.token, options_.token)) {
+    // once per connection: the connection ends here
+    log::warn("uh serve: {}: hello {}; the connection is closed", c.peer->address(),
+              h.token.empty() ? "without the token" : "with a wrong token");
     c.peer->send(error_reply(
         req_id, "hello",
         h.token.empty() ? "this service needs a token: send hello with \"token\"" : "wrong token"));
+    c.closing = true;
     c.peer->close(1008, "wrong or missing token");
     return {};
   }
@@ -402,6 +480,8 @@ void Hub::close_slot() {
   ++generation_;
   stop_timer_.cancel();
   event_timer_.cancel();
+  // the scene's inline meshes were its own: they go with it
+  for (const auto& file : slot_->inline_meshes) remove_inline_mesh(file, options_.cache_dir);
   slot_.reset();
   broadcast_session("closed");
 }
@@ -510,6 +590,7 @@ std::string Hub::on_edit(ClientId id, const json& req_id, const std::string& typ
     fields["collision_hz"] = doc.scene().collision_hz;
   }
   if (!done) return done.error().message;
+  slot_->mesh_replies.clear();  // an object may have another mesh now
   static const std::map<std::string, std::string, std::less<>> kReplies = {
       {"add_object", "object_added"}, {"remove_object", "object_removed"}, {"set_pose", "pose_set"},
       {"set_watch", "watch_set"},     {"set_device", "device_set"},        {"set_tool", "tool_set"},
@@ -574,6 +655,7 @@ void Hub::shutdown() {
     c.peer->close(1001, "the service is stopping");
   }
   if (builder_.joinable()) builder_.join();
+  if (mesher_.joinable()) mesher_.join();
 }
 
 }  // namespace uh::service

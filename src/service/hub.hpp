@@ -60,6 +60,8 @@ class Hub final : public Endpoint {
   struct Client {
     Peer* peer = nullptr;
     bool greeted = false;
+    int messages_before_hello = 0;
+    bool closing = false;  // refused for good (a wrong token): what it sends is ignored
     double rate_hz = 0.0;  // 0: not subscribed
     std::unique_ptr<boost::asio::steady_timer> state_timer;
     // an add_object that announced mesh_binary waits for its frame; without `add` (the request
@@ -82,6 +84,10 @@ class Hub final : public Endpoint {
     std::unique_ptr<controllers::HapticSession> owned;
     controllers::HapticSession* session = nullptr;
     json start_id;  // the start request, answered when running
+    // inline meshes written for this slot: removed (with their packing cache) when it closes
+    std::vector<std::filesystem::path> inline_meshes;
+    // `mesh` replies already made, by object name: a get_mesh flood costs no reading or encoding
+    std::map<std::string, std::string, std::less<>> mesh_replies;
     const controllers::Scene& scene() const { return document ? document->scene() : *hosted; }
   };
 
@@ -100,6 +106,10 @@ class Hub final : public Endpoint {
   std::string on_announce_mesh(ClientId id, Client& c, const ParsedRequest& req);
   std::string on_mesh_frame(ClientId id, const Client::PendingMesh& pending,
                             std::span<const std::byte> bytes);
+  // the inline mesh checked and written off this thread: added to the document if it still may be
+  void mesh_written(std::uint64_t generation, ClientId id, const Client::PendingMesh& pending,
+                    Result<InlineMesh> written);
+  std::string on_get_mesh(ClientId id, Client& c, const json& req_id, const GetMesh& g);
 
   // an error text when `id` may not change the session
   std::string check_control(ClientId id, bool needs_open) const;
@@ -123,6 +133,8 @@ class Hub final : public Endpoint {
   boost::asio::steady_timer stop_timer_;
   boost::asio::steady_timer event_timer_;
   std::jthread builder_;  // the one session build at a time
+  std::jthread mesher_;   // the one inline mesh checked and written at a time
+  bool meshing_ = false;  // mesher_ works (network thread)
   bool shut_down_ = false;
 };
 

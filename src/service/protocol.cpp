@@ -5,36 +5,10 @@
 
 #include <fmt/format.h>
 
+#include "uh/core/json_nesting.hpp"
+
 namespace uh::service {
 namespace {
-
-// Deeper documents are refused before nlohmann parses them, so that nothing later (dump, the
-// scene parser) recurses deeply on a client's input.
-constexpr int kMaxNesting = 32;
-
-// The deepest nesting of arrays and objects in `text`, ignoring brackets inside strings.
-int nesting_depth(std::string_view text) {
-  int depth = 0, deepest = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-      continue;
-    }
-    if (c == '"')
-      in_string = true;
-    else if (c == '[' || c == '{')
-      deepest = std::max(deepest, ++depth);
-    else if (c == ']' || c == '}')
-      --depth;
-  }
-  return deepest;
-}
 
 // Reads the fields of one request object; every error names the field.
 class Fields {
@@ -251,8 +225,8 @@ std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_hand
 
 ParsedRequest parse_request(std::string_view text) {
   ParsedRequest out;
-  if (nesting_depth(text) > kMaxNesting) {
-    out.error = fmt::format("message nested deeper than {} levels", kMaxNesting);
+  if (json_nesting_depth(text) > kMaxJsonNesting) {
+    out.error = fmt::format("message nested deeper than {} levels", kMaxJsonNesting);
     return out;
   }
   json j;

@@ -1,9 +1,7 @@
 #include "scene_document.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <span>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -34,15 +32,13 @@ void absolutise(json& holder, const char* key, const std::filesystem::path& dir)
 }  // namespace
 
 Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{fmt::format("{}: cannot open the scene file", path.string())};
-  std::stringstream text;
-  text << in.rdbuf();
+  auto text = controllers::read_scene_file(path);
+  if (!text) return text.error();
   // the scene parser names what is wrong; the document is read only once it accepted the text
-  auto scene = controllers::parse_scene(text.str(), path.string(), path.parent_path());
+  auto scene = controllers::parse_scene(*text, path.string(), path.parent_path());
   if (!scene) return scene.error();
   SceneDocument d;
-  d.doc_ = json::parse(text.str());
+  d.doc_ = json::parse(*text);
   d.source_ = path.string();
   d.base_dir_ = path.parent_path();
   d.scene_ = std::move(scene).value();
@@ -78,8 +74,12 @@ Status SceneDocument::add_object(json object, const std::filesystem::path& dir) 
   return apply(std::move(candidate));
 }
 
-Result<collette::MeshReport> SceneDocument::add_inline_object(json object, collette::TriangleMesh mesh,
-                                                              const std::filesystem::path& mesh_dir) {
+Status SceneDocument::add_inline_object(json object, const std::filesystem::path& mesh_file) {
+  object["mesh"] = mesh_file.string();
+  return add_object(std::move(object), mesh_file.parent_path());
+}
+
+Result<InlineMesh> write_inline_mesh(collette::TriangleMesh mesh, const std::filesystem::path& mesh_dir) {
   auto valid = collette::validate_mesh(std::move(mesh));
   if (!valid) return valid.error();
   const std::string obj = collette::obj_text(
@@ -88,13 +88,26 @@ Result<collette::MeshReport> SceneDocument::add_inline_object(json object, colle
   const auto path = mesh_dir / fmt::format("{:016x}.obj", hash);
   std::error_code ec;
   std::filesystem::create_directories(mesh_dir, ec);
-  if (ec) return Error{fmt::format("{}: cannot create the folder: {}", mesh_dir.string(), ec.message())};
+  // the service's folders are its own business: the message names only the file kind
+  if (ec) return Error{fmt::format("cannot create the folder for inline meshes: {}", ec.message())};
   // named by its content: a file already there holds this very mesh
   if (!std::filesystem::exists(path, ec))
-    if (auto written = write_file_atomically(path, obj); !written) return written.error();
-  object["mesh"] = path.string();
-  if (auto added = add_object(std::move(object), mesh_dir); !added) return added.error();
-  return valid->report;
+    if (auto written = write_file_atomically(path, obj); !written)
+      return Error{"the inline mesh could not be written to the service's cache"};
+  return InlineMesh{path, valid->report};
+}
+
+void remove_inline_mesh(const std::filesystem::path& mesh_file, const std::filesystem::path& cache_dir) {
+  std::error_code ec;
+  std::filesystem::remove(mesh_file, ec);
+  // the packing cache names its files "<mesh stem>-<hash>-...ist" (controllers::load_shape_tree)
+  const std::string prefix = mesh_file.stem().string() + "-";
+  std::vector<std::filesystem::path> made;
+  for (std::filesystem::directory_iterator it(cache_dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::filesystem::path& p = it->path();
+    if (p.filename().string().rfind(prefix, 0) == 0 && p.extension() == ".ist") made.push_back(p);
+  }
+  for (const auto& p : made) std::filesystem::remove(p, ec);
 }
 
 Status SceneDocument::remove_object(const std::string& name) {

@@ -29,12 +29,9 @@ class SceneDocument {
   /// Paths given in edits (`mesh`, `ist`, a device's `file`) are relative to `dir` (the service's
   /// working directory), not to the scene file.
   Status add_object(nlohmann::json object, const std::filesystem::path& dir);
-  /// An object whose mesh came inline (a decoded `mesh_binary` frame, in mesh units): welded,
-  /// repaired and checked as a mesh file is (a mesh that is not closed is refused with the counts),
-  /// written as OBJ into `mesh_dir` under a name made of its content (so the packing cache finds
-  /// the same mesh again) and added with that file as its `mesh`. Returns what validation found.
-  Result<collette::MeshReport> add_inline_object(nlohmann::json object, collette::TriangleMesh mesh,
-                                                 const std::filesystem::path& mesh_dir);
+  /// An object whose mesh came inline, once write_inline_mesh() wrote it: added with that file
+  /// as its `mesh`.
+  Status add_inline_object(nlohmann::json object, const std::filesystem::path& mesh_file);
   Status remove_object(const std::string& name);
   Status set_pose(const std::string& name, const nlohmann::json& pose);
   Status set_watch(const std::vector<std::string>& names);
@@ -56,6 +53,22 @@ class SceneDocument {
   std::filesystem::path base_dir_;
   controllers::Scene scene_;
 };
+
+/// An inline mesh (a decoded `mesh_binary` frame, in mesh units) written for a scene: its file and
+/// what validation found.
+struct InlineMesh {
+  std::filesystem::path file;
+  collette::MeshReport report;
+};
+
+/// Welds, repairs and checks an inline mesh as a mesh file is (a mesh that is not closed is
+/// refused with the counts) and writes it as OBJ into `mesh_dir` under a name made of its content
+/// (so the packing cache finds the same mesh again). Any thread: the service runs it off its
+/// network thread.
+Result<InlineMesh> write_inline_mesh(collette::TriangleMesh mesh, const std::filesystem::path& mesh_dir);
+
+/// Removes an inline mesh file and the packing cache's .ist files made of it (in `cache_dir`).
+void remove_inline_mesh(const std::filesystem::path& mesh_file, const std::filesystem::path& cache_dir);
 
 /// A scene for a `scene` reply: name, objects with poses, watched names, tool and device, rates.
 nlohmann::json describe_scene(const controllers::Scene& scene);

@@ -32,7 +32,8 @@ Result<std::unique_ptr<Server>> Server::start(ServerOptions options) {
        .files = std::move(options.files),
        .ws_description = "this is the WebSocket endpoint of the uh service (docs/protocol.md)\n",
        .no_page = "this build of uh has no live view\n",
-       .program = "uh serve"},
+       .program = "uh serve",
+       .max_connections = options.max_connections},
       [&](boost::asio::io_context& io) {
         auto made = std::make_unique<Hub>(io, std::move(hub_options));
         hub = made.get();

@@ -18,6 +18,7 @@
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/use_awaitable.hpp>
+#include <boost/asio/write.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
@@ -34,6 +35,9 @@ using namespace std::chrono_literals;
 
 // A client that stops reading is closed once this much waits to be sent to it.
 constexpr std::size_t kMaxOutboxBytes = 64u << 20;
+
+// Connections beyond the limit being told so at once; more are closed without an answer.
+constexpr int kMaxRefusing = 16;
 
 // Coroutines end on errors they see; anything thrown is a bug, reported and contained.
 auto exception_reporter(std::string program) {
@@ -70,7 +74,11 @@ class SocketEntry {
 class Connection final : public Peer, public std::enable_shared_from_this<Connection> {
  public:
   Connection(beast::tcp_stream stream, Endpoint& hub, OpenSockets& open, const std::string& program)
-      : ws_(std::move(stream)), hub_(hub), open_(open), program_(program), wake_(ws_.get_executor()) {}
+      : ws_(std::move(stream)), hub_(hub), open_(open), program_(program), wake_(ws_.get_executor()) {
+    beast::error_code ec;
+    const auto remote = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
+    address_ = ec ? std::string("?") : fmt::format("{}:{}", remote.address().to_string(), remote.port());
+  }
 
   asio::awaitable<void> run(http::request<http::string_body> request) {
     auto self = shared_from_this();
@@ -118,6 +126,9 @@ class Connection final : public Peer, public std::enable_shared_from_this<Connec
     }
     wake_.cancel();
   }
+
+  std::size_t queued_bytes() const override { return outbox_bytes_; }
+  const std::string& address() const override { return address_; }
 
   void close(std::uint16_t code, std::string_view reason) override {
     if (close_code_ != 0) return;
@@ -172,6 +183,7 @@ class Connection final : public Peer, public std::enable_shared_from_this<Connec
   std::optional<std::string> state_;  // the newest unsent state message
   std::uint16_t close_code_ = 0;
   std::string close_reason_;
+  std::string address_;
 };
 
 std::string_view path_of(std::string_view target) {
@@ -258,11 +270,35 @@ struct WebSocketHost::Impl {
     if (--live == 0 && stopping) io.stop();
   }
 
+  // one connection too many: told so in HTTP (a WebSocket client sees its handshake refused with
+  // 503) without reading its request, and closed
+  asio::awaitable<void> refuse(tcp::socket socket) {
+    ++refusing;
+    const std::string body = fmt::format("{}: too many connections (the limit is {}); try again later\n",
+                                         options.program, options.max_connections);
+    const std::string response = fmt::format(
+        "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: "
+        "{}\r\nConnection: close\r\n\r\n{}",
+        body.size(), body);
+    beast::tcp_stream stream(std::move(socket));
+    stream.expires_after(5s);
+    beast::error_code ec;
+    co_await asio::async_write(stream, asio::buffer(response), asio::redirect_error(asio::use_awaitable, ec));
+    stream.socket().shutdown(tcp::socket::shutdown_both, ec);
+    --refusing;
+  }
+
   asio::awaitable<void> accept() {
     for (;;) {
       beast::error_code ec;
       tcp::socket socket = co_await acceptor.async_accept(asio::redirect_error(asio::use_awaitable, ec));
       if (ec) co_return;
+      if (live >= options.max_connections) {
+        // a flood of them is closed without a word
+        if (refusing >= kMaxRefusing) continue;
+        asio::co_spawn(io, refuse(std::move(socket)), exception_reporter(options.program));
+        continue;
+      }
       asio::co_spawn(io, serve(std::move(socket)), exception_reporter(options.program));
     }
   }
@@ -278,6 +314,7 @@ struct WebSocketHost::Impl {
   std::uint16_t port = 0;
   std::string url;
   int live = 0;           // connections being served (network thread)
+  int refusing = 0;       // connections being told that there are too many (network thread)
   bool stopping = false;  // network thread
   std::atomic<bool> stopped{false};
 };

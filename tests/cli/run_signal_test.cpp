@@ -1,4 +1,5 @@
-// `uh run` interrupted as a user interrupts it: SIGINT (Ctrl-C) or SIGTERM sent to the running
+// `uh run` interrupted as a user or the system interrupts it: SIGINT (Ctrl-C), SIGTERM, SIGHUP (a
+// closed terminal or SSH session), SIGPIPE (a closed pipe) or SIGQUIT sent to the running
 // program, with and without the live view (--view). It must send zero force, print its summary,
 // keep the trace (whose last row is that zero) and exit with 128 + the signal number; on each
 // hardware driver (its stand-in) and with two devices of different drivers in one session, each
@@ -11,11 +12,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
-#include <memory>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -107,9 +109,15 @@ struct Interrupt {
   bool two_devices = false;
 };
 
+// "SIGHUP" for SIGHUP (glibc's abbreviation, as the kernel's headers name it)
+std::string signal_name(int signal_number) {
+  const char* abbreviation = sigabbrev_np(signal_number);
+  return abbreviation != nullptr ? std::string("SIG") + abbreviation : std::string("a signal");
+}
+
 // names the case in test output (instead of the struct's bytes)
 void PrintTo(const Interrupt& i, std::ostream* out) {
-  *out << (i.signal_number == SIGINT ? "SIGINT" : "SIGTERM") << (i.view ? " with --view" : "")
+  *out << signal_name(i.signal_number) << (i.view ? " with --view" : "")
        << (i.force_dimension ? " on forcedimension" : "") << (i.open_haptics ? " on openhaptics" : "")
        << (i.haply ? " on haply" : "") << (i.two_devices ? " on openhaptics and haply at once" : "");
 }
@@ -124,7 +132,7 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   const bool two_devices = GetParam().two_devices;
   // the stand-in libHD serves the one-device openhaptics case and the two-device scene's left hand
   const bool open_haptics = GetParam().open_haptics || two_devices;
-  const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+  const std::string name = signal_name(signal_number);
   const fs::path dir = fs::temp_directory_path() / fmt::format("uh_run_signal_test_{}_{}{}{}", ::getpid(),
                                                                signal_number, view ? "_view" : "",
                                                                force_dimension ? "_dhd"
@@ -294,23 +302,25 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
   fs::remove_all(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Signals, RunSignalTest,
-                         ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false},
-                                           Interrupt{SIGINT, true}, Interrupt{SIGTERM, true},
-                                           Interrupt{SIGINT, false, true}, Interrupt{SIGTERM, false, true},
-                                           Interrupt{SIGINT, false, false, true},
-                                           Interrupt{SIGTERM, false, false, true},
-                                           Interrupt{SIGINT, false, false, false, true},
-                                           Interrupt{SIGTERM, false, false, false, true},
-                                           Interrupt{SIGINT, false, false, false, false, true},
-                                           Interrupt{SIGTERM, false, false, false, false, true}),
-                         [](const ::testing::TestParamInfo<Interrupt>& p) {
-                           return std::string(p.param.signal_number == SIGINT ? "Sigint" : "Sigterm") +
-                                  (p.param.view ? "WithView" : "") +
-                                  (p.param.force_dimension ? "OnForceDimension" : "") +
-                                  (p.param.open_haptics ? "OnOpenHaptics" : "") + (p.param.haply ? "OnHaply" : "") +
-                                  (p.param.two_devices ? "OnTwoDevices" : "");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Signals, RunSignalTest,
+    ::testing::Values(Interrupt{SIGINT, false}, Interrupt{SIGTERM, false}, Interrupt{SIGINT, true},
+                      Interrupt{SIGTERM, true}, Interrupt{SIGINT, false, true},
+                      Interrupt{SIGTERM, false, true}, Interrupt{SIGINT, false, false, true},
+                      Interrupt{SIGTERM, false, false, true}, Interrupt{SIGINT, false, false, false, true},
+                      Interrupt{SIGTERM, false, false, false, true},
+                      Interrupt{SIGINT, false, false, false, false, true},
+                      Interrupt{SIGTERM, false, false, false, false, true}, Interrupt{SIGHUP, false},
+                      Interrupt{SIGPIPE, false}, Interrupt{SIGQUIT, false}, Interrupt{SIGHUP, true},
+                      Interrupt{SIGHUP, false, false, true}),
+    [](const ::testing::TestParamInfo<Interrupt>& p) {
+      std::string name = signal_name(p.param.signal_number);
+      for (std::size_t i = 1; i < name.size(); ++i)
+        name[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[i])));
+      return name + (p.param.view ? "WithView" : "") + (p.param.force_dimension ? "OnForceDimension" : "") +
+             (p.param.open_haptics ? "OnOpenHaptics" : "") + (p.param.haply ? "OnHaply" : "") +
+             (p.param.two_devices ? "OnTwoDevices" : "");
+    });
 
 }  // namespace
 }  // namespace uh

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <fstream>
 #include <set>
@@ -245,6 +247,53 @@ TEST(Scene, LoadSceneNamesAMissingFile) {
   const auto scene = load_scene("/nonexistent/scene.json");
   ASSERT_FALSE(scene.has_value());
   EXPECT_NE(scene.error().message.find("/nonexistent/scene.json: cannot open"), std::string::npos);
+}
+
+// Paths a scene names are opened as regular files only: a directory, a FIFO or a device is an
+// error naming the field and the path, found when the scene is read (not an abort, a hang or an
+// endless read when it is packed).
+TEST(Scene, RefusesMeshesAndScenesThatAreNotRegularFiles) {
+  const auto dir = testing::fresh_cache("not-files");
+  const auto fifo = dir / "pipe.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string good = small_scene_json();
+  struct Case {
+    std::string mesh;
+    std::string expected;
+  };
+  const Case cases[] = {
+      {dir.string(), fmt::format("field 'objects[0].mesh': {}: is a directory, not a file", dir.string())},
+      {"/dev/zero", "field 'objects[0].mesh': /dev/zero: is a device, not a file"},
+      {fifo.string(),
+       fmt::format("field 'objects[0].mesh': {}: is a FIFO (named pipe), not a file", fifo.string())},
+  };
+  for (const Case& c : cases) {
+    const auto scene = parse_scene(replaced(good, R"("meshes/bunny_npm_3674.obj")", "\"" + c.mesh + "\""),
+                                   "test.json", test_assets());
+    ASSERT_FALSE(scene.has_value()) << c.mesh;
+    EXPECT_NE(scene.error().message.find(c.expected), std::string::npos) << scene.error().message;
+  }
+  for (const std::filesystem::path& file : {dir, std::filesystem::path("/dev/zero"), fifo}) {
+    const auto scene = load_scene(file);
+    ASSERT_FALSE(scene.has_value()) << file;
+    EXPECT_EQ(scene.error().message.rfind(file.string() + ": is a", 0), 0u) << scene.error().message;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A scene file nested deeper than any scene needs is refused before it is parsed, with the same
+// guard as the service's messages (it crashed a server that opened it by path).
+TEST(Scene, RefusesJsonNestedDeeperThanTheGuard) {
+  const std::string deep = "{\"name\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  const auto scene = parse(deep);
+  ASSERT_FALSE(scene.has_value());
+  EXPECT_EQ(scene.error().message, "test.json: the JSON is nested deeper than 32 levels");
+  const auto dir = testing::fresh_cache("deep");
+  std::ofstream(dir / "deep.json") << deep;
+  const auto loaded = load_scene(dir / "deep.json");
+  ASSERT_FALSE(loaded.has_value());
+  EXPECT_NE(loaded.error().message.find("nested deeper than 32 levels"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Scene, TheRepositoryScenesParse) {

@@ -172,16 +172,38 @@ TEST(MuseumServer, SnapshotsComeAtTwentyToThirtyHertzOfGameTime) {
   EXPECT_NE(refused.error().message.find("speed 50 is not within 0.1..20"), std::string::npos);
 }
 
-TEST(MuseumServer, ADroppedPlayerPausesTheRoundAndAReconnectResumesIt) {
-  auto server = start(open_hall_round());
-  ASSERT_TRUE(server);
-  auto vive = std::make_unique<Client>(server->port());
-  vive->request(hello_as("vive"), "welcome");
-  Client phantom(server->port());
+// Says `hello` and returns the answer (welcome or error, other messages skipped); while the role is
+// still taken by a client that just left (the server has not yet seen its socket close), again.
+json hello_when_free(Client& c, const json& hello) {
+  for (;;) {
+    c.send(hello);
+    std::optional<json> m;
+    do m = c.read();
+    while (m && (*m)["type"] != "welcome" && (*m)["type"] != "error");
+    if (!m) return json::object();
+    if ((*m)["type"] == "welcome" ||
+        (*m)["message"].get<std::string>().find("role is taken by another client") == std::string::npos)
+      return *m;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+// Vive and Phantom say hello; returns once the round has played a few ticks.
+json play_a_little(Client& vive, Client& phantom) {
+  vive.request(hello_as("vive"), "welcome");
   phantom.request(hello_as("phantom"), "welcome");
   json s;
   do s = *next_snapshot(phantom);
   while (s["phase"] != "playing" || s["tick"].get<int>() < 6);
+  return s;
+}
+
+TEST(MuseumServer, ADroppedPlayerPausesTheRoundAndAReconnectResumesIt) {
+  auto server = start(open_hall_round());
+  ASSERT_TRUE(server);
+  auto vive = std::make_unique<Client>(server->port());
+  Client phantom(server->port());
+  json s = play_a_little(*vive, phantom);
   // Vive walks east, then drops out
   vive->send({{"type", "move"}, {"move", {1.0, 0.0}}});
   do s = *next_snapshot(phantom);
@@ -209,6 +231,95 @@ TEST(MuseumServer, ADroppedPlayerPausesTheRoundAndAReconnectResumesIt) {
   while (s["tick"].get<std::int64_t>() < paused_tick + 6);
   EXPECT_EQ(s["vive"]["pos"][0], paused_x) << "a reconnected Vive does not keep walking";
   EXPECT_LT(s["time_left_s"].get<double>(), paused_time);
+}
+
+// A player who reconnects over and over never moves a paused round: it resumes a second after both
+// players are back (100 reconnects of Vive, each sending a run, moved her 6 cm while the round showed
+// paused); the round itself keeps its tick and timer meanwhile.
+TEST(MuseumServer, ReconnectingOverAndOverDoesNotMoveAPausedRound) {
+  GameServerOptions options = open_hall_round();
+  options.resume_delay_s = 600.0;  // longer than the test: the check does not depend on its speed
+  auto server = start(options);
+  ASSERT_TRUE(server);
+  auto vive = std::make_unique<Client>(server->port());
+  Client phantom(server->port());
+  json s = play_a_little(*vive, phantom);
+  vive.reset();
+  do s = *next_snapshot(phantom);
+  while (s["phase"] != "paused");
+  const auto paused_tick = s["tick"].get<std::int64_t>();
+  const double paused_x = s["vive"]["pos"][0];
+  for (int i = 0; i < 10; ++i) {
+    Client again(server->port());
+    ASSERT_EQ(hello_when_free(again, hello_as("vive"))["type"], "welcome");
+    again.send({{"type", "move"}, {"move", {1.0, 0.0}}, {"run", true}});
+    // two snapshots (six ticks of the rules) with her back and running: the round stays paused
+    for (int k = 0; k < 2; ++k) {
+      const json seen = *next_snapshot(again);
+      EXPECT_EQ(seen["phase"], "paused");
+      EXPECT_EQ(seen["tick"], paused_tick);
+    }
+  }
+  const museum::GameState state = server->state();
+  EXPECT_EQ(state.tick, paused_tick) << "the round did not play";
+  EXPECT_EQ(state.vive.pos.x, paused_x) << "Vive did not move";
+  EXPECT_TRUE(state.paused);
+}
+
+// Phantom's seat is its station's: while it is away nobody else takes it without the seat key of
+// its first welcome (which only Phantom was given); with the key, the station comes back.
+TEST(MuseumServer, PhantomsSeatIsTakenAgainOnlyWithItsKey) {
+  GameServerOptions options = open_hall_round();
+  options.token = "s3cret";
+  options.seat_hold_s = 3600.0;  // longer than the test: the check does not depend on its speed
+  auto server = start(options);
+  ASSERT_TRUE(server);
+  const json token = {{"token", "s3cret"}};
+  Client vive(server->port());
+  EXPECT_FALSE(vive.request(hello_as("vive", token), "welcome").contains("seat_key"))
+      << "only Phantom's seat has a key";
+  std::string key;
+  {
+    Client phantom(server->port());
+    key = phantom.request(hello_as("phantom", token), "welcome")["seat_key"].get<std::string>();
+    EXPECT_EQ(key.size(), 32u);
+  }
+  // a token holder who is not the station
+  Client thief(server->port());
+  json e = hello_when_free(thief, hello_as("phantom", token));
+  EXPECT_NE(e["message"].get<std::string>().find("the phantom seat is held for the station that took it"),
+            std::string::npos)
+      << e;
+  thief.send(hello_as("phantom", {{"token", "s3cret"}, {"seat_key", std::string(32, '0')}}));
+  e = thief.expect("error");
+  EXPECT_EQ(e["message"], "the seat_key is wrong");
+  thief.send(hello_as("phantom", {{"token", "s3cret"}, {"seat_key", "guess"}}));
+  thief.expect("error");
+  EXPECT_FALSE(thief.read().has_value()) << "closed after three failed hellos";
+  Client station(server->port());
+  const json back = station.request(hello_as("phantom", {{"token", "s3cret"}, {"seat_key", key}}), "welcome");
+  EXPECT_EQ(back["seat_key"], key);
+}
+
+// Without a token everyone on the machine may play any role, and after the hold another station
+// may sit down (a station that is gone for good does not end the round): it gets a new key.
+TEST(MuseumServer, PhantomsSeatIsFreeWithoutATokenAndAfterTheHold) {
+  for (const bool with_token : {false, true}) {
+    GameServerOptions options = open_hall_round();
+    if (with_token) options.token = "s3cret";
+    options.seat_hold_s = 0.0;
+    auto server = start(options);
+    ASSERT_TRUE(server);
+    const json token = with_token ? json{{"token", "s3cret"}} : json::object();
+    std::string first;
+    {
+      Client phantom(server->port());
+      first = phantom.request(hello_as("phantom", token), "welcome")["seat_key"].get<std::string>();
+    }
+    Client other(server->port());
+    const json welcome = hello_when_free(other, hello_as("phantom", token));
+    EXPECT_NE(welcome["seat_key"], first);
+  }
 }
 
 TEST(MuseumServer, ATokenIsRequiredWhenConfiguredAndOffLoopback) {

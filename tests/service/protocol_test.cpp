@@ -317,10 +317,18 @@ TEST_F(SceneDocumentTest, AnInlineMeshIsCheckedLikeAFileAndStoredByContent) {
   ASSERT_TRUE(bunny.has_value()) << bunny.error().message;
   const json object = {{"name", "inline"}, {"spheres", 200}, {"meters_per_unit", 0.01}};
   const auto mesh_dir = dir_ / "inline-meshes";
+  // as the service does it: the mesh checked and written (off its network thread), then added
+  const auto add_inline_object = [&](const json& o,
+                                     const collette::TriangleMesh& mesh) -> Result<collette::MeshReport> {
+    auto written = write_inline_mesh(mesh, mesh_dir);
+    if (!written) return written.error();
+    if (auto added = doc_->add_inline_object(o, written->file); !added) return added.error();
+    return written->report;
+  };
   // sent with the opposite winding, as an engine with clockwise front faces would: fixed as for files
   collette::TriangleMesh flipped = *bunny;
   for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
-  auto report = doc_->add_inline_object(object, flipped, mesh_dir);
+  auto report = add_inline_object(object, flipped);
   ASSERT_TRUE(report.has_value()) << report.error().message;
   EXPECT_TRUE(report->winding_flipped);
   EXPECT_EQ(report->vertex_count, static_cast<std::int64_t>(bunny->vertices.size()));
@@ -332,20 +340,20 @@ TEST_F(SceneDocumentTest, AnInlineMeshIsCheckedLikeAFileAndStoredByContent) {
   EXPECT_EQ(stored->triangles.size(), bunny->triangles.size());
   EXPECT_NEAR(stored->report.volume, bunny->report.volume, 1e-9 * bunny->report.volume);
   // the same mesh again is the same file (the packing cache is keyed by the file's content)
-  ASSERT_TRUE(doc_->add_inline_object({{"name", "again"}, {"spheres", 200}}, flipped, mesh_dir));
+  ASSERT_TRUE(add_inline_object({{"name", "again"}, {"spheres", 200}}, flipped));
   EXPECT_EQ(doc_->scene().objects.back().shape.mesh, stored_path);
 
   // an open mesh is refused naming the request, as a file is naming the file
   collette::TriangleMesh open = *bunny;
   open.source_name = "add_object 'open' (mesh_binary)";
   open.triangles.pop_back();
-  auto refused = doc_->add_inline_object({{"name", "open"}}, open, mesh_dir);
+  auto refused = add_inline_object({{"name", "open"}}, open);
   ASSERT_FALSE(refused.has_value());
   EXPECT_NE(refused.error().message.find("add_object 'open' (mesh_binary): mesh is not closed"),
             std::string::npos)
       << refused.error().message;
   // a refused object (its name is taken) changes nothing
-  EXPECT_FALSE(doc_->add_inline_object({{"name", "bunny"}}, *bunny, mesh_dir).has_value());
+  EXPECT_FALSE(add_inline_object({{"name", "bunny"}}, *bunny).has_value());
   EXPECT_EQ(doc_->scene().objects.size(), 3u);
 }
 

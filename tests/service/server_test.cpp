@@ -10,6 +10,9 @@
 #include <cmath>
 #include <optional>
 #include <set>
+#include <thread>
+
+#include <sys/stat.h>
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -156,6 +159,187 @@ TEST_F(ServerTest, ATokenIsRequiredWhenConfiguredAndOffLoopback) {
   Client c(port());
   c.hello("s3cret");
   c.request({{"type", "ping"}}, "pong");
+}
+
+// A scene or mesh path that is a FIFO, a device or a directory is an error naming it; the network
+// thread never blocks on one (a FIFO without a writer stalled every client) nor reads one without
+// end (/dev/zero grew the server by gigabytes), and a directory mesh never reaches the packing
+// (which aborted the server at start).
+TEST_F(ServerTest, PathsThatAreNotRegularFilesAreRefusedWithoutStoppingOthers) {
+  const auto fifo = dir_ / "scene-pipe.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  Client c(port());
+  c.hello();
+  Client other(port());
+  other.hello();
+  const json from_fifo = c.request({{"type", "open"}, {"scene", fifo.string()}}, "error");
+  EXPECT_NE(from_fifo["message"].get<std::string>().find("is a FIFO (named pipe), not a file"),
+            std::string::npos)
+      << from_fifo;
+  other.request({{"type", "ping"}}, "pong");
+  const json from_zero = c.request({{"type", "open"}, {"scene", "/dev/zero"}}, "error");
+  EXPECT_EQ(from_zero["message"], "/dev/zero: is a device, not a file");
+  const json from_dir = c.request({{"type", "open"}, {"scene", dir_.string()}}, "error");
+  EXPECT_NE(from_dir["message"].get<std::string>().find("is a directory, not a file"), std::string::npos);
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  for (const std::string& mesh : {dir_.string(), std::string("/dev/zero"), fifo.string()}) {
+    const json e =
+        c.request({{"type", "add_object"}, {"object", {{"name", "bad"}, {"mesh", mesh}}}}, "error");
+    EXPECT_NE(e["message"].get<std::string>().find("field 'objects[1].mesh': " + mesh + ": is a"),
+              std::string::npos)
+        << e;
+  }
+  const json tool = c.request({{"type", "set_tool"}, {"tool", {{"mesh", dir_.string()}}}}, "error");
+  EXPECT_NE(tool["message"].get<std::string>().find("is a directory, not a file"), std::string::npos) << tool;
+  other.request({{"type", "ping"}}, "pong");
+  std::filesystem::remove(fifo);
+}
+
+// Before a successful hello the service holds nothing large for a client: an add_object that
+// announces a binary frame does not raise the frame limit (a 2 MiB frame is closed with 1009, as
+// any message above the limit), and a client that sends many messages without a hello is closed.
+TEST_F(ServerTest, NothingLargeIsHeldForAClientBeforeItsHello) {
+  start_server("s3cret");
+  {
+    Client c(port());
+    c.send({{"type", "add_object"},
+            {"object", {{"name", "x"}}},
+            {"mesh_binary", {{"vertices", 100000}, {"triangles", 100000}}}});
+    EXPECT_NE(c.expect("error")["message"].get<std::string>().find("send hello first"), std::string::npos);
+    // the server closes (1009) as soon as it reads the frame's header: the rest of the frame may
+    // meet a closed socket, so a failed write is that close too
+    try {
+      c.send_binary(std::string(2400000, '\0'));
+    } catch (const boost::system::system_error&) {
+    }
+    beast::error_code ended;
+    while (c.read(&ended)) {
+    }
+    EXPECT_TRUE(c.close_reason().code == websocket::close_code::too_big || ended)
+        << "the connection ended: " << ended.message();
+  }
+  {
+    Client c(port());
+    try {
+      for (int i = 0; i < 40; ++i) c.send({{"type", "ping"}});
+    } catch (const boost::system::system_error&) {
+      // closed after the 16th
+    }
+    int errors = 0;
+    beast::error_code ended;
+    while (c.read(&ended)) ++errors;
+    EXPECT_EQ(errors, 16) << "each early message is answered until the connection is closed";
+    EXPECT_EQ(c.close_reason().code, websocket::close_code::policy_error);
+    EXPECT_EQ(c.close_reason().reason, "too many messages before hello");
+  }
+  // a wrong token closes at once; what the client sends after it is not read
+  {
+    Client c(port());
+    c.send({{"type", "hello"}, {"protocol", 1}, {"token", "guess1"}});
+    c.send({{"type", "hello"}, {"protocol", 1}, {"token", "s3cret"}});
+    EXPECT_NE(c.expect("error")["message"].get<std::string>().find("wrong token"), std::string::npos);
+    beast::error_code ended;
+    EXPECT_FALSE(c.read(&ended).has_value()) << "the second hello is not answered";
+    EXPECT_EQ(c.close_reason().code, websocket::close_code::policy_error);
+  }
+  Client c(port());
+  c.hello("s3cret");
+}
+
+// A bounded number of connections: one more gets HTTP 503 naming the limit; a freed place is
+// served again.
+TEST_F(ServerTest, ConnectionsBeyondTheLimitAreRefusedWithAClearAnswer) {
+  server_.reset();
+  ServerOptions options{.host = "127.0.0.1", .port = 0, .max_connections = 3};
+  options.cache_dir = UH_TEST_CACHE_DIR;
+  auto s = Server::start(std::move(options));
+  ASSERT_TRUE(s.has_value()) << s.error().message;
+  server_ = std::move(s).value();
+  auto first = std::make_unique<Client>(port());
+  first->hello();
+  Client second(port()), third(port());
+  second.hello();
+  third.hello();
+  const auto [status, body] = http_get(port(), "/");
+  EXPECT_EQ(status, 503u);
+  EXPECT_EQ(body, "uh serve: too many connections (the limit is 3); try again later\n");
+  first.reset();
+  // the server notices the closed connection on its own thread: wait for the place, bounded
+  const auto deadline = std::chrono::steady_clock::now() + test_support::kPatience;
+  unsigned again = 503;
+  while (again == 503 && std::chrono::steady_clock::now() < deadline) {
+    again = http_get(port(), "/").first;
+    if (again == 503) std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(again, 404u) << "served again (this server has no page)";
+}
+
+// get_mesh asked over and over by a client that does not read is refused once its replies pile up,
+// instead of the server growing its queue (and closing it) or spending its thread on it; another
+// client's state stream goes on.
+TEST_F(ServerTest, AGetMeshFloodIsBoundedAndOthersKeepTheirStream) {
+  Client watcher(port());
+  watcher.hello();
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}}, "opened");  // the default scene: a reply of about 140 kB
+  // 200 replies (28 MB) are more than the 8 MiB bound and the kernel's socket buffers together
+  constexpr int kRequests = 200;
+  watcher.request({{"type", "subscribe"}, {"rate_hz", 50}}, "subscribed");
+  c.request({{"type", "start"}}, "started");
+  for (int i = 0; i < kRequests; ++i) c.send({{"type", "get_mesh"}, {"object", "bunny"}, {"id", i}});
+  for (int i = 0; i < 20; ++i) watcher.expect("state");
+  int meshes = 0, refused = 0;
+  while (meshes + refused < kRequests) {
+    const auto m = c.read();
+    ASSERT_TRUE(m.has_value()) << "the flooding client stays connected";
+    if ((*m)["type"] == "mesh") {
+      EXPECT_EQ((*m)["id"], meshes + refused);
+      EXPECT_EQ((*m)["object"], "bunny");
+      ++meshes;
+    } else if ((*m)["type"] == "error") {
+      EXPECT_NE((*m)["message"].get<std::string>().find("read them before asking for another mesh"),
+                std::string::npos)
+          << *m;
+      ++refused;
+    }
+  }
+  EXPECT_GE(meshes, 1);
+  EXPECT_GE(refused, 1);
+  // once read, it may ask again
+  const json again = c.request({{"type", "get_mesh"}, {"object", "bunny"}, {"id", "again"}}, "mesh");
+  EXPECT_EQ(again["id"], "again");
+  EXPECT_GT(again["triangles"].size(), 10000u);
+}
+
+// An inline mesh is the scene's own: its file (and its packing cache) goes when the scene closes,
+// so that clients cannot fill the service's disk.
+TEST_F(ServerTest, AnInlineMeshFileGoesWithItsScene) {
+  server_.reset();
+  const auto cache = dir_ / "own-cache";
+  ServerOptions options{.host = "127.0.0.1", .port = 0, .cache_dir = cache, .working_dir = dir_};
+  auto s = Server::start(std::move(options));
+  ASSERT_TRUE(s.has_value()) << s.error().message;
+  server_ = std::move(s).value();
+  auto bunny = collette::load_mesh(testing::assets() / "meshes" / "bunny_npm_3674.obj");
+  ASSERT_TRUE(bunny.has_value()) << bunny.error().message;
+  const auto files_in = [](const std::filesystem::path& d) {
+    std::error_code ec;
+    std::size_t n = 0;
+    for (std::filesystem::directory_iterator it(d, ec), end; !ec && it != end; it.increment(ec)) ++n;
+    return n;
+  };
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
+  c.send({{"type", "add_object"},
+          {"object", {{"name", "inline"}, {"spheres", 100}, {"meters_per_unit", 0.01}}},
+          {"mesh_binary", {{"vertices", bunny->vertices.size()}, {"triangles", bunny->triangles.size()}}}});
+  c.send_binary(encode_mesh_binary(*bunny));
+  c.expect("object_added");
+  EXPECT_EQ(files_in(cache / "inline-meshes"), 1u);
+  c.request({{"type", "close"}}, "closed");
+  EXPECT_EQ(files_in(cache / "inline-meshes"), 0u);
 }
 
 TEST_F(ServerTest, ServesThePageOverHttp) {

@@ -96,7 +96,12 @@ struct Scene {
 /// Reads a scene file. Errors name the file, the field (as a JSON path such as
 /// `tool.device.driver`) and what is expected; unknown fields are errors too (typos).
 /// Relative mesh and .ist paths are resolved against the scene file's directory.
+/// The file must be a regular file of at most kMaxSceneFileBytes (uh/core/regular_file.hpp); a
+/// mesh or .ist it names must be a regular file too.
 Result<Scene> load_scene(const std::filesystem::path& path);
+
+/// The text of a scene file, read as load_scene() reads it (a regular file, size-limited).
+Result<std::string> read_scene_file(const std::filesystem::path& path);
 
 /// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
 Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);

@@ -26,6 +26,8 @@ struct ItemView {
 /// `welcome`: the level (rooms, cases, the table, the kinds; the rule numbers the station needs).
 struct Welcome {
   std::string role{};
+  /// Phantom's only: the key that takes its seat again after a dropped connection (hello.seat_key).
+  std::string seat_key{};
   museum::Level level{};
   std::vector<std::string> targets{};
 };
@@ -112,7 +114,8 @@ Result<ServerMessage> parse_server_message(std::string_view text);
 
 /// The JSON text of a hello in `role` (vive, phantom or watcher), of Phantom's verdict and of
 /// Vive's move (`move`: the direction, at most unit length) and actions (break, take, deliver).
-std::string hello_text(std::string_view role, std::string_view token);
+/// `seat_key` (Phantom's reconnect, from its first welcome) is sent when not empty.
+std::string hello_text(std::string_view role, std::string_view token, std::string_view seat_key = {});
 std::string verdict_text(int item, museum::Verdict verdict);
 std::string move_text(museum::Vec2 move, bool run);
 std::string action_text(std::string_view action);

@@ -38,6 +38,12 @@ struct GameServerOptions {
   /// Game seconds per second of the wall clock, 0.1..20: 1 for people; a round of bots only may
   /// run faster (`uh museum play --bots --speed`).
   double speed = 1.0;
+  /// A paused round plays again this long [s, wall clock] after both players are back (its first
+  /// start is at once): a player who reconnects over and over never moves it. 0..600.
+  double resume_delay_s = 1.0;
+  /// With a token: Phantom's seat is held this long [s] after its station dropped out; meanwhile
+  /// only a hello with the station's `seat_key` takes it (token holders cannot). 0..3600.
+  double seat_hold_s = 60.0;
   std::vector<service::StaticFile> files{};  ///< the browser client's files, if any
 };
 

@@ -34,6 +34,8 @@ struct ServerOptions {
   std::filesystem::path cache_dir{};    ///< where .ist builds are cached; empty: the default
   std::filesystem::path working_dir{};  ///< relative paths in requests; empty: the current folder
   bool raise_priority = false;          ///< sessions ask for SCHED_FIFO (as `uh run`)
+  /// Connections served at once; one more is answered with HTTP 503 (docs/protocol.md).
+  int max_connections = 500;
 };
 
 class Server {

@@ -42,6 +42,11 @@ class Peer {
   virtual void send(std::string text, bool is_state = false) = 0;
   /// Sends a close frame with `code` (RFC 6455) after the queued messages.
   virtual void close(std::uint16_t code, std::string_view reason) = 0;
+  /// Bytes of messages queued for this client and not yet written (state messages aside): an
+  /// endpoint refuses a request whose large reply would pile up behind a client that does not read.
+  virtual std::size_t queued_bytes() const = 0;
+  /// The client's address ("127.0.0.1:50412"), for the log.
+  virtual const std::string& address() const = 0;
 };
 
 /// The logic behind the socket. Every call comes on the host's network thread.
@@ -75,6 +80,9 @@ struct HostOptions {
   std::string no_page = "this build has no page\n";
   /// Names the program in the rare messages the host prints itself (e.g. "uh serve").
   std::string program = "uh";
+  /// At most this many connections (HTTP and WebSocket) at once; one more is answered with HTTP
+  /// 503 and closed. Each holds at most the endpoint's message limit and its outbox.
+  int max_connections = 500;
 };
 
 class WebSocketHost {
