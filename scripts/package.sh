@@ -2,26 +2,34 @@
 # Builds the release artifacts under dist/, all versioned by project(VERSION) in CMakeLists.txt:
 #   unrealhaptics_<v>_amd64.deb   uh, libuh.so, headers, the CMake package, the Python module,
 #                                 scenes and meshes, docs and uh's man page (docs/packaging.md)
+#   unrealhaptics-<v>-windows-x64.zip   uh.dll, its import library, uh.h, the C API's docs
+#   org.unrealhaptics.core-<v>.tgz      the Unity package with libuh.so (and uh.dll) in Plugins/x86_64
+#   unrealhaptics-godot-<v>.zip         the Godot addon with the Linux uh program in it
 #   SHA256SUMS                    the artifacts' checksums
-# usage: package.sh [--build-dir DIR] [--no-build] [--out DIR]
-#   --build-dir DIR  the Linux Release build to package (default build/package, configured here)
-#   --no-build       package DIR as it is (the package_deb test does so with the Release build)
-#   --out DIR        where the artifacts go (default dist/)
+# usage: package.sh [--build-dir DIR] [--windows-build-dir DIR] [--no-build] [--out DIR]
+#   --build-dir DIR          the Linux Release build to package (default build/package, configured here)
+#   --windows-build-dir DIR  the mingw-w64 build (default build/windows); without its uh.dll
+#                            (with --no-build) the Windows zip and the Unity package's uh.dll are left out
+#   --no-build               package the builds as they are (the package tests do so)
+#   --out DIR                where the artifacts go (default dist/)
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 
 build_dir=build/package
+windows_dir=build/windows
 build=1
 out="$uh_root/dist"
 while [ $# -gt 0 ]; do
   case $1 in
     --build-dir) build_dir=$2; shift 2 ;;
+    --windows-build-dir) windows_dir=$2; shift 2 ;;
     --no-build) build=0; shift ;;
     --out) out=$2; shift 2 ;;
     *) echo "package: unknown argument $1 (see the script's header)" >&2; exit 2 ;;
   esac
 done
 case $build_dir in /*) ;; *) build_dir="$uh_root/$build_dir" ;; esac
+case $windows_dir in /*) ;; *) windows_dir="$uh_root/$windows_dir" ;; esac
 
 version=$(sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9]+\.[0-9]+\.[0-9]+).*/\1/p' "$uh_root/CMakeLists.txt")
 [ -n "$version" ] || { echo "package: no project(VERSION) in CMakeLists.txt" >&2; exit 1; }
@@ -34,7 +42,12 @@ if [ "$build" = 1 ]; then
   bash "$uh_root/scripts/install-deps.sh"
   echo "== build (Release, $build_dir) =="
   uh_build "${build_dir#"$uh_root"/}" -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF
+  echo "== build (Windows x64, mingw-w64, $windows_dir) =="
+  uh_build "${windows_dir#"$uh_root"/}" uh_capi -- -DCMAKE_TOOLCHAIN_FILE="$uh_root/cmake/mingw-w64-x86_64.cmake" \
+    -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF
 fi
+uh_dll="$windows_dir/bin/uh.dll"
+[ -f "$uh_dll" ] || { echo "package: no $uh_dll: the Windows zip and the Unity package's uh.dll are left out"; uh_dll=""; }
 
 # Depends: of the package's ELF files, from the Debian packages their libraries come from
 # (dpkg-shlibdeps wants a source package's layout: ROOT is debian/<package>/ beside debian/control)
@@ -101,7 +114,95 @@ EOF
   echo "$deb"
 }
 
+package_windows() {
+  local name="unrealhaptics-${version}-windows-x64" root="$work/windows"
+  echo "== $name.zip =="
+  DESTDIR="$root" cmake --install "$windows_dir" --prefix "/$name" >/dev/null
+  mkdir -p "$root/$name/doc"
+  cp "$uh_root/docs/capi.md" "$root/$name/doc/"
+  (cd "$root" && zip -qrX "$out/$name.zip" "$name")
+}
+
+# Unity's import settings: a .meta beside every asset and folder, its GUID derived from the path so
+# that every release gives an asset the same one (scenes reference scripts by GUID)
+unity_meta() {
+  local asset=$1 relative=$2 importer=$3 guid
+  guid=$(printf 'org.unrealhaptics.core/%s' "$relative" | md5sum | cut -c1-32)
+  {
+    printf 'fileFormatVersion: 2\nguid: %s\n' "$guid"
+    if [ -d "$asset" ]; then printf 'folderAsset: yes\n'; fi
+    printf '%s:\n  externalObjects: {}\n' "$importer"
+    case $importer in
+      MonoImporter) printf '  serializedVersion: 2\n  defaultReferences: []\n  executionOrder: 0\n  icon: {instanceID: 0}\n' ;;
+      PluginImporter) unity_plugin_platforms "$(basename "$asset")" ;;
+    esac
+    printf '  userData: \n  assetBundleName: \n  assetBundleVariant: \n'
+  } >"$asset.meta"
+}
+
+# a native plugin's platforms: the .so files for the Linux editor and player, uh.dll for Windows'
+unity_plugin_platforms() {
+  local os=Linux player=Linux64 other=Win64
+  case $1 in *.dll) os=Windows player=Win64 other=Linux64 ;; esac
+  printf '  serializedVersion: 2\n  iconMap: {}\n  executionOrder: {}\n  defineConstraints: []\n'
+  printf '  isPreloaded: 0\n  isOverridable: 0\n  isExplicitlyReferenced: 0\n  validateReferences: 1\n'
+  printf '  platformData:\n'
+  printf '  - first:\n      Any: \n    second:\n      enabled: 0\n      settings: {}\n'
+  printf '  - first:\n      Editor: Editor\n    second:\n      enabled: 1\n      settings:\n        CPU: x86_64\n        DefaultValueInitialized: true\n        OS: %s\n' "$os"
+  printf '  - first:\n      Standalone: %s\n    second:\n      enabled: 1\n      settings:\n        CPU: x86_64\n' "$player"
+  printf '  - first:\n      Standalone: %s\n    second:\n      enabled: 0\n      settings:\n        CPU: None\n' "$other"
+}
+
+unity_importer() {
+  case $1 in
+    *.cs) echo MonoImporter ;;
+    *.asmdef) echo AssemblyDefinitionImporter ;;
+    package.json) echo PackageManifestImporter ;;
+    *.md) echo TextScriptImporter ;;
+    *.so | *.so.* | *.dll) echo PluginImporter ;;
+    *) echo DefaultImporter ;;
+  esac
+}
+
+# The Unity package as npm packs it (one folder, package/): the manifest, README, Runtime/, and
+# Plugins/x86_64 with libuh.so, the shared libraries it needs (found beside it through its RPATH
+# $ORIGIN, staged as for the Unreal plugin) and uh.dll; their Debian copyright files in Licenses~
+package_unity() {
+  local name="org.unrealhaptics.core-${version}.tgz" root="$work/unity/package" staged="$work/unity-staged"
+  echo "== $name =="
+  mkdir -p "$root/Plugins/x86_64"
+  cp "$uh_root/engines/unity/package.json" "$uh_root/engines/unity/README.md" "$root/"
+  cp -r "$uh_root/engines/unity/Runtime" "$root/"
+  UH_PLUGIN_DIR="$staged" bash "$uh_root/engines/unreal/UnrealHaptics/stage-libuh.sh" "$build_dir" /nonexistent >/dev/null
+  local lib="$staged/Source/ThirdParty/UhLibrary/lib/Linux"
+  [ -f "$lib/libuh.so" ] || { echo "package: libuh.so was not staged" >&2; exit 1; }
+  while read -r file; do cp "$lib/$file" "$root/Plugins/x86_64/"; done <"$lib/files.txt"
+  if [ -d "$lib/licenses" ]; then cp -r "$lib/licenses" "$root/Licenses~"; fi
+  if [ -n "$uh_dll" ]; then cp "$uh_dll" "$root/Plugins/x86_64/"; fi
+  local asset
+  while IFS= read -r asset; do
+    unity_meta "$asset" "${asset#"$root"/}" "$(unity_importer "$(basename "$asset")")"
+  done < <(find "$root" -mindepth 1 -not -path '*~*' -not -name '*.meta')
+  tar --sort=name --owner=0 --group=0 --numeric-owner --mtime="@0" -C "$work/unity" -czf "$out/$name" package
+}
+
+# The Godot addon in the asset library's layout (addons/unrealhaptics/), with the Linux uh program
+# in addons/unrealhaptics/bin/ (the HapticManager starts it: its uh_program or UH_PROGRAM names it)
+package_godot() {
+  local name="unrealhaptics-godot-${version}.zip" root="$work/godot"
+  echo "== $name =="
+  mkdir -p "$root/addons"
+  cp -r "$uh_root/engines/godot/addons/unrealhaptics" "$root/addons/"
+  mkdir -p "$root/addons/unrealhaptics/bin"
+  cp "$build_dir/apps/uh/uh" "$root/addons/unrealhaptics/bin/uh"
+  (cd "$root" && zip -qrX "$out/$name" addons)
+}
+
+rm -f "$out"/unrealhaptics_*.deb "$out"/unrealhaptics-*.zip "$out"/org.unrealhaptics.core-*.tgz "$out/SHA256SUMS"
 package_deb
-(cd "$out" && sha256sum -- *.deb >SHA256SUMS)
+if [ -n "$uh_dll" ]; then package_windows; fi
+package_unity
+package_godot
+(cd "$out" && sha256sum -- *.deb *.zip *.tgz >SHA256SUMS)
 echo "== $out/SHA256SUMS =="
 cat "$out/SHA256SUMS"
