@@ -12,7 +12,9 @@ mkdir -p "$work"
 
 fail() { echo "package_deb: $*" >&2; exit 1; }
 
-bash "$source_dir/scripts/package.sh" --build-dir "$build_dir" --no-build --out "$work/dist"
+# the Linux artifacts of this build only: a Windows build folder may hold another version's uh.dll
+bash "$source_dir/scripts/package.sh" --build-dir "$build_dir" --windows-build-dir "$work/no-windows-build" \
+  --no-build --out "$work/dist"
 version=$(sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9.]+).*/\1/p' "$source_dir/CMakeLists.txt")
 deb="$work/dist/unrealhaptics_${version}_$(dpkg --print-architecture).deb"
 [ -f "$deb" ] || fail "no $deb"
