@@ -6,11 +6,12 @@
 #   org.unrealhaptics.core-<v>.tgz      the Unity package with libuh.so (and uh.dll) in Plugins/x86_64
 #   unrealhaptics-godot-<v>.zip         the Godot addon with the Linux uh program in it
 #   SHA256SUMS                    the artifacts' checksums
-# usage: package.sh [--build-dir DIR] [--windows-build-dir DIR] [--no-build] [--out DIR]
+# usage: package.sh [--build-dir DIR] [--windows-build-dir DIR] [--no-build] [--windows-only] [--out DIR]
 #   --build-dir DIR          the Linux Release build to package (default build/package, configured here)
 #   --windows-build-dir DIR  the mingw-w64 build (default build/windows); without its uh.dll
 #                            (with --no-build) the Windows zip and the Unity package's uh.dll are left out
 #   --no-build               package the builds as they are (the package tests do so)
+#   --windows-only           the Windows zip alone (the Windows build's test of it)
 #   --out DIR                where the artifacts go (default dist/)
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
@@ -18,12 +19,14 @@ source "$(dirname "$0")/common.sh"
 build_dir=build/package
 windows_dir=build/windows
 build=1
+linux=1
 out="$uh_root/dist"
 while [ $# -gt 0 ]; do
   case $1 in
     --build-dir) build_dir=$2; shift 2 ;;
     --windows-build-dir) windows_dir=$2; shift 2 ;;
     --no-build) build=0; shift ;;
+    --windows-only) linux=0; shift ;;
     --out) out=$2; shift 2 ;;
     *) echo "package: unknown argument $1 (see the script's header)" >&2; exit 2 ;;
   esac
@@ -40,11 +43,15 @@ mkdir -p "$out"
 
 if [ "$build" = 1 ]; then
   bash "$uh_root/scripts/install-deps.sh"
+fi
+if [ "$build" = 1 ] && [ "$linux" = 1 ]; then
   echo "== build (Release, $build_dir) =="
   uh_build "${build_dir#"$uh_root"/}" -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF -DUH_BUILD_BENCHMARKS=OFF
+fi
+if [ "$build" = 1 ]; then
   echo "== build (Windows x64, mingw-w64, $windows_dir) =="
   uh_build "${windows_dir#"$uh_root"/}" uh_capi -- -DCMAKE_TOOLCHAIN_FILE="$uh_root/cmake/mingw-w64-x86_64.cmake" \
-    -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=OFF
+    -DCMAKE_BUILD_TYPE=Release
 fi
 uh_dll="$windows_dir/bin/uh.dll"
 [ -f "$uh_dll" ] || { echo "package: no $uh_dll: the Windows zip and the Unity package's uh.dll are left out"; uh_dll=""; }
@@ -199,10 +206,13 @@ package_godot() {
 }
 
 rm -f "$out"/unrealhaptics_*.deb "$out"/unrealhaptics-*.zip "$out"/org.unrealhaptics.core-*.tgz "$out/SHA256SUMS"
-package_deb
+if [ "$linux" = 1 ]; then package_deb; fi
 if [ -n "$uh_dll" ]; then package_windows; fi
-package_unity
-package_godot
-(cd "$out" && sha256sum -- *.deb *.zip *.tgz >SHA256SUMS)
+if [ "$linux" = 1 ]; then
+  package_unity
+  package_godot
+fi
+(cd "$out" && shopt -s nullglob && files=(*.deb *.zip *.tgz) && [ ${#files[@]} -gt 0 ] &&
+  sha256sum -- "${files[@]}" >SHA256SUMS) || { echo "package: no artifact made" >&2; exit 1; }
 echo "== $out/SHA256SUMS =="
 cat "$out/SHA256SUMS"
