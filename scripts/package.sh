@@ -34,7 +34,7 @@ done
 case $build_dir in /*) ;; *) build_dir="$uh_root/$build_dir" ;; esac
 case $windows_dir in /*) ;; *) windows_dir="$uh_root/$windows_dir" ;; esac
 
-version=$(sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9]+\.[0-9]+\.[0-9]+).*/\1/p' "$uh_root/CMakeLists.txt")
+version=$(uh_project_version)
 [ -n "$version" ] || { echo "package: no project(VERSION) in CMakeLists.txt" >&2; exit 1; }
 arch=$(dpkg --print-architecture)
 work=$(mktemp -d)

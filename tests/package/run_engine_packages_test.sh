@@ -12,12 +12,8 @@ set -euo pipefail
 source_dir=$1
 dist=$2
 work=$3
-rm -rf "$work"
-mkdir -p "$work"
-
-fail() { echo "package_engines: $*" >&2; exit 1; }
-
-version=$(sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9.]+).*/\1/p' "$source_dir/CMakeLists.txt")
+source "$(dirname "$0")/common.sh"
+package_test_init package_engines "$work"
 unity_tgz="$dist/org.unrealhaptics.core-$version.tgz"
 godot_zip="$dist/unrealhaptics-godot-$version.zip"
 [ -f "$unity_tgz" ] || fail "no $unity_tgz"

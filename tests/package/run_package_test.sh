@@ -7,15 +7,12 @@ here=$(cd "$(dirname "$0")" && pwd)
 source_dir=$(cd "$here/../.." && pwd)
 build_dir=$1
 work=$2
-rm -rf "$work"
-mkdir -p "$work"
-
-fail() { echo "package_deb: $*" >&2; exit 1; }
+source "$here/common.sh"
+package_test_init package_deb "$work"
 
 # the Linux artifacts of this build only: a Windows build folder may hold another version's uh.dll
 bash "$source_dir/scripts/package.sh" --build-dir "$build_dir" --windows-build-dir "$work/no-windows-build" \
   --no-build --out "$work/dist"
-version=$(sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9.]+).*/\1/p' "$source_dir/CMakeLists.txt")
 deb="$work/dist/unrealhaptics_${version}_$(dpkg --print-architecture).deb"
 [ -f "$deb" ] || fail "no $deb"
 (cd "$work/dist" && sha256sum --check --quiet SHA256SUMS) || fail "SHA256SUMS does not match"

@@ -9,13 +9,10 @@ build_dir=$2
 wine_run=$3
 test_program=$4
 work=$5
-rm -rf "$work"
-mkdir -p "$work"
-
-fail() { echo "windows_zip: $*" >&2; exit 1; }
+source "$(dirname "$0")/common.sh"
+package_test_init windows_zip "$work"
 
 bash "$source_dir/scripts/package.sh" --windows-only --windows-build-dir "$build_dir" --no-build --out "$work/dist"
-version=$(sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9.]+).*/\1/p' "$source_dir/CMakeLists.txt")
 name="unrealhaptics-$version-windows-x64"
 (cd "$work/dist" && sha256sum --check --quiet SHA256SUMS) || fail "SHA256SUMS does not match"
 (cd "$work" && unzip -q "dist/$name.zip")
