@@ -39,3 +39,8 @@ uh_bench_run() {
   echo "running: uh run $*" >&2
   "$UH" run "$@" --json >"$out/$name.json"
 }
+
+# The release's version: project(VERSION) of the top-level CMakeLists.txt (docs/packaging.md).
+uh_project_version() {
+  sed -nE 's/^project\([A-Za-z]+ VERSION ([0-9]+\.[0-9]+\.[0-9]+).*/\1/p' "$uh_root/CMakeLists.txt"
+}

@@ -5,10 +5,13 @@
 # build folder. A GDScript error does not end Godot, so the run is bounded by a timeout; a uh serve
 # the test started is ended by its process id if it outlived Godot.
 # usage: scripts/godot-test.sh BUILD_DIR     (prints "N passed, N failed"; exit status 1 on failure)
+#   UH_PROGRAM (environment): another uh than the build's; UH_GODOT_PROJECT: another copy of the demo
+#   project (the packaged addon's test, tests/package/run_engine_packages_test.sh)
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:?usage: godot-test.sh BUILD_DIR}" && pwd)
-uh="$build/apps/uh/uh"
+uh="${UH_PROGRAM:-$build/apps/uh/uh}"
+project="${UH_GODOT_PROJECT:-$root/engines/godot/demo}"
 [ -x "$uh" ] || { echo "godot-test: $uh is missing (build the uh program first)"; exit 1; }
 command -v godot3-server >/dev/null || { echo "godot-test: godot3-server is missing (scripts/install-deps.sh)"; exit 1; }
 work="$build/godot"
@@ -18,7 +21,7 @@ port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0
 log="$work/godot.log"
 HOME="$work/home" XDG_CONFIG_HOME="$work/config" XDG_DATA_HOME="$work/data" XDG_CACHE_HOME="$work/cache" \
   LANG=en_US.UTF-8 LC_ALL= UH_PROGRAM="$uh" UH_TEST_PORT="$port" UH_CACHE_DIR="${UH_CACHE_DIR:-$build/test-cache}" \
-  timeout -k 5 180 godot3-server --path "$root/engines/godot/demo" -s "$root/engines/godot/tests/run_tests.gd" \
+  timeout -k 5 180 godot3-server --path "$project" -s "$root/engines/godot/tests/run_tests.gd" \
   >"$log" 2>&1
 code=$?
 cat "$log"

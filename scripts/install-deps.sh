@@ -16,6 +16,7 @@ packages=(
   g++-mingw-w64-x86-64-posix wine64
   godot3-server mono-mcs mono-runtime
   rt-tests  # cyclictest, the reference of scripts/bench-latency.sh
+  help2man zip  # scripts/package.sh: uh's man page, the Windows and Godot archives
 )
 
 # the live view's build (npm ci, esbuild) needs node and npm: Debian's, unless another node is there

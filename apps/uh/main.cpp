@@ -16,6 +16,7 @@ int fail(const std::string& message) {
 
 int main(int argc, char** argv) {
   CLI::App app{"uh: build Inner Sphere Trees, query them, list haptic devices and run haptic sessions"};
+  app.set_version_flag("--version", "uh " UH_VERSION_STRING);
   app.require_subcommand(1);
   uh::cli::CommandRunner runner;
   uh::cli::add_devices_command(app, runner);
