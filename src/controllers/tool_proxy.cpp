@@ -14,11 +14,12 @@ namespace {
 double tool_radius(const collette::SphereTree& tree) {
   if (tree.empty()) return 0.01;
   const collette::SphereTreeNode& root = tree.root();
-  const double r = norm(Vec3{root.x, root.y, root.z}) + static_cast<double>(root.radius);
+  const Vec3 c{static_cast<double>(root.x), static_cast<double>(root.y), static_cast<double>(root.z)};
+  const double r = norm(c) + static_cast<double>(root.radius);
   return r > 0.0 ? r : 0.01;
 }
 
-Vec3 centre(const Sphere& s) { return {s.x, s.y, s.z}; }
+Vec3 centre(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
 
 // The rotation of a rotation vector (axis times angle).
 Quat quat_from_rotation_vector(const Vec3& w) {
@@ -138,7 +139,8 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
     const Vec3 b = transform_point(section.world_from_b, centre(p.sphere_b_local));
     const double distance = norm(b - a);
     const Vec3 n = distance > 1e-12 ? (b - a) / distance
-                                    : Vec3{p.normal_world[0], p.normal_world[1], p.normal_world[2]};
+                                    : Vec3{static_cast<double>(p.normal_world[0]), static_cast<double>(p.normal_world[1]),
+                                           static_cast<double>(p.normal_world[2])};
     const double rb = static_cast<double>(p.sphere_b_local.radius);
     double gap = distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
     if (textured) {

@@ -52,14 +52,16 @@ Packed pack(const collette::TriangleMesh& mesh, std::int64_t spheres) {
   return {std::make_shared<const collette::SphereTree>(std::move(tree).value()), packing->report.max_gap};
 }
 
+Vec3 centre_of(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
+
 // The deepest overlap of any tool sphere with any plate sphere, by brute force [m].
 double deepest_overlap(const collette::SphereTree& plate, const Pose& world_from_plate,
                        const collette::SphereTree& tool, const Pose& world_from_tool) {
   double deepest = 0.0;
   for (const Sphere& b : tool.leaves()) {
-    const Vec3 cb = transform_point(world_from_tool, Vec3{b.x, b.y, b.z});
+    const Vec3 cb = transform_point(world_from_tool, centre_of(b));
     for (const Sphere& a : plate.leaves()) {
-      const Vec3 ca = transform_point(world_from_plate, Vec3{a.x, a.y, a.z});
+      const Vec3 ca = transform_point(world_from_plate, centre_of(a));
       deepest = std::max(deepest, static_cast<double>(a.radius + b.radius) - norm(cb - ca));
     }
   }
