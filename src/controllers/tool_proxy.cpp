@@ -191,7 +191,7 @@ void ToolProxy::add_to_smooth(std::int32_t leaf, const Vec3& centre_world, doubl
   s.gradient += w * normal;
 }
 
-// The smooth constraints, after the pairs' (the heap's order no longer matters).
+// The smooth constraints, after the pairs' (the heap's order no longer matters); on_step clears the sums.
 void ToolProxy::append_smooth(const Pose& proxy) {
   for (const std::int32_t leaf : touched_) {
     SmoothLeaf& s = smooth_[static_cast<std::size_t>(leaf)];
@@ -205,9 +205,7 @@ void ToolProxy::append_smooth(const Pose& proxy) {
           .gap = (soft_gap + options_.penetration_m) / length,
           .tag = s.tag};
     }
-    s = {};
   }
-  touched_.clear();
 }
 
 // The contact's normal and friction from the constraints holding the proxy (the largest
@@ -351,6 +349,7 @@ void ToolProxy::on_step(double time_s) {
     append_smooth(from);
     proxy_ = advance(from, target, out);
   }
+  // the sums start again next step (whether or not this one used them)
   for (const std::int32_t leaf : touched_) smooth_[static_cast<std::size_t>(leaf)] = {};
   touched_.clear();
   max_constraints_.store(std::max(max_constraints_.load(std::memory_order_relaxed), constraint_count_),

@@ -198,9 +198,14 @@ TEST(HapticSessionThreaded, TheProxyRunsOnTheCollisionThreadAndEndsWithZeroForce
   options.proxy = true;
   auto session = HapticSession::create(*scene, options);
   ASSERT_TRUE(session.has_value()) << session.error().message;
-  ASSERT_TRUE((*session)->run(1.5, [](const SessionState&) {}).has_value());
+  std::ostringstream trace;
+  ASSERT_TRUE((*session)->run(1.5, [](const SessionState&) {}, &trace).has_value());
   const SessionReport& r = (*session)->report();
   EXPECT_TRUE(r.proxy);
+  const auto table = testing::parse_trace(trace.str());
+  ASSERT_GT(table.rows.size(), 100u);
+  EXPECT_EQ(norm(table.force(table.rows.size() - 1)), 0.0) << "the stop sent zero force";
+  EXPECT_GT(r.force_max_n, 0.1) << "the spring to the proxy pushed the handle out of the bunny";
   EXPECT_GT(r.proxy_stats.updates, 30u) << "a loose bound for sanitizer builds";
   EXPECT_EQ(r.force_nonfinite, 0u);
   EXPECT_LE(r.force_max_n, 6.0 + 1e-9);
