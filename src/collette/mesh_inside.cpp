@@ -40,4 +40,18 @@ Vec3 MeshInside::closest_point(const Vec3& p) const {
   return q;
 }
 
+SurfacePoint MeshInside::nearest(const Vec3& p, double max_distance) const {
+  SurfacePoint out;
+  std::int32_t triangle = -1;
+  const double d2 = impl_->bvh.closest(p, &out.point, max_distance * max_distance, &triangle);
+  if (triangle < 0) return out;
+  const detail::Triangle& t = impl_->bvh.triangles()[static_cast<std::size_t>(triangle)];
+  const Vec3 n = cross(t.b - t.a, t.c - t.a);
+  const double length = norm(n);
+  out.found = true;
+  out.face_normal = length > 0.0 ? n / length : Vec3{};
+  out.distance = std::sqrt(d2);
+  return out;
+}
+
 }  // namespace uh::collette

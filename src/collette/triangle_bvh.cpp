@@ -124,9 +124,10 @@ void TriangleBvh::build(std::int32_t node, std::int32_t first, std::int32_t coun
   build(left + 1, first + half, count - half, order, centroids);
 }
 
-double TriangleBvh::closest(const Vec3& p, Vec3* nearest, double max_d2) const {
+double TriangleBvh::closest(const Vec3& p, Vec3* nearest, double max_d2, std::int32_t* triangle) const {
   double best = max_d2;
   Vec3 best_point{};
+  std::int32_t best_triangle = -1;
   if (tris_.empty()) return best;
   std::int32_t stack[128];
   int top = 0;
@@ -141,6 +142,7 @@ double TriangleBvh::closest(const Vec3& p, Vec3* nearest, double max_d2) const {
         if (d2 < best) {
           best = d2;
           best_point = q;
+          best_triangle = i;
         }
       }
       continue;
@@ -158,7 +160,9 @@ double TriangleBvh::closest(const Vec3& p, Vec3* nearest, double max_d2) const {
       if (dr < best) stack[top++] = n.first + 1;
     }
   }
+  if (best_triangle < 0) return best;
   if (nearest != nullptr) *nearest = best_point;
+  if (triangle != nullptr) *triangle = best_triangle;
   return best;
 }
 

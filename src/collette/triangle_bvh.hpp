@@ -33,8 +33,10 @@ class TriangleBvh {
   TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<std::array<std::int32_t, 3>>& triangles);
 
   bool empty() const { return tris_.empty(); }
-  /// Squared distance to the nearest triangle, with the nearest point; `max_d2` prunes the search.
-  double closest(const Vec3& p, Vec3* nearest = nullptr, double max_d2 = 1e300) const;
+  /// Squared distance to the nearest triangle, with the nearest point and that triangle's index in
+  /// triangles(); `max_d2` prunes the search (nothing nearer: max_d2, and the outputs untouched).
+  double closest(const Vec3& p, Vec3* nearest = nullptr, double max_d2 = 1e300,
+                 std::int32_t* triangle = nullptr) const;
   /// Crossings of the ray o + t d with 0 < t < t_max, appended as (t, w): w = +1 where the ray
   /// leaves through a triangle (along its outward normal), -1 where it enters.
   void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<std::pair<double, int>>& hits) const;

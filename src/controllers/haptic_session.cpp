@@ -22,6 +22,29 @@ double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// Per object of the scene: its mesh surface in metres when a tool watches it and it has a mesh
+// file (the proxy rests on it), else null. Objects of one mesh share it.
+using ObjectSurfaces = std::vector<std::shared_ptr<const collette::MeshInside>>;
+Result<ObjectSurfaces> load_watched_surfaces(const Scene& scene) {
+  ObjectSurfaces surfaces(scene.objects.size());
+  std::map<std::pair<std::string, double>, std::shared_ptr<const collette::MeshInside>> by_mesh;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& object = scene.objects[i];
+    if (std::find(scene.watch.begin(), scene.watch.end(), object.name) == scene.watch.end()) continue;
+    const auto key = std::make_pair(object.shape.mesh.string(), object.shape.meters_per_unit);
+    if (const auto it = by_mesh.find(key); it != by_mesh.end() && !object.shape.tree) {
+      surfaces[i] = it->second;
+      continue;
+    }
+    auto surface = load_shape_surface(object.shape);
+    if (!surface)
+      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, surface.error().message)};
+    surfaces[i] = *surface;
+    if (!object.shape.tree) by_mesh.emplace(key, *surface);
+  }
+  return surfaces;
+}
+
 }  // namespace
 
 // One tool: its device's manager (its own haptic loop and limit chain), its controllers, what
@@ -48,6 +71,7 @@ struct HapticSession::ToolRig {
   ToolReport report;
   haptico::DeviceCommand last_sent{};
   Vec3 last_sent_position{};  // the handle when last_sent was sent [m, device frame]
+  double last_sent_time_s = 0.0;
   bool have_last_sent = false;
 
   // collision thread: per scene object, whether this tool touches it
@@ -105,16 +129,6 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
 
-  session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
-      .rate_hz = session->collision_hz_,
-      .raise_priority = options.raise_priority,
-      // the proxy's constraints are the pairs within the margin: it may step no farther than that
-      .contact_margin = std::max(options.contact_margin.value_or(scene.contact_margin),
-                                 force_options.proxy.enabled ? force_options.proxy.step_m : 0.0),
-      .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
-  auto& world = *session->world_;
-  std::vector<collette::ObjectId> object_ids;
-  std::vector<double> object_coverages;
   // objects of one shape share its tree (a room repeats a few meshes): loaded once
   std::map<std::tuple<std::string, std::string, std::int64_t, double, double>, ShapeTree> loaded;
   const auto load_shared = [&](const SceneShape& shape) -> Result<ShapeTree> {
@@ -125,16 +139,39 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     if (tree && !shape.tree) loaded.emplace(key, *tree);
     return tree;
   };
+  std::vector<ShapeTree> object_trees;
   for (const SceneObject& object : scene.objects) {
     auto tree = load_shared(object.shape);
     if (!tree) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message)};
-    auto id = world.add_object({.tree = tree->tree,
+    object_trees.push_back(*tree);
+  }
+  Result<ObjectSurfaces> surfaces =
+      force_options.proxy.enabled ? load_watched_surfaces(scene) : ObjectSurfaces(scene.objects.size());
+  if (!surfaces) return surfaces.error();
+  double surface_gap_m = 0.0;
+  for (std::size_t i = 0; i < object_trees.size(); ++i)
+    if (surfaces->at(i)) surface_gap_m = std::max(surface_gap_m, object_trees[i].surface_gap_m);
+
+  session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
+      .rate_hz = session->collision_hz_,
+      .raise_priority = options.raise_priority,
+      // the proxy's constraints are the pairs within the margin: it may step no farther than that;
+      // on a mesh surface the spheres lie up to the packing's gap below it
+      .contact_margin = std::max(options.contact_margin.value_or(scene.contact_margin),
+                                 force_options.proxy.enabled ? force_options.proxy.step_m + surface_gap_m : 0.0),
+      .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
+  auto& world = *session->world_;
+  std::vector<collette::ObjectId> object_ids;
+  std::vector<double> object_coverages;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& object = scene.objects[i];
+    auto id = world.add_object({.tree = object_trees[i].tree,
                                 .world_from_object = object.pose,
-                                .coverage = tree->coverage,
+                                .coverage = object_trees[i].coverage,
                                 .name = object.name});
     if (!id) return id.error();
     object_ids.push_back(*id);
-    object_coverages.push_back(tree->coverage);
+    object_coverages.push_back(object_trees[i].coverage);
   }
   // the tool is B of every watcher: the frames' forces push it out of the objects. Watching every
   // object is one watcher of the tool against everything (the broad phase picks the objects it
@@ -209,8 +246,11 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
           forcecomp::combine_materials(scene.objects[i].material, tool.material, tool.force);
       rig->force_controller->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage, &material);
       if (rig->proxy)
-        rig->proxy->watch(object_ids[i], material.friction_static, material.friction_dynamic, material.object_texture,
-                          material.tool_texture);
+        rig->proxy->watch(object_ids[i], {.friction_static = material.friction_static,
+                                          .friction_dynamic = material.friction_dynamic,
+                                          .object_texture = material.object_texture,
+                                          .tool_texture = material.tool_texture,
+                                          .surface = surfaces->at(i)});
     }
     if (rig->proxy) rig->proxy->bind();
     rig->bridging_controller = std::make_unique<BridgingController>(world, rig->tool_id, tool.workspace,
@@ -260,6 +300,7 @@ Status HapticSession::begin_run() {
     rig->report.force_max_n = 0.0;
     rig->report.torque_max_nm = 0.0;
     rig->report.work_on_hand_j = 0.0;
+    rig->report.contact_squared_speed_integral = 0.0;
     rig->have_last_sent = false;
     rig->ticks_at_start = rig->manager->ticks();
   }
@@ -345,9 +386,13 @@ void HapticSession::take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& 
       // too stiff coupling active
       const double work = dot(rig.last_sent.force, s.state.position - rig.last_sent_position);
       if (std::isfinite(work)) report.work_on_hand_j += work;
+      const double period = s.state.time_s - rig.last_sent_time_s;
+      const double squared = squared_norm(s.state.position - rig.last_sent_position) / period;
+      if (period > 0.0 && std::isfinite(squared) && squared_norm(rig.last_sent.force) > 0.0) report.contact_squared_speed_integral += squared;
     }
     rig.last_sent = s.sent;
     rig.last_sent_position = s.state.position;
+    rig.last_sent_time_s = s.state.time_s;
     rig.have_last_sent = true;
     report.force_max_n = std::max(report.force_max_n, norm(s.sent.force));
     report.torque_max_nm = std::max(report.torque_max_nm, norm(s.sent.torque));
@@ -708,7 +753,7 @@ nlohmann::json tool_report_json(const ToolReport& r) {
             {"coupling", r.coupling},
             {"proxy", proxy_report_json(r)}}},
           {"contact", {{"ticks", r.contact_ticks}}},
-          {"energy", {{"work_on_hand_j", r.work_on_hand_j}}}};
+          {"energy", {{"work_on_hand_j", r.work_on_hand_j}, {"contact_squared_speed_integral_m2_s", r.contact_squared_speed_integral}}}};
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "embedded_assets.hpp"
 #include "uh/collette/ist_builder.hpp"
 #include "uh/collette/ist_file.hpp"
+#include "uh/collette/mesh_import.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/core/atomic_file_writer.hpp"
 #include "uh/core/json_nesting.hpp"
@@ -721,7 +722,15 @@ Result<ShapeTree> load_shape_tree(
   const double scale = shape.ist.empty() ? shape.meters_per_unit : asset.meta.meters_per_unit;
   return ShapeTree{
       std::make_shared<const collette::SphereTree>(collette::scale_sphere_tree(asset.tree, scale)),
-      asset.meta.coverage};
+      asset.meta.coverage, asset.meta.max_gap * scale};
+}
+
+Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape) {
+  if (shape.mesh.empty() || shape.tree) return std::shared_ptr<const collette::MeshInside>{};
+  auto mesh = collette::load_mesh(shape.mesh);
+  if (!mesh) return mesh.error();
+  for (Vec3& v : mesh->vertices) v = v * shape.meters_per_unit;
+  return std::make_shared<const collette::MeshInside>(*mesh);
 }
 
 }  // namespace uh::controllers

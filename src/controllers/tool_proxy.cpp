@@ -90,15 +90,19 @@ ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, c
       options_(options),
       solver_({.radius_m = tool_radius(tool_tree),
                .rotate = rotate,
-               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16) + tool_tree.leaf_count()}),
+               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16) + 2 * tool_tree.leaf_count()}),
       slide_solver_({.radius_m = tool_radius(tool_tree), .rotate = rotate, .max_constraints = 6}),
       pair_capacity_(std::max<std::int32_t>(options.max_constraints, 16)),
-      constraints_(static_cast<std::size_t>(pair_capacity_ + tool_tree.leaf_count())),
+      // after the pairs: a smooth or surface row per tool sphere, two where it is near two objects
+      constraints_(static_cast<std::size_t>(pair_capacity_ + 2 * tool_tree.leaf_count())),
       smooth_(static_cast<std::size_t>(tool_tree.leaf_count())) {
   touched_.reserve(static_cast<std::size_t>(tool_tree.leaf_count()));
 }
 
 void ToolProxy::bind() {
+  const std::size_t slots = smooth_.size() * watched_.size();
+  surface_seen_.assign(slots, 0);
+  near_surface_.reserve(slots);
   collision_connection_ = world_->on_collision().connect<&ToolProxy::on_collision>(*this);
   step_connection_ = world_->on_step().connect<&ToolProxy::on_step>(*this);
 }
@@ -121,9 +125,11 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
   queried_ = section.world_from_b;
   have_query_ = true;
   const std::int32_t tag = watched_index(section.object_a);
-  const WatchedObject& watched = watched_[static_cast<std::size_t>(tag)];
-  const bool textured = watched.object_texture.kind != forcecomp::TextureKind::kNone ||
-                        watched.tool_texture.kind != forcecomp::TextureKind::kNone;
+  WatchedObject& watched = watched_[static_cast<std::size_t>(tag)];
+  watched.world_from_object = section.world_from_a;
+  const ProxyContact& contact = watched.contact;
+  const bool textured = contact.object_texture.kind != forcecomp::TextureKind::kNone ||
+                        contact.tool_texture.kind != forcecomp::TextureKind::kNone;
   const Pose object_from_world = inverse(section.world_from_a);
   const Pose tool_from_world = inverse(section.world_from_b);
   const auto pairs = frame.pairs().subspan(static_cast<std::size_t>(section.first_pair),
@@ -146,14 +152,15 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
     if (textured) {
       // the relief where the pair touches, on the object's sphere and on the tool's
       const Vec3 on_object = a + static_cast<double>(p.sphere_a_local.radius) * n;
-      gap -= forcecomp::texture_height(watched.object_texture, transform_point(object_from_world, on_object)) +
-             forcecomp::texture_height(watched.tool_texture, transform_point(tool_from_world, b - rb * n));
+      gap -= forcecomp::texture_height(contact.object_texture, transform_point(object_from_world, on_object)) +
+             forcecomp::texture_height(contact.tool_texture, transform_point(tool_from_world, b - rb * n));
     }
     const forcecomp::ProxyConstraint c{.normal = n,
                                        .lever = (b - rb * n) - section.world_from_b.position,
                                        .gap = gap,
                                        .tag = tag};
-    if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m, c.tag);
+    if (contact.surface) add_to_surface(p.leaf_b, tag, b, rb);
+    else if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m, c.tag);
     // beyond the capacity the nearest pairs are kept (a heap on the gap, largest on top); the step
     // shrinks to the smallest gap left out
     const auto by_gap = [](const forcecomp::ProxyConstraint& x, const forcecomp::ProxyConstraint& y) {
@@ -208,6 +215,41 @@ void ToolProxy::append_smooth(const Pose& proxy) {
   }
 }
 
+// A tool sphere near an object with a mesh surface, once per step and object.
+void ToolProxy::add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& centre_world, double radius) {
+  if (leaf < 0 || static_cast<std::size_t>(leaf) >= smooth_.size()) return;
+  const std::size_t slot = static_cast<std::size_t>(leaf) * watched_.size() + static_cast<std::size_t>(tag);
+  if (surface_seen_[slot] != 0) return;
+  surface_seen_[slot] = 1;
+  near_surface_.push_back({.leaf = leaf, .tag = tag, .centre = centre_world, .radius = radius});  // reserved
+}
+
+// A row per tool sphere near a mesh surface: its centre stays its radius (less the allowed
+// penetration, plus the textures' relief) away from the surface's nearest point, along the line to
+// it. The distance to a face is linear in the step and to a convex edge or corner convex, so the
+// row is exact or conservative there. A centre found on the inner side of the nearest face (it
+// began inside, or a saddle corner) gets no row: the sphere pairs hold it.
+void ToolProxy::append_surface(const Pose& proxy) {
+  for (const SurfaceLeaf& near : near_surface_) {
+    const WatchedObject& watched = watched_[static_cast<std::size_t>(near.tag)];
+    const ProxyContact& contact = watched.contact;
+    const Pose object_from_world = inverse(watched.world_from_object);
+    const Vec3 p = transform_point(object_from_world, near.centre);
+    const collette::SurfacePoint q =
+        contact.surface->nearest(p, near.radius + options_.step_m + options_.penetration_m);
+    if (!q.found || dot(p - q.point, q.face_normal) < 0.0) continue;
+    const Vec3 n_object = q.distance > 1e-12 ? (p - q.point) / q.distance : q.face_normal;
+    const Vec3 n = rotate(watched.world_from_object.rotation, n_object);
+    double gap = q.distance - near.radius + options_.penetration_m;
+    gap -= forcecomp::texture_height(contact.object_texture, q.point) +
+           forcecomp::texture_height(contact.tool_texture,
+                                     transform_point(inverse(queried_), near.centre - near.radius * n));
+    if (constraint_count_ >= static_cast<std::int32_t>(constraints_.size())) break;
+    constraints_[static_cast<std::size_t>(constraint_count_++)] = {
+        .normal = n, .lever = (near.centre - near.radius * n) - proxy.position, .gap = gap, .tag = near.tag};
+  }
+}
+
 // The contact's normal and friction from the constraints holding the proxy (the largest
 // coefficients of the objects they are with); `active` indexes `rows`, or null: the first `count`.
 ToolProxy::HoldingFriction ToolProxy::holding_friction(std::span<const forcecomp::ProxyConstraint> rows,
@@ -218,8 +260,9 @@ ToolProxy::HoldingFriction ToolProxy::holding_friction(std::span<const forcecomp
     const forcecomp::ProxyConstraint& c = rows[static_cast<std::size_t>(active != nullptr ? active[i] : i)];
     sum += c.normal;
     if (c.tag >= 0 && static_cast<std::size_t>(c.tag) < watched_.size()) {
-      h.friction_static = std::max(h.friction_static, watched_[static_cast<std::size_t>(c.tag)].friction_static);
-      h.friction_dynamic = std::max(h.friction_dynamic, watched_[static_cast<std::size_t>(c.tag)].friction_dynamic);
+      const ProxyContact& contact = watched_[static_cast<std::size_t>(c.tag)].contact;
+      h.friction_static = std::max(h.friction_static, contact.friction_static);
+      h.friction_dynamic = std::max(h.friction_dynamic, contact.friction_dynamic);
     }
   }
   h.normal = norm(sum) > 0.0 ? normalized(sum) : Vec3{};
@@ -244,9 +287,9 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   const double limit = reach / std::sqrt(2.0);
   Vec3 t, w;
   const double length = wanted_step(from, target, limit, t, w);
-  // a point at lever r turns on an arc: it falls short of the chord's tangent by at most
-  // |w|^2 |r| / 2 <= |(t, R w)|^2 / (2 R)
-  const double arc = squared_norm(w) > 0.0 ? std::min(length, limit) * std::min(length, limit) / (2.0 * radius) : 0.0;
+  // a point at lever r turns on an arc: it falls short of the chord's tangent by |w|^2 |r| / 2, at
+  // most |(t, R w)|^2 / (2 R) whatever rotation the projection adds (solve_turning)
+  const double worst_arc = std::min(length, limit) * std::min(length, limit) / (2.0 * radius);
   // the step moves no point farther than sqrt(2) |(t, R w)| (a projection onto constraints that the
   // step 0 meets is no longer than what it projects), so a pair with a larger gap cannot bind:
   // only the others go to the solver (a hand moving slowly sees a few of the margin's pairs)
@@ -254,18 +297,16 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   for (std::int32_t k = 0; k < constraint_count_; ++k)
     deepest = std::max(deepest, -constraints_[static_cast<std::size_t>(k)].gap);
   raise_max(deepest_m_, deepest);
-  const double moves = deepest > 0.0 ? reach : std::sqrt(2.0) * std::min(length, limit);
+  const double moves = (deepest > 0.0 ? reach : std::sqrt(2.0) * std::min(length, limit)) + worst_arc;
   std::int32_t kept = 0;
-  for (std::int32_t k = 0; k < constraint_count_; ++k) {
-    forcecomp::ProxyConstraint c = constraints_[static_cast<std::size_t>(k)];
-    c.gap -= arc;
-    if (c.gap < moves) constraints_[static_cast<std::size_t>(kept++)] = c;
-  }
+  for (std::int32_t k = 0; k < constraint_count_; ++k)
+    if (constraints_[static_cast<std::size_t>(k)].gap < moves)
+      constraints_[static_cast<std::size_t>(kept++)] = constraints_[static_cast<std::size_t>(k)];
   const std::span<forcecomp::ProxyConstraint> rows{constraints_.data(), static_cast<std::size_t>(kept)};
   forcecomp::ProxyStep step{.translation = t, .rotation = w};
   if (!rows.empty()) {
     const auto started = std::chrono::steady_clock::now();
-    step = solver_.solve(rows, t, w);
+    step = solve_turning(rows, t, w, worst_arc);
     solve_time_.record(static_cast<std::uint64_t>(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - started).count()));
     if (!step.converged) unsolved_.fetch_add(1, std::memory_order_relaxed);
@@ -301,6 +342,28 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   }
   out.reach_m = options_.step_m;
   return next;
+}
+
+// Solves the step with every gap less the arc its rotation sags by (|w|^2 R / 2 for the rotation w
+// it turns out to take): first assuming the wanted rotation's, then, if the projection turned the
+// tool farther, that rotation's with room to spare, and at last the bound `worst_arc` that holds
+// for any projection. A step that does not turn keeps its gaps whole, so a tool pressed straight
+// onto a face rests where the constraints say, not an arc's sag above it.
+forcecomp::ProxyStep ToolProxy::solve_turning(std::span<forcecomp::ProxyConstraint> rows, const Vec3& t,
+                                              const Vec3& w, double worst_arc) {
+  const double radius = solver_.options().radius_m;
+  double arc = 0.5 * radius * squared_norm(w);
+  double taken = 0.0;  // the arc the rows' gaps are lowered by now
+  forcecomp::ProxyStep step;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    for (forcecomp::ProxyConstraint& c : rows) c.gap -= arc - taken;
+    taken = arc;
+    step = solver_.solve(rows, t, w);
+    const double sag = 0.5 * radius * squared_norm(step.rotation);
+    if (sag <= arc + 1e-12) break;
+    arc = attempt == 0 ? std::min(2.0 * sag, worst_arc) : worst_arc;
+  }
+  return step;
 }
 
 double ToolProxy::wanted_step(const Pose& from, const Pose& target, double limit, Vec3& t, Vec3& w) const {
@@ -347,8 +410,12 @@ void ToolProxy::on_step(double time_s) {
     seated_ = true;
     const Pose from = have_query_ ? queried_ : proxy_;
     append_smooth(from);
+    append_surface(from);
     proxy_ = advance(from, target, out);
   }
+  for (const SurfaceLeaf& near : near_surface_)
+    surface_seen_[static_cast<std::size_t>(near.leaf) * watched_.size() + static_cast<std::size_t>(near.tag)] = 0;
+  near_surface_.clear();
   // the sums start again next step (whether or not this one used them)
   for (const std::int32_t leaf : touched_) smooth_[static_cast<std::size_t>(leaf)] = {};
   touched_.clear();

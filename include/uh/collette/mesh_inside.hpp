@@ -8,6 +8,14 @@
 
 namespace uh::collette {
 
+/// The nearest point of a mesh's surface to a query point (MeshInside::nearest). Plain data.
+struct SurfacePoint {
+  bool found = false;  ///< a triangle lies within the query's distance
+  Vec3 point{};        ///< the nearest point on the surface
+  Vec3 face_normal{};  ///< the unit normal of the triangle it lies on (outward for an outward-wound mesh)
+  double distance = 0.0;
+};
+
 /// Point queries against one mesh, accelerated by a triangle BVH built in the constructor.
 ///
 /// contains() counts signed ray crossings (the winding number along a ray, so interpenetrating
@@ -37,6 +45,11 @@ class MeshInside {
   double signed_distance(const Vec3& p) const;
   /// Nearest point on the surface to p.
   Vec3 closest_point(const Vec3& p) const;
+  /// The nearest point on the surface to p if one lies within `max_distance`, with its triangle's
+  /// normal (the side p is on: dot(p - point, face_normal) >= 0 outside a closed outward mesh,
+  /// wherever the nearest point is inside a face or on a convex edge or corner). Allocation-free;
+  /// the search visits only the BVH nodes within `max_distance`.
+  SurfacePoint nearest(const Vec3& p, double max_distance) const;
 
  private:
   struct Impl;

@@ -97,10 +97,16 @@ struct ToolReport {
   haptico::LimitCounters limits{};     ///< ticks in which each limit of the chain engaged
   std::uint64_t zeroed_ticks = 0;      ///< ticks sent zero by a halt or a fault (this device's or another's)
   std::uint64_t contact_ticks = 0;
-  /// Energy the device put into the hand [J]: per tick, the force sent (held over the period)
-  /// times the handle's displacement until the next tick; exact for a zero-order hold. Over a
-  /// closed path it is <= 0 when the rendering is passive.
+  /// Energy the device's motors put into the hand [J]: per tick, the force sent (held over the
+  /// period) times the handle's displacement until the next tick; exact for a zero-order hold.
   double work_on_hand_j = 0.0;
+  /// The sum over the ticks that held a force of |displacement|^2 / period [m^2/s], at most the
+  /// integral of the handle's squared speed while in contact: a device whose mechanism has the
+  /// damping b dissipates at least b times this meanwhile. Colgate's passivity (a sampled spring is
+  /// passive with the device's damping when b > K T / 2) is work_on_hand_j - b *
+  /// contact_squared_speed_integral <= 0 over a closed path: the energy that reaches the hand
+  /// through the handle (the zero-order hold's gain is at most K T / 2 times this).
+  double contact_squared_speed_integral = 0.0;
   bool multi_rate = true;
   std::string tick_force = "model";                             ///< "model" or "exact" (with multi_rate)
   std::uint64_t model_clamped_ticks = 0, model_held_ticks = 0;  ///< ForceControllerStats

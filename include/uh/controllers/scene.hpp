@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "uh/collette/mesh_inside.hpp"
 #include "uh/collette/sphere_tree.hpp"
 #include "uh/controllers/force_controller.hpp"
 #include "uh/controllers/workspace_mapping.hpp"
@@ -129,6 +130,8 @@ std::filesystem::path default_cache_dir();
 struct ShapeTree {
   std::shared_ptr<const collette::SphereTree> tree;
   double coverage = 1.0;
+  /// The packing's largest distance from the mesh's surface to its spheres [m] (0 for a tree in memory).
+  double surface_gap_m = 0.0;
 };
 
 /// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the
@@ -138,5 +141,10 @@ struct ShapeTree {
 Result<ShapeTree> load_shape_tree(
     const SceneShape& shape, const std::filesystem::path& cache_dir,
     const std::function<void(const std::string& what, double fraction)>& progress = {});
+
+/// The shape's mesh surface in metres, for exact nearest-point queries (the proxy rests on it rather
+/// than on the packing's grain); null when the shape has no mesh file (a .ist or a tree alone).
+/// The mesh is read and validated as for packing. Setup only.
+Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape);
 
 }  // namespace uh::controllers

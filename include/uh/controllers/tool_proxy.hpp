@@ -24,10 +24,12 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "uh/collette/collision_world.hpp"
+#include "uh/collette/mesh_inside.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/delegator.hpp"
 #include "uh/core/latency_histogram.hpp"
@@ -55,6 +57,25 @@ struct ToolProxyOptions {
   /// step_m (the pairs beyond the margin are not in the sum). A ball sliding on a face packed with
   /// 10,000 spheres ripples 19 % of its normal force on the spheres' union, 11 % at 0.2 mm.
   double smoothing_m = 0.0002;
+};
+
+/// What a watched object is to the proxy (ToolProxy::watch). Plain data.
+struct ProxyContact {
+  /// Coulomb friction of the pair (forcecomp::combine_materials), rendered on the proxy as a
+  /// friction cone: a stick point, breakaway at `friction_static`, sliding at `friction_dynamic`.
+  double friction_static = 0.0;
+  double friction_dynamic = 0.0;
+  /// The textures of the pair (`object_texture` in the object's frame, `tool_texture` in the
+  /// tool's, forcecomp::texture_height): each raises the surface the proxy rests on by its height
+  /// where it touches, so the proxy rides over the texture's relief.
+  forcecomp::Texture object_texture{};
+  forcecomp::Texture tool_texture{};
+  /// The object's mesh surface in metres, in its own frame, or null. With it the proxy rests on the
+  /// mesh itself: each tool sphere near the object is kept off the surface's nearest point, so a flat
+  /// face is flat, not the packing's grain (the sphere pairs stay as constraints underneath, and the
+  /// soft minimum is not needed). The world's contact margin must then be at least step_m plus the
+  /// packing's surface gap, so that every tool sphere within step_m of the mesh is in a pair.
+  std::shared_ptr<const collette::MeshInside> surface{};
 };
 
 /// The proxy as the haptic thread reads it. Plain data.
@@ -101,15 +122,7 @@ class ToolProxy {
 
   /// Pairs with `object` constrain the proxy (others, such as other tools, pass through).
   /// Controlling thread, before bind().
-  /// With the Coulomb friction of the pair (forcecomp::combine_materials), rendered on the proxy
-  /// as a friction cone (a stick point, breakaway at `friction_static`, sliding at `friction_dynamic`).
-  /// With the textures of the pair (`object_texture` in the object's frame, `tool_texture` in the
-  /// tool's, forcecomp::texture_height): each raises the surface the proxy rests on by its height
-  /// where a pair touches, so the proxy rides over the texture's relief.
-  void watch(collette::ObjectId object, double friction_static = 0.0, double friction_dynamic = 0.0,
-             const forcecomp::Texture& object_texture = {}, const forcecomp::Texture& tool_texture = {}) {
-    watched_.push_back({object, friction_static, friction_dynamic, object_texture, tool_texture});
-  }
+  void watch(collette::ObjectId object, const ProxyContact& contact = {}) { watched_.push_back({object, contact}); }
   /// Connects to the world's OnCollision and OnStep. Controlling thread, before the threads start.
   void bind();
 
@@ -148,8 +161,12 @@ class ToolProxy {
   void add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal, double gap,
                      std::int32_t tag);
   void append_smooth(const Pose& proxy);
+  void add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& centre_world, double radius);
+  void append_surface(const Pose& proxy);
   void add_section(const ContactFrame& frame, const ContactSection& section);
   Pose advance(const Pose& from, const Pose& target, ProxyState& out);
+  forcecomp::ProxyStep solve_turning(std::span<forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w,
+                                     double worst_arc);
   double wanted_step(const Pose& from, const Pose& target, double limit, Vec3& t, Vec3& w) const;
 
   collette::CollisionWorld* world_;
@@ -159,10 +176,8 @@ class ToolProxy {
   forcecomp::ProxySolver slide_solver_;  // haptic thread (six constraints)
   struct WatchedObject {
     collette::ObjectId id;
-    double friction_static;
-    double friction_dynamic;
-    forcecomp::Texture object_texture;
-    forcecomp::Texture tool_texture;
+    ProxyContact contact;
+    Pose world_from_object{};  // collision thread: at this step's query
   };
   std::vector<WatchedObject> watched_;
   bool sliding_ = false;  // collision thread: the proxy broke away from its stick point
@@ -185,6 +200,15 @@ class ToolProxy {
   };
   std::vector<SmoothLeaf> smooth_;
   std::vector<std::int32_t> touched_;
+  // the tool spheres near an object with a mesh surface: (tool leaf, watched object) once per step
+  struct SurfaceLeaf {
+    std::int32_t leaf = -1;
+    std::int32_t tag = -1;
+    Vec3 centre{};  // world frame [m]
+    double radius = 0.0;
+  };
+  std::vector<SurfaceLeaf> near_surface_;
+  std::vector<std::uint8_t> surface_seen_;  // per (leaf, watched object): already in near_surface_
   std::int32_t constraint_count_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
