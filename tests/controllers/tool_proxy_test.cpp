@@ -14,6 +14,9 @@
 #include <cstdio>
 #include <memory>
 #include <vector>
+#include <cstdlib>
+#include <string>
+#include <sstream>
 
 #include "scene_test_support.hpp"
 #include "uh/collette/collision_world.hpp"
@@ -412,6 +415,47 @@ TEST(ToolProxy, RepeatedPressesPutNoEnergyIntoAReactingHand) {
   std::printf("too stiff: motors' work %+.3f mJ, into the hand %+.3f mJ\n", r.work_on_hand_j * 1e3,
               energy_into_hand(r, hand_device_damping(*too_stiff)) * 1e3);
   EXPECT_GT(energy_into_hand(r, hand_device_damping(*too_stiff)), 0.01);
+  std::filesystem::remove_all(cache);
+}
+
+// A stalled collision thread (here: stepped only every 100 ms) leaves the proxy's data stale: the
+// safety chain's watchdog takes the spring to zero within its ramp after the data's age passes its
+// bound, as it does the penalty path's, and no force is sent on data older than that plus the ramp.
+TEST(ToolProxy, AStalledCollisionThreadFadesTheSpringToZero) {
+  auto scene = load_scene(testing::test_assets().parent_path() / "scenes" / "bunny_hand_press.json");
+  ASSERT_TRUE(scene) << scene.error().message;
+  const double max_age = scene->force.safety.watchdog.max_age_s;
+  const double ramp = scene->force.safety.watchdog.ramp_s;
+  ASSERT_LT(max_age + ramp, 0.09);  // a step every 100 ms leaves stale ticks in every period
+  scene->force.proxy.step_m = 0.01;  // so that the proxy, a step per 100 ms, keeps up with the hand
+  const std::filesystem::path cache = testing::fresh_cache("proxy_stall");
+  SessionOptions options;
+  options.cache_dir = cache;
+  options.proxy = true;
+  auto session = HapticSession::create(*scene, options);
+  ASSERT_TRUE(session) << session.error().message;
+  std::stringstream trace;
+  ASSERT_TRUE((*session)->run_stepped(scene->seconds, 100, &trace).has_value());
+  EXPECT_GT((*session)->report().proxy_stats.contact_updates, 5u);
+  std::string line;
+  std::getline(trace, line);  // header: tick_time_s, ..., fx, fy, fz at columns 23-25
+  int pushed = 0, late = 0, late_with_force = 0;
+  for (int tick = 0; std::getline(trace, line); ++tick) {
+    std::vector<double> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(std::strtod(cell.c_str(), nullptr));
+    ASSERT_GE(cells.size(), 26u);
+    const double force = std::hypot(cells[23], cells[24], cells[25]);
+    const double since_step = (tick % 100) * 1e-3;  // the collision step runs before tick 0, 100, ...
+    if (force > 0.5) ++pushed;
+    if (since_step > max_age + ramp + 2e-3) {
+      ++late;
+      if (force > 0.0) ++late_with_force;
+    }
+  }
+  EXPECT_GT(pushed, 20) << "the presses are pushed back while the data is fresh";
+  EXPECT_GT(late, 1000);
+  EXPECT_EQ(late_with_force, 0) << "force sent on data older than the watchdog's age and ramp";
   std::filesystem::remove_all(cache);
 }
 
