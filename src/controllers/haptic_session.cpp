@@ -148,17 +148,13 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   Result<ObjectSurfaces> surfaces =
       force_options.proxy.enabled ? load_watched_surfaces(scene) : ObjectSurfaces(scene.objects.size());
   if (!surfaces) return surfaces.error();
-  double surface_gap_m = 0.0;
-  for (std::size_t i = 0; i < object_trees.size(); ++i)
-    if (surfaces->at(i)) surface_gap_m = std::max(surface_gap_m, object_trees[i].surface_gap_m);
-
   session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
       .rate_hz = session->collision_hz_,
       .raise_priority = options.raise_priority,
-      // the proxy's constraints are the pairs within the margin: it may step no farther than that;
-      // on a mesh surface the spheres lie up to the packing's gap below it
+      // the proxy's constraints are the pairs within the margin: it may step no farther than that
+      // (its mesh rows come with the pairs: docs/forcecomp.md, "Resting on the mesh")
       .contact_margin = std::max(options.contact_margin.value_or(scene.contact_margin),
-                                 force_options.proxy.enabled ? force_options.proxy.step_m + surface_gap_m : 0.0),
+                                 force_options.proxy.enabled ? force_options.proxy.step_m : 0.0),
       .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;

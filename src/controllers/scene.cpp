@@ -722,7 +722,7 @@ Result<ShapeTree> load_shape_tree(
   const double scale = shape.ist.empty() ? shape.meters_per_unit : asset.meta.meters_per_unit;
   return ShapeTree{
       std::make_shared<const collette::SphereTree>(collette::scale_sphere_tree(asset.tree, scale)),
-      asset.meta.coverage, asset.meta.max_gap * scale};
+      asset.meta.coverage};
 }
 
 Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape) {

@@ -187,7 +187,7 @@ Ripple slide_ripple(const Packed& slab, double smoothing_m, double press_m,
                     std::shared_ptr<const collette::MeshInside> surface = {}, double* lowest_m = nullptr) {
   const auto ball = std::make_shared<const collette::SphereTree>(
       *collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}}));
-  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002 + (surface ? slab.max_gap : 0.0)});
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
   const auto slab_id = world.add_object({.tree = slab.tree, .is_static = true, .name = "slab"});
   const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
   EXPECT_TRUE(world.add_tool_watcher(*tool_id));

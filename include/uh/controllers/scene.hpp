@@ -130,8 +130,6 @@ std::filesystem::path default_cache_dir();
 struct ShapeTree {
   std::shared_ptr<const collette::SphereTree> tree;
   double coverage = 1.0;
-  /// The packing's largest distance from the mesh's surface to its spheres [m] (0 for a tree in memory).
-  double surface_gap_m = 0.0;
 };
 
 /// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the

@@ -73,8 +73,10 @@ struct ProxyContact {
   /// The object's mesh surface in metres, in its own frame, or null. With it the proxy rests on the
   /// mesh itself: each tool sphere near the object is kept off the surface's nearest point, so a flat
   /// face is flat, not the packing's grain (the sphere pairs stay as constraints underneath, and the
-  /// soft minimum is not needed). The world's contact margin must then be at least step_m plus the
-  /// packing's surface gap, so that every tool sphere within step_m of the mesh is in a pair.
+  /// soft minimum is not needed). A tool sphere gets its mesh row once a pair puts it within the
+  /// world's margin of the object's spheres, which lie up to the packing's surface gap G below the
+  /// mesh: a tool approaching faster than (margin - G) a step may sink into the mesh by up to G
+  /// (never into the spheres) for a step before the row pushes it out.
   std::shared_ptr<const collette::MeshInside> surface{};
 };
 
