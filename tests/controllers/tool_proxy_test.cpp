@@ -257,6 +257,113 @@ TEST(ToolProxy, RestsOnTheMeshSoAPackedFlatFaceDoesNotRipple) {
   }
 }
 
+// Force continuity over an edge: a ball pressed 1.5 mm into a packed slab's top face and drawn at
+// 2 cm/s off its edge rolls over it on the proxy; the force's change per tick stays within what the
+// spring does when the handle moves, K v T (times two: the proxy moves as far), at the edge too.
+TEST(ToolProxy, TheForceChangesByAtMostKvTPerTickOverAnEdge) {
+  collette::TriangleMesh m = box_mesh({0.1, 0.1, 0.02});
+  for (Vec3& v : m.vertices) v.z -= 0.01;  // top face at z = 0, the edge at x = 0.05
+  const Packed slab = pack(m, 10000);
+  const auto ball = std::make_shared<const collette::SphereTree>(
+      *collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}}));
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  const auto slab_id = world.add_object({.tree = slab.tree, .is_static = true, .name = "slab"});
+  const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
+  ASSERT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball, {.enabled = true}, true);
+  proxy.watch(*slab_id, {.surface = std::make_shared<const collette::MeshInside>(*collette::validate_mesh(m))});
+  proxy.bind();
+  const double stiffness = 1500.0, speed = 0.02, period = 1e-3;
+  Pose handle;
+  ProxyState state{};
+  Vec3 last{};
+  double largest_step = 0.0, largest_force = 0.0, lowest = 1.0;
+  for (int i = 0; i < 4000; ++i) {
+    // down onto the face at x = 4 cm, then along x at 2 cm/s to 2 cm past the edge
+    const double x = i < 1000 ? 0.04 : 0.04 + speed * period * (i - 1000);
+    handle.position = {x, 0.0, std::max(0.02 - 0.00005 * i, 0.0035)};
+    proxy.set_target(handle);
+    world.step(period * i);
+    if (const ProxyState* s = proxy.take()) state = *s;
+    const Vec3 force = stiffness * (proxy.slide(state, handle).position - handle.position);
+    if (i > 1000) largest_step = std::max(largest_step, norm(force - last));
+    largest_force = std::max(largest_force, norm(force));
+    lowest = std::min(lowest, state.world_from_proxy.position.z - 0.005);
+    last = force;
+  }
+  std::printf("over the edge: largest force %.3f N, largest step per tick %.4f N (K v T = %.4f N)\n", largest_force,
+              largest_step, stiffness * speed * period);
+  EXPECT_GT(largest_force, 2.0);  // it was pressed
+  EXPECT_LE(largest_step, 2.0 * stiffness * speed * period);
+  EXPECT_GT(proxy.pose().position.z, -0.0055);  // and went over the edge, not through the slab
+}
+
+// A square peg (10 x 10 x 40 mm, packed) lowered, tilted 3 deg and 0.5 mm off centre, into a
+// 12 mm square hole 4 cm deep (four packed walls and a floor, each with its mesh): the 6-DOF proxy
+// slides and turns it down to the floor without snagging on the walls' packing, turning it by at
+// most a small angle per step. The reference is the geometry: the peg's lowest sphere ends within
+// the peg's own packing gap and the allowed penetration of the floor, and no peg sphere's centre
+// ever comes nearer a wall's face than its radius less the penetration.
+TEST(ToolProxy, APegSlidesIntoAHoleWithoutSnagging) {
+  struct Block {
+    Vec3 size, centre;
+  };
+  const double half = 0.006;  // the hole's half width
+  const std::vector<Block> blocks{{{0.02, 0.052, 0.04}, {-half - 0.01, 0, -0.02}},
+                                  {{0.02, 0.052, 0.04}, {half + 0.01, 0, -0.02}},
+                                  {{0.012, 0.02, 0.04}, {0, -half - 0.01, -0.02}},
+                                  {{0.012, 0.02, 0.04}, {0, half + 0.01, -0.02}},
+                                  {{0.052, 0.052, 0.01}, {0, 0, -0.045}}};
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  std::vector<collette::ObjectId> ids;
+  std::vector<std::shared_ptr<const collette::MeshInside>> surfaces;
+  for (const Block& b : blocks) {
+    collette::TriangleMesh m = box_mesh(b.size);
+    for (Vec3& v : m.vertices) v += b.centre;
+    const Packed packed = pack(m, 3000);
+    const auto id = world.add_object({.tree = packed.tree, .is_static = true, .name = "wall"});
+    ASSERT_TRUE(id);
+    ids.push_back(*id);
+    surfaces.push_back(std::make_shared<const collette::MeshInside>(*collette::validate_mesh(m)));
+  }
+  const Packed peg = pack(box_mesh({0.01, 0.01, 0.04}), 3000);
+  const auto tool_id = world.add_object({.tree = peg.tree, .has_initial_pose = false, .name = "peg"});
+  ASSERT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *peg.tree, {.enabled = true}, true);
+  for (std::size_t i = 0; i < ids.size(); ++i) proxy.watch(ids[i], {.surface = surfaces[i]});
+  proxy.bind();
+  Pose handle;
+  handle.rotation = quat_from_axis_angle({0, 1, 0}, 3.0 * kPi / 180.0);
+  Quat previous = handle.rotation;
+  double largest_turn = 0.0, nearest_wall = 1.0;
+  for (int i = 0; i < 4000; ++i) {
+    // from 1 cm above the hole down at 2 cm/s, the handle aiming 1 cm below the floor
+    handle.position = {0.0005, 0.0, std::max(0.04 - 0.00002 * i, -0.03)};
+    proxy.set_target(handle);
+    world.step(1e-3 * i);
+    const Pose& now = proxy.pose();
+    largest_turn = std::max(largest_turn, std::abs(forcecomp::rotation_vector(now.rotation * conjugate(previous)).y));
+    previous = now.rotation;
+    if (i % 50 == 0)
+      for (const Sphere& s : peg.tree->leaves()) {
+        const Vec3 c = transform_point(now, centre_of(s));
+        if (c.z < 0.0 && c.z > -0.04)  // beside the walls: their faces are x, y = +-half
+          nearest_wall = std::min(nearest_wall, half - std::max(std::abs(c.x), std::abs(c.y)) - static_cast<double>(s.radius));
+      }
+  }
+  double lowest = 1.0;
+  for (const Sphere& s : peg.tree->leaves())
+    lowest = std::min(lowest, transform_point(proxy.pose(), centre_of(s)).z - static_cast<double>(s.radius));
+  std::printf("peg in a hole: lowest point %.2f mm above the floor (peg's packing gap %.2f mm), nearest a wall %.3f mm, "
+              "largest turn per step %.3f deg, %llu unsolved\n",
+              (lowest + 0.04) * 1e3, peg.max_gap * 1e3, nearest_wall * 1e3, largest_turn * 180.0 / kPi,
+              static_cast<unsigned long long>(proxy.stats().unsolved));
+  EXPECT_LT(lowest + 0.04, peg.max_gap + 0.0005) << "snagged above the floor";
+  EXPECT_GT(lowest + 0.04, -ToolProxyOptions{}.penetration_m - 1e-5);
+  EXPECT_GT(nearest_wall, -ToolProxyOptions{}.penetration_m - 1e-5);
+  EXPECT_LT(largest_turn, 0.5 * kPi / 180.0);
+}
+
 // Friction as a cone on the proxy: a ball pressed into a packed face with about 2 N and pulled
 // sideways sticks until the sideways force is mu_s times the normal force, then slides at mu_d.
 // The reference is Coulomb's law on the spring force the device would feel.
