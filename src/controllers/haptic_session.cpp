@@ -32,7 +32,8 @@ Result<ObjectSurfaces> load_watched_surfaces(const Scene& scene) {
     const SceneObject& object = scene.objects[i];
     if (std::find(scene.watch.begin(), scene.watch.end(), object.name) == scene.watch.end()) continue;
     const auto key = std::make_pair(object.shape.mesh.string(), object.shape.meters_per_unit);
-    if (const auto it = by_mesh.find(key); it != by_mesh.end() && !object.shape.tree) {
+    if (object.shape.mesh.empty() || object.shape.tree) continue;
+    if (const auto it = by_mesh.find(key); it != by_mesh.end()) {
       surfaces[i] = it->second;
       continue;
     }
@@ -40,7 +41,7 @@ Result<ObjectSurfaces> load_watched_surfaces(const Scene& scene) {
     if (!surface)
       return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, surface.error().message)};
     surfaces[i] = *surface;
-    if (!object.shape.tree) by_mesh.emplace(key, *surface);
+    by_mesh.emplace(key, *surface);
   }
   return surfaces;
 }

@@ -100,6 +100,7 @@ ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, c
 }
 
 void ToolProxy::bind() {
+  texture_contact_.assign(watched_.size(), TextureContact{});
   const std::size_t slots = smooth_.size() * watched_.size();
   surface_seen_.assign(slots, 0);
   near_surface_.reserve(slots);
@@ -219,34 +220,53 @@ void ToolProxy::append_smooth(const Pose& proxy) {
 void ToolProxy::add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& centre_world, double radius) {
   if (leaf < 0 || static_cast<std::size_t>(leaf) >= smooth_.size()) return;
   const std::size_t slot = static_cast<std::size_t>(leaf) * watched_.size() + static_cast<std::size_t>(tag);
-  if (surface_seen_[slot] != 0) return;
+  if (slot >= surface_seen_.size() || surface_seen_[slot] != 0) return;  // watched after bind(): no room
   surface_seen_[slot] = 1;
   near_surface_.push_back({.leaf = leaf, .tag = tag, .centre = centre_world, .radius = radius});  // reserved
 }
 
 // A row per tool sphere near a mesh surface: its centre stays its radius (less the allowed
-// penetration, plus the textures' relief) away from the surface's nearest point, along the line to
-// it. The distance to a face is linear in the step and to a convex edge or corner convex, so the
-// row is exact or conservative there. A centre found on the inner side of the nearest face (it
-// began inside, or a saddle corner) gets no row: the sphere pairs hold it.
+// penetration) away from the surface's nearest point, along the line to it. The distance to a face
+// is linear in the step and to a convex edge or corner convex, so the row is exact or conservative
+// there. A centre found on the inner side of the nearest face (it began inside, or a saddle corner)
+// gets no row: the sphere pairs hold it. Textures then raise each object's rows (texture_contact).
 void ToolProxy::append_surface(const Pose& proxy) {
+  const std::int32_t first = constraint_count_;
   for (const SurfaceLeaf& near : near_surface_) {
     const WatchedObject& watched = watched_[static_cast<std::size_t>(near.tag)];
-    const ProxyContact& contact = watched.contact;
-    const Pose object_from_world = inverse(watched.world_from_object);
-    const Vec3 p = transform_point(object_from_world, near.centre);
+    const Vec3 p = transform_point(inverse(watched.world_from_object), near.centre);
     const collette::SurfacePoint q =
-        contact.surface->nearest(p, near.radius + options_.step_m + options_.penetration_m);
+        watched.contact.surface->nearest(p, near.radius + options_.step_m + options_.penetration_m);
     if (!q.found || dot(p - q.point, q.face_normal) < 0.0) continue;
     const Vec3 n_object = q.distance > 1e-12 ? (p - q.point) / q.distance : q.face_normal;
     const Vec3 n = rotate(watched.world_from_object.rotation, n_object);
-    double gap = q.distance - near.radius + options_.penetration_m;
-    gap -= forcecomp::texture_height(contact.object_texture, q.point) +
-           forcecomp::texture_height(contact.tool_texture,
-                                     transform_point(inverse(queried_), near.centre - near.radius * n));
+    const double gap = q.distance - near.radius + options_.penetration_m;
     if (constraint_count_ >= static_cast<std::int32_t>(constraints_.size())) break;
     constraints_[static_cast<std::size_t>(constraint_count_++)] = {
         .normal = n, .lever = (near.centre - near.radius * n) - proxy.position, .gap = gap, .tag = near.tag};
+    TextureContact& t = texture_contact_[static_cast<std::size_t>(near.tag)];
+    if (gap < t.gap) t = {.gap = gap, .on_object = q.point, .on_tool = near.centre - near.radius * n};
+  }
+  texture_rows({constraints_.data() + first, static_cast<std::size_t>(constraint_count_ - first)});
+}
+
+// A texture is felt where the contact is, as the penalty path's surface stage feels it: each
+// object's rows are raised by its and the tool's texture heights at its nearest row's contact point
+// (one point per object, so a large tool rides the relief under its contact point rather than
+// bridging it). Clears the contact points for the next step.
+void ToolProxy::texture_rows(std::span<forcecomp::ProxyConstraint> rows) {
+  const Pose tool_from_world = inverse(queried_);
+  for (std::size_t tag = 0; tag < watched_.size(); ++tag) {
+    TextureContact& t = texture_contact_[tag];
+    const ProxyContact& contact = watched_[tag].contact;
+    if (t.gap < std::numeric_limits<double>::infinity() && (contact.object_texture.kind != forcecomp::TextureKind::kNone ||
+                                                             contact.tool_texture.kind != forcecomp::TextureKind::kNone)) {
+      const double height = forcecomp::texture_height(contact.object_texture, t.on_object) +
+                            forcecomp::texture_height(contact.tool_texture, transform_point(tool_from_world, t.on_tool));
+      for (forcecomp::ProxyConstraint& c : rows)
+        if (c.tag == static_cast<std::int32_t>(tag)) c.gap -= height;
+    }
+    t = {};
   }
 }
 

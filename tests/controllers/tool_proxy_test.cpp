@@ -367,12 +367,14 @@ TEST(ToolProxy, APegSlidesIntoAHoleWithoutSnagging) {
 // Friction as a cone on the proxy: a ball pressed into a packed face with about 2 N and pulled
 // sideways sticks until the sideways force is mu_s times the normal force, then slides at mu_d.
 // The reference is Coulomb's law on the spring force the device would feel.
-TEST(ToolProxy, FrictionSticksUntilMuStaticThenSlidesAtMuDynamic) {
-  const Packed slab = [] {
-    collette::TriangleMesh m = box_mesh({0.1, 0.1, 0.02});
-    for (Vec3& v : m.vertices) v.z -= 0.01;
-    return pack(m, 10000);
-  }();
+class Friction : public ::testing::TestWithParam<bool> {};  // on the mesh, or on the spheres' union
+
+TEST_P(Friction, SticksUntilMuStaticThenSlidesAtMuDynamic) {
+  collette::TriangleMesh m = box_mesh({0.1, 0.1, 0.02});
+  for (Vec3& v : m.vertices) v.z -= 0.01;
+  const Packed slab = pack(m, 10000);
+  std::shared_ptr<const collette::MeshInside> surface;
+  if (GetParam()) surface = std::make_shared<const collette::MeshInside>(*collette::validate_mesh(m));
   const auto ball = std::make_shared<const collette::SphereTree>(
       *collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}}));
   collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
@@ -380,7 +382,7 @@ TEST(ToolProxy, FrictionSticksUntilMuStaticThenSlidesAtMuDynamic) {
   const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
   ASSERT_TRUE(world.add_tool_watcher(*tool_id));
   ToolProxy proxy(world, *tool_id, *ball, {.enabled = true}, true);
-  proxy.watch(*slab_id, {.friction_static = 0.6, .friction_dynamic = 0.4});
+  proxy.watch(*slab_id, {.friction_static = 0.6, .friction_dynamic = 0.4, .surface = surface});
   proxy.bind();
   const double stiffness = 1500.0;
   Pose handle;
@@ -415,10 +417,11 @@ TEST(ToolProxy, FrictionSticksUntilMuStaticThenSlidesAtMuDynamic) {
   ASSERT_GT(sliding_ratios.size(), 500u);
   std::sort(sliding_ratios.begin(), sliding_ratios.end());
   const double median = sliding_ratios[sliding_ratios.size() / 2];
-  std::printf("friction on the proxy: breakaway at %.3f (mu_s 0.6; largest before it %.3f), sliding median %.3f (mu_d 0.4)\n",
-              break_ratio, peak_ratio, median);
+  std::printf("friction on the proxy (%s): breakaway at %.3f (mu_s 0.6; largest before it %.3f), sliding median %.3f (mu_d 0.4)\n",
+              GetParam() ? "mesh" : "spheres", break_ratio, peak_ratio, median);
   EXPECT_NEAR(median, 0.4, 0.04);
 }
+INSTANTIATE_TEST_SUITE_P(OnTheMeshAndOnTheSpheres, Friction, ::testing::Values(true, false));
 
 // The whole session (scenes/thin_wall.json): a simulated hand pulls the 1 cm ball 3 cm through a
 // 3 mm plate tilted 20 degrees with up to 8 N. Through the proxy the ball stays on its side and the

@@ -67,7 +67,8 @@ struct ProxyContact {
   double friction_dynamic = 0.0;
   /// The textures of the pair (`object_texture` in the object's frame, `tool_texture` in the
   /// tool's, forcecomp::texture_height): each raises the surface the proxy rests on by its height
-  /// where it touches, so the proxy rides over the texture's relief.
+  /// where it touches (with a mesh surface: at the contact point, the nearest row's, for all the
+  /// object's rows, so the proxy rides over the texture's relief under it).
   forcecomp::Texture object_texture{};
   forcecomp::Texture tool_texture{};
   /// The object's mesh surface in metres, in its own frame, or null. With it the proxy rests on the
@@ -165,6 +166,7 @@ class ToolProxy {
   void append_smooth(const Pose& proxy);
   void add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& centre_world, double radius);
   void append_surface(const Pose& proxy);
+  void texture_rows(std::span<forcecomp::ProxyConstraint> rows);
   void add_section(const ContactFrame& frame, const ContactSection& section);
   Pose advance(const Pose& from, const Pose& target, ProxyState& out);
   forcecomp::ProxyStep solve_turning(std::span<forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w,
@@ -211,6 +213,13 @@ class ToolProxy {
   };
   std::vector<SurfaceLeaf> near_surface_;
   std::vector<std::uint8_t> surface_seen_;  // per (leaf, watched object): already in near_surface_
+  // per watched object: its nearest mesh row's contact point this step, where its texture is felt
+  struct TextureContact {
+    double gap = std::numeric_limits<double>::infinity();
+    Vec3 on_object{};  // object frame
+    Vec3 on_tool{};    // world frame
+  };
+  std::vector<TextureContact> texture_contact_;
   std::int32_t constraint_count_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
