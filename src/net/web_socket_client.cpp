@@ -1,9 +1,11 @@
 #include "uh/net/web_socket_client.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <deque>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <boost/asio/connect.hpp>
@@ -98,35 +100,49 @@ struct WebSocketClient::Impl {
     });
   }
 
-  Status open(const WsUrl& url, const ConnectOptions& options) {
-    cancel = options.cancel;
+  // why a step did not complete within `limit`
+  std::string timed_out(Duration limit) const {
+    return cancel != nullptr && cancel->load() ? std::string("connecting was cancelled")
+                                               : fmt::format("no answer within {}", seconds_text(limit));
+  }
+
+  // where `url` points: an IP address as it is (no lookup, no resolver thread), a name resolved
+  Result<std::vector<tcp::endpoint>> resolve(const WsUrl& url, const ConnectOptions& options) {
+    beast::error_code ec;
+    const asio::ip::address address = asio::ip::make_address(url.host, ec);
+    unsigned short port = 0;
+    const auto [end, parsed] = std::from_chars(url.port.data(), url.port.data() + url.port.size(), port);
+    if (!ec && parsed == std::errc{} && end == url.port.data() + url.port.size())
+      return std::vector<tcp::endpoint>{tcp::endpoint(address, port)};
     tcp::resolver resolver(io);
     std::optional<beast::error_code> resolved;
-    tcp::resolver::results_type endpoints;
+    std::vector<tcp::endpoint> endpoints;
     resolver.async_resolve(url.host, url.port,
-                           [&](beast::error_code ec, tcp::resolver::results_type results) {
-                             resolved = ec;
-                             endpoints = std::move(results);
+                           [&](beast::error_code e, const tcp::resolver::results_type& results) {
+                             resolved = e;
+                             endpoints.assign(results.begin(), results.end());
                            });
-    // why a step did not complete in time
-    const auto timed_out = [&] {
-      return cancel != nullptr && cancel->load()
-                 ? std::string("connecting was cancelled")
-                 : fmt::format("no answer within {}", seconds_text(options.step_limit));
-    };
     if (!run_until([&] { return resolved.has_value(); }, options.step_limit)) {
       resolver.cancel();
       abandon([&] { return resolved.has_value(); });
-      return Error{fmt::format("cannot resolve the host of {}: {}", options.name, timed_out())};
+      return Error{
+          fmt::format("cannot resolve the host of {}: {}", options.name, timed_out(options.step_limit))};
     }
     if (*resolved)
       return Error{fmt::format("cannot resolve the host of {}: {}", options.name, resolved->message())};
+    return endpoints;
+  }
+
+  Status open(const WsUrl& url, const ConnectOptions& options) {
+    cancel = options.cancel;
+    auto endpoints = resolve(url, options);
+    if (!endpoints) return endpoints.error();
     std::optional<beast::error_code> connected;
-    asio::async_connect(ws.next_layer(), endpoints,
+    asio::async_connect(ws.next_layer(), *endpoints,
                         [&connected](beast::error_code ec, const tcp::endpoint&) { connected = ec; });
     if (!run_until([&] { return connected.has_value(); }, options.step_limit)) {
       abandon([&] { return connected.has_value(); });
-      return Error{fmt::format("cannot reach {}: {}", options.name, timed_out())};
+      return Error{fmt::format("cannot reach {}: {}", options.name, timed_out(options.step_limit))};
     }
     if (*connected) return Error{fmt::format("cannot reach {}: {}", options.name, connected->message())};
     std::optional<beast::error_code> shaken;
@@ -134,7 +150,8 @@ struct WebSocketClient::Impl {
                        [&shaken](beast::error_code ec) { shaken = ec; });
     if (!run_until([&] { return shaken.has_value(); }, options.step_limit)) {
       abandon([&] { return shaken.has_value(); });
-      return Error{fmt::format("{} did not complete the WebSocket handshake: {}", options.name, timed_out())};
+      return Error{fmt::format("{} did not complete the WebSocket handshake: {}", options.name,
+                               timed_out(options.step_limit))};
     }
     if (*shaken)
       return Error{fmt::format("{} refused the WebSocket handshake: {}", options.name, shaken->message())};
