@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "uh/museum/level.hpp"
-#include "uh/service/web_socket_host.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 namespace uh::cli {
 
 /// The files and the texts they point into (keep it alive while the server runs).
 struct MuseumClientFiles {
   std::vector<std::string> texts;
-  std::vector<service::StaticFile> files;
+  std::vector<net::StaticFile> files;
   bool has_page = false;  ///< whether the build bundled the page (UH_BUILD_VIEW)
 };
 

@@ -5,8 +5,8 @@
 
 namespace uh::cli::view {
 
-std::vector<service::StaticFile> static_files(std::string_view folder) {
-  std::vector<service::StaticFile> out;
+std::vector<net::StaticFile> static_files(std::string_view folder) {
+  std::vector<net::StaticFile> out;
   for (const File& f : files()) {
     const std::filesystem::path path(f.path);
     if (path.parent_path() != std::filesystem::path(folder)) continue;

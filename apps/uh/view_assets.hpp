@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "uh/service/server.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 namespace uh::cli::view {
 
@@ -20,6 +20,6 @@ std::span<const File> files();
 
 /// The files of one page's folder as the server serves them: "dist" gives the live view
 /// ("/index.html", "/view.js"), "dist/museum" Vive's client ("/index.html", "/museum.js").
-std::vector<service::StaticFile> static_files(std::string_view folder = "dist");
+std::vector<net::StaticFile> static_files(std::string_view folder = "dist");
 
 }  // namespace uh::cli::view

@@ -8,24 +8,17 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
-#include <boost/asio/connect.hpp>
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/beast/core/buffers_to_string.hpp>
-#include <boost/beast/core/flat_buffer.hpp>
-#include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/error.hpp>
 #include <nlohmann/json.hpp>
+
+#include "uh/net/web_socket_client.hpp"
+#include "uh/net/ws_url.hpp"
 
 namespace uh::devices {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
 using json = nlohmann::json;
 using haptico::DeviceStatus;
 using Clock = TickRecorder::Clock;
@@ -44,25 +37,9 @@ thread_local bool t_in_run = false;
 
 double steady_now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
-struct Url {
-  std::string host, port, path;
-};
-
-Result<Url> parse_url(const std::string& text) {
-  constexpr std::string_view kScheme = "ws://";
-  if (text.rfind(kScheme, 0) != 0) return Error{"expected ws://HOST:PORT[/PATH]"};
-  const std::string rest = text.substr(kScheme.size());
-  const std::size_t slash = rest.find('/');
-  const std::string authority = rest.substr(0, slash);
-  Url url;
-  url.path = slash == std::string::npos ? "/" : rest.substr(slash);
-  const std::size_t colon = authority.rfind(':');
-  url.host = authority.substr(0, colon);
-  url.port = colon == std::string::npos ? "80" : authority.substr(colon + 1);
-  if (url.host.empty()) return Error{"no host (expected ws://HOST:PORT[/PATH])"};
-  if (url.port.empty() || url.port.find_first_not_of("0123456789") != std::string::npos)
-    return Error{fmt::format("'{}' is not a port number", url.port)};
-  return url;
+Result<net::WsUrl> parse_url(const std::string& text) {
+  return net::parse_ws_url(text,
+                           {.wrong_form = "expected ws://HOST:PORT[/PATH]", .example = kHaplyDefaultUrl});
 }
 
 // a device id goes into the command text as it is: only the characters of Haply's ids
@@ -103,70 +80,19 @@ std::string error_text(const json& error) {
 
 }  // namespace
 
-// The WebSocket and its I/O context. Every operation runs with a time limit: it is started
-// asynchronously and the context runs until it completed or the limit passed; its completion is
-// kept here, so that an operation still pending after its limit completes harmlessly later.
+// The WebSocket to the service; every wait on it is bounded (net::WebSocketClient).
 struct HaplyDevice::Connection {
-  asio::io_context io;
-  websocket::stream<tcp::socket> ws{io};
-  beast::flat_buffer in;
+  std::unique_ptr<net::WebSocketClient> client;
+  std::string reply;  // the last message received
   std::array<char, 512> out{};
-  std::optional<beast::error_code> read_done, write_done, close_done;
-  bool alive = false;  // the connection works (no error seen)
-  // operations started and not completed (one may outlive its time limit)
-  bool read_pending = false;
-  bool write_pending = false;
-  bool close_pending = false;
 
-  // runs the context until `done()` or `limit` passed; false on timeout
-  template <typename Done>
-  bool run_until(Done done, std::chrono::milliseconds limit) {
-    const auto deadline = Clock::now() + limit;
-    io.restart();
-    while (!done())
-      if (io.run_one_until(deadline) == 0) return done();
-    return true;
-  }
-  void start_write(std::size_t n) {
-    write_done.reset();
-    write_pending = true;
-    ws.async_write(asio::buffer(out.data(), n), [this](beast::error_code ec, std::size_t) {
-      write_done = ec;
-      write_pending = false;
-    });
-  }
-  void start_read() {
-    read_done.reset();
-    in.clear();
-    read_pending = true;
-    ws.async_read(in, [this](beast::error_code ec, std::size_t) {
-      read_done = ec;
-      read_pending = false;
-    });
-  }
-  // the command text for `force` [N] to device `id` into `out`; its length
-  std::size_t format_command(const std::string& id, const Vec3& force) {
+  // the command text for `force` [N] to device `id`
+  std::string_view format_command(const std::string& id, const Vec3& force) {
     const int n = std::snprintf(
         out.data(), out.size(),
         R"({"inverse3":[{"device_id":"%s","commands":{"set_cursor_force":{"vector":{"x":%.9g,"y":%.9g,"z":%.9g}}}}]})",
         id.c_str(), force.x, force.y, force.z);
-    return static_cast<std::size_t>(n);
-  }
-  void start_close() {
-    close_done.reset();
-    close_pending = true;
-    ws.async_close(websocket::close_code::normal, [this](beast::error_code ec) {
-      close_done = ec;
-      close_pending = false;
-    });
-  }
-  // closes the socket; operations still pending complete (aborted) before this returns
-  void drop() {
-    beast::error_code ignored;
-    ws.next_layer().shutdown(tcp::socket::shutdown_both, ignored);
-    ws.next_layer().close(ignored);
-    alive = false;
-    run_until([this] { return !read_pending && !write_pending && !close_pending; }, kHangUpTimeout);
+    return {out.data(), static_cast<std::size_t>(n)};
   }
 };
 
@@ -195,7 +121,7 @@ Result<std::unique_ptr<haptico::HapticDevice>> HaplyDevice::create(const haptico
   auto timeout = config.number("timeout_ms", kDefaultTimeoutMs);
   if (!timeout) return Error{fmt::format("haply: {}", timeout.error().message)};
   if (!(*timeout >= 1.0 && *timeout <= 10000.0)) return Error{"haply: timeout_ms must be in [1, 10000]"};
-  if (Result<Url> url = parse_url(haply_service_url(config).path); !url)
+  if (Result<net::WsUrl> url = parse_url(haply_service_url(config).path); !url)
     return Error{fmt::format("haply: url '{}' (from {}): {}", haply_service_url(config).path,
                              haply_service_url(config).origin, url.error().message)};
   sel.max_force_n = *force;
@@ -221,37 +147,25 @@ Status HaplyDevice::open() {
   faulted_ = false;
   state_ = {};
   pending_force_ = {};
-  const Result<Url> url = parse_url(url_.path);  // checked by create()
+  const Result<net::WsUrl> url = parse_url(url_.path);  // checked by create()
   const std::string where = fmt::format("the Inverse Service at {} (from {})", url_.path, url_.origin);
-  auto c = std::make_unique<Connection>();
-  beast::error_code ec;
-  tcp::resolver resolver(c->io);
-  const auto endpoints = resolver.resolve(url->host, url->port, ec);
-  if (ec) return Error{fmt::format("haply: cannot resolve {}: {}", where, ec.message())};
-  std::optional<beast::error_code> connected;
-  asio::async_connect(c->ws.next_layer(), endpoints,
-                      [&connected](beast::error_code e, const tcp::endpoint&) { connected = e; });
   const auto unreachable = [&](const std::string& why) -> Status {
-    c->drop();
-    return Error{
-        fmt::format("haply: cannot reach {}: {}; is the service running? (see docs/devices.md)", where, why)};
+    return Error{fmt::format("haply: {}; is the service running? (see docs/devices.md)", why)};
   };
-  if (!c->run_until([&] { return connected.has_value(); }, kConnectTimeout))
-    return unreachable("no answer within 2 s");
-  if (*connected) return unreachable(connected->message());
-  c->alive = true;
-  std::optional<beast::error_code> shaken;
-  c->ws.async_handshake(fmt::format("{}:{}", url->host, url->port), url->path,
-                        [&shaken](beast::error_code e) { shaken = e; });
-  if (!c->run_until([&] { return shaken.has_value(); }, kConnectTimeout))
-    return unreachable("the WebSocket handshake got no answer within 2 s");
-  if (*shaken) return unreachable(fmt::format("the WebSocket handshake failed: {}", shaken->message()));
-  c->start_read();
-  if (!c->run_until([&] { return c->read_done.has_value(); }, kConnectTimeout))
-    return unreachable("the service sent no inventory within 2 s");
-  if (*c->read_done)
-    return unreachable(fmt::format("reading its inventory failed: {}", c->read_done->message()));
-  const std::string inventory = beast::buffers_to_string(c->in.data());
+  auto client = net::WebSocketClient::connect(*url, {.name = where, .step_limit = kConnectTimeout});
+  if (!client) return unreachable(client.error().message);
+  auto c = std::make_unique<Connection>();
+  c->client = std::move(client).value();
+  switch (c->client->receive(c->reply, kConnectTimeout)) {
+    case net::WebSocketClient::Received::message:
+      break;
+    case net::WebSocketClient::Received::nothing:
+      return unreachable(fmt::format("cannot reach {}: the service sent no inventory within 2 s", where));
+    case net::WebSocketClient::Received::ended:
+      return unreachable(fmt::format("cannot reach {}: reading its inventory failed: {}", where,
+                                     c->client->error().message()));
+  }
+  const std::string inventory = c->reply;
   connection_ = std::move(c);
   if (Status s = describe(inventory); !s) {
     hang_up();
@@ -360,42 +274,40 @@ void HaplyDevice::fault(const char* what, const std::string& detail) {
 
 bool HaplyDevice::exchange() {
   Connection& c = *connection_;
-  if (!c.alive || c.read_pending || c.write_pending) {
+  net::WebSocketClient& client = *c.client;
+  if (!client.alive() || client.reading()) {
     fault("the connection to the service is gone", "no command can be sent");
     return false;
   }
-  c.start_write(c.format_command(info_.serial, pending_force_));
-  c.start_read();
-  const auto failed = [&c] { return (c.write_done && *c.write_done) || (c.read_done && *c.read_done); };
-  if (!c.run_until([&] { return (c.read_done && c.write_done) || failed(); }, selection_.timeout)) {
-    fault(fmt::format("the Inverse Service did not answer within {} ms", selection_.timeout.count()).c_str(),
+  client.send(c.format_command(info_.serial, pending_force_));
+  switch (client.receive(c.reply, selection_.timeout)) {
+    case net::WebSocketClient::Received::message:
+      return take_reply(c.reply);
+    case net::WebSocketClient::Received::nothing:
+      fault(
+          fmt::format("the Inverse Service did not answer within {} ms", selection_.timeout.count()).c_str(),
           "it stopped sending device states");
-    return false;
+      return false;
+    case net::WebSocketClient::Received::ended:
+      break;
   }
-  if (failed()) {
-    const beast::error_code ec = c.write_done && *c.write_done ? *c.write_done : *c.read_done;
-    c.alive = false;
-    fault("the connection to the Inverse Service was lost",
-          ec == websocket::error::closed ? std::string("the service closed it") : ec.message());
-    return false;
-  }
-  return take_reply(beast::buffers_to_string(c.in.data()));
+  const auto ec = client.error();
+  fault("the connection to the Inverse Service was lost",
+        ec == boost::beast::websocket::error::closed ? std::string("the service closed it") : ec.message());
+  return false;
 }
 
 void HaplyDevice::hang_up() {
   if (!connection_) return;
   Connection& c = *connection_;
+  net::WebSocketClient& client = *c.client;
   // the device must not keep the last force: zero, if the service can still be told
-  if (c.alive && !c.write_pending) {
-    c.start_write(c.format_command(info_.serial, Vec3{}));
-    c.run_until([&c] { return c.write_done.has_value(); }, kHangUpTimeout);
-    if (c.write_done && !*c.write_done && !c.read_pending) {
-      // the reply to the zero may come before the service's close: the close reads past it
-      c.start_close();
-      c.run_until([&c] { return c.close_done.has_value(); }, kHangUpTimeout);
-    }
+  if (client.alive()) {
+    client.send(c.format_command(info_.serial, Vec3{}));
+    // the reply to the zero may come before the service's close: the close reads past it
+    if (client.flush(kHangUpTimeout) && !client.reading()) (void)client.close(kHangUpTimeout);
   }
-  c.drop();
+  client.drop();
   connection_.reset();
 }
 

@@ -39,8 +39,6 @@ std::optional<ArtifactKind> artifact_kind(std::string_view name) {
   return std::nullopt;
 }
 
-const char* to_string(Piece piece) { return piece == Piece::genuine ? "genuine" : "forgery"; }
-
 namespace {
 
 constexpr double kPi = std::numbers::pi;

@@ -6,67 +6,54 @@
 #include <thread>
 
 #include <fmt/format.h>
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/steady_timer.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/websocket.hpp>
 
 #include "uh/core/log.hpp"
 #include "uh/core/spsc_queue.hpp"
+#include "uh/net/web_socket_client.hpp"
 
 namespace uh::museum_client {
 namespace {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
 using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kQueueCapacity = 1024;
-constexpr auto kPoll = 10ms;  // how often the network thread looks at the outgoing queue and stop
+constexpr auto kPoll = 10ms;  // how long the network thread waits for a message before it looks at
+                              // the outgoing queue and stop
+constexpr auto kConnectStepLimit = 5s;
+
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
 
 }  // namespace
 
 Result<ServerAddress> parse_server_url(const std::string& url) {
-  std::string rest = url;
-  ServerAddress a;
-  for (const char* scheme : {"ws://", "http://"}) {
-    if (rest.rfind(scheme, 0) == 0) rest = rest.substr(std::char_traits<char>::length(scheme));
-  }
-  if (rest.find("://") != std::string::npos)
-    return Error{fmt::format("server '{}': the address must be ws://HOST:PORT/ws or http://HOST:PORT/", url)};
-  const auto slash = rest.find('/');
-  const std::string authority = rest.substr(0, slash);
-  const auto colon = authority.rfind(':');
-  if (authority.empty() || colon == std::string::npos || colon == 0 || colon + 1 == authority.size())
-    return Error{fmt::format("server '{}': give the host and the port, e.g. ws://127.0.0.1:7780/ws", url)};
-  a.host = authority.substr(0, colon);
-  a.port = authority.substr(colon + 1);
-  if (a.port.find_first_not_of("0123456789") != std::string::npos || a.port.size() > 5 ||
-      std::stoi(a.port) > 65535)
-    return Error{fmt::format("server '{}': the port '{}' is not a number from 0 to 65535", url, a.port)};
-  return a;
+  auto address =
+      net::parse_ws_url(url, {.wrong_form = "the address must be ws://HOST:PORT/ws or http://HOST:PORT/",
+                              .example = "ws://127.0.0.1:7780/ws",
+                              .default_port = "",
+                              .default_path = "/ws",
+                              .page_address = true});
+  if (!address) return Error{fmt::format("server '{}': {}", url, address.error().message)};
+  return address;
 }
 
 struct GameLink::Impl {
   Impl(ServerAddress where, LinkOptions link_options)
-      : address(std::move(where)), options(std::move(link_options)), timer(io), retry_timer(io) {}
+      : address(std::move(where)), options(std::move(link_options)) {}
 
   ServerAddress address;
   LinkOptions options;
-  asio::io_context io;
-  std::optional<websocket::stream<beast::tcp_stream>> ws;
-  asio::steady_timer timer;
-  asio::steady_timer retry_timer;
-  beast::flat_buffer buffer;
-  std::deque<std::string> writing;  // the network thread's: frames being written, in order
-  std::deque<LinkNote> backlog;     // the network thread's: notes the owner had no room for yet
-  bool write_busy = false;
+  // the network thread's
+  std::unique_ptr<net::WebSocketClient> client;
+  std::deque<LinkNote> backlog;  // notes the owner had no room for yet
   bool ever_connected = false;
   bool told_dropped = false;
-  std::string seat_key;  // the network thread's: from the first welcome (Phantom's seat)
+  bool retrying = true;              // false: the link stays down after a drop
+  Clock::time_point next_attempt{};  // of connecting, after a drop
+  std::string seat_key;              // from the first welcome (Phantom's seat)
+  std::string received;
 
   SpscQueue<LinkNote> inbox{kQueueCapacity};      // network thread -> owner
   SpscQueue<std::string> outbox{kQueueCapacity};  // owner -> network thread
@@ -87,24 +74,11 @@ struct GameLink::Impl {
   }
 
   void open() {
-    ws.emplace(io);
-    beast::get_lowest_layer(*ws).expires_after(5s);
-    auto resolver = std::make_shared<tcp::resolver>(io);
-    resolver->async_resolve(
-        address.host, address.port,
-        [this, resolver](beast::error_code ec, tcp::resolver::results_type results) {
-          if (ec) return lost(ec, "cannot resolve the server's host");
-          beast::get_lowest_layer(*ws).async_connect(results, [this](beast::error_code e,
-                                                                     const tcp::endpoint&) {
-            if (e) return lost(e, "cannot reach the server");
-            beast::get_lowest_layer(*ws).expires_never();
-            ws->set_option(websocket::stream_base::timeout::suggested(beast::role_type::client));
-            ws->async_handshake(address.host + ":" + address.port, address.path, [this](beast::error_code h) {
-              if (h) return lost(h, "the server refused the WebSocket handshake");
-              joined();
-            });
-          });
-        });
+    auto connected = net::WebSocketClient::connect(
+        address, {.name = "the server", .step_limit = kConnectStepLimit, .cancel = &stopping});
+    if (!connected) return lost(connected.error().message);
+    client = std::move(connected).value();
+    joined();
   }
 
   void joined() {
@@ -112,94 +86,63 @@ struct GameLink::Impl {
     if (ever_connected) note({.kind = LinkNote::Kind::reconnected});
     ever_connected = true;
     told_dropped = false;
-    writing.clear();
-    write_busy = false;
-    ws->text(true);
-    write(hello_text(options.role, options.token, seat_key));
-    read();
+    client->send(hello_text(options.role, options.token, seat_key));
   }
 
-  void read() {
-    ws->async_read(buffer, [this](beast::error_code ec, std::size_t) {
-      if (ec) return lost(ec, "the connection to the server ended");
-      std::string text = beast::buffers_to_string(buffer.data());
-      buffer.consume(buffer.size());
-      auto parsed = parse_server_message(text);
-      // the seat this link took is taken again with its key after a dropped connection
-      if (parsed)
-        if (const auto* w = std::get_if<Welcome>(&*parsed); w != nullptr && !w->seat_key.empty())
-          seat_key = w->seat_key;
-      if (parsed) {
-        note({.kind = LinkNote::Kind::message, .message = std::move(*parsed), .text = std::move(text)});
-      } else {
-        log::warn("museum {}: ignored a message from the server: {}", options.role, parsed.error().message);
-        note({.kind = LinkNote::Kind::bad_message, .text = parsed.error().message});
-      }
-      read();
-    });
-  }
-
-  void write(std::string text) {
-    writing.push_back(std::move(text));
-    if (!write_busy) write_next();
-  }
-  void write_next() {
-    if (writing.empty() || !ws) {
-      write_busy = false;
-      return;
+  void take(std::string text) {
+    auto parsed = parse_server_message(text);
+    // the seat this link took is taken again with its key after a dropped connection
+    if (parsed)
+      if (const auto* w = std::get_if<Welcome>(&*parsed); w != nullptr && !w->seat_key.empty())
+        seat_key = w->seat_key;
+    if (parsed) {
+      note({.kind = LinkNote::Kind::message, .message = std::move(*parsed), .text = std::move(text)});
+    } else {
+      log::warn("museum {}: ignored a message from the server: {}", options.role, parsed.error().message);
+      note({.kind = LinkNote::Kind::bad_message, .text = parsed.error().message});
     }
-    write_busy = true;
-    ws->async_write(asio::buffer(writing.front()), [this](beast::error_code ec, std::size_t) {
-      if (ec) return;  // the read fails too and reports the drop
-      writing.pop_front();
-      write_next();
-    });
   }
 
-  void lost(beast::error_code ec, const char* what) {
+  void lost(const std::string& why) {
     up.store(false);
+    client.reset();
     if (stopping.load()) return;
     if (!told_dropped) {
       told_dropped = true;
-      note({.kind = LinkNote::Kind::dropped, .text = fmt::format("{}: {}", what, ec.message())});
+      note({.kind = LinkNote::Kind::dropped, .text = why});
     }
-    if (ws) {
-      beast::error_code ignored;
-      beast::get_lowest_layer(*ws).socket().close(ignored);
-    }
-    if (!options.reconnect) return;
-    retry_timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(options.retry_s)));
-    retry_timer.async_wait([this](beast::error_code e) {
-      if (!e && !stopping.load()) open();
-    });
+    retrying = options.reconnect;
+    next_attempt = Clock::now() + seconds(options.retry_s);
   }
 
-  void poll() {
-    timer.expires_after(kPoll);
-    timer.async_wait([this](beast::error_code ec) {
-      if (ec) return;
-      if (stopping.load()) {
-        retry_timer.cancel();
-        if (ws) {
-          beast::error_code ignored;
-          beast::get_lowest_layer(*ws).socket().close(ignored);
-        }
-        io.stop();
-        return;
+  // one turn of the network thread: connect when due, wait a little for a message, send what the
+  // owner queued
+  void turn() {
+    if (!client && retrying && Clock::now() >= next_attempt) open();
+    if (client) {
+      switch (client->receive(received, kPoll)) {
+        case net::WebSocketClient::Received::message:
+          take(std::move(received));
+          break;
+        case net::WebSocketClient::Received::ended:
+          lost(fmt::format("the connection to the server ended: {}", client->error().message()));
+          break;
+        case net::WebSocketClient::Received::nothing:
+          break;
       }
-      flush_backlog();
-      std::string text;
-      while (outbox.try_pop(text))
-        if (up.load()) write(std::move(text));  // a verdict while away is dropped: the station gives it again
-      poll();
-    });
+    } else {
+      std::this_thread::sleep_for(kPoll);
+    }
+    flush_backlog();
+    std::string text;
+    while (outbox.try_pop(text))
+      if (client) client->send(text);  // a verdict while away is dropped: the station gives it again
   }
 
   void run() {
-    open();
-    poll();
-    io.run();
+    while (!stopping.load()) turn();
+    up.store(false);
+    client.reset();
   }
 };
 

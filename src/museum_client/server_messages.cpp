@@ -239,7 +239,7 @@ Result<ServerMessage> parse_in_hand(const json& m, Reader& r) {
     const std::string piece = r.text(m, "piece");
     if (r.error.empty() && piece != "genuine" && piece != "forgery")
       r.error = fmt::format("'piece' is '{}'; it must be genuine or forgery", piece);
-    h.piece = piece == "forgery" ? museum_artifacts::Piece::forgery : museum_artifacts::Piece::genuine;
+    h.piece = piece == "forgery" ? museum::Piece::forgery : museum::Piece::genuine;
   }
   if (!r.error.empty()) return Error{r.error};
   return ServerMessage{h};

@@ -19,7 +19,7 @@ namespace uh::museum_service {
 namespace {
 
 namespace asio = boost::asio;
-using service::Peer;
+using net::Peer;
 using Clock = std::chrono::steady_clock;
 
 // clients send small messages; anything larger is closed with 1009
@@ -92,7 +92,7 @@ class LogBudget {
 constexpr int kMaxCatchUpTicks = 5;
 
 // The round and its clients, on the host's network thread: no locks.
-class GameHub final : public service::Endpoint {
+class GameHub final : public net::Endpoint {
  public:
   GameHub(asio::io_context& io, const museum::Level& level, std::uint64_t seed, std::string token,
           int snapshot_every, double speed, double resume_delay_s, double seat_hold_s)
@@ -237,7 +237,7 @@ class GameHub final : public service::Endpoint {
       return refuse(id, c, req_id, type,
                     fmt::format("protocol {} is not supported; this server speaks {}", h.protocol,
                                 kGameProtocolVersion));
-    if (!token_.empty() && !service::same_token(h.token, token_))
+    if (!token_.empty() && !net::same_token(h.token, token_))
       return refuse_hello(id, c, req_id,
                           h.token.empty() ? "this server needs a token" : "the token is wrong");
     if (h.role != Role::watcher && role_connected(h.role))
@@ -245,7 +245,7 @@ class GameHub final : public service::Endpoint {
                     fmt::format("the {} role is taken by another client", to_string(h.role)));
     // Phantom's seat is its station's: while it is held, only the holder of its key takes it again
     const bool same_station =
-        !phantom_seat_key_.empty() && service::same_token(h.seat_key, phantom_seat_key_);
+        !phantom_seat_key_.empty() && net::same_token(h.seat_key, phantom_seat_key_);
     if (h.role == Role::phantom && seat_held() && !same_station)
       return refuse_hello(
           id, c, req_id,
@@ -442,7 +442,7 @@ class GameHub final : public service::Endpoint {
 }  // namespace
 
 struct GameServer::Impl {
-  std::unique_ptr<service::WebSocketHost> host;
+  std::unique_ptr<net::WebSocketHost> host;
   GameHub* hub = nullptr;  // the host's endpoint: the network thread's
 };
 
@@ -466,7 +466,7 @@ Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options)
   const int every = std::max(1, static_cast<int>(std::lround(tick_hz / options.snapshot_hz)));
   auto impl = std::make_unique<Impl>();
   GameHub* hub = nullptr;
-  auto host = service::WebSocketHost::start(
+  auto host = net::WebSocketHost::start(
       {.host = options.host,
        .port = options.port,
        .has_token = !options.token.empty(),

@@ -20,9 +20,13 @@
 #include "protocol.hpp"
 #include "scene_document.hpp"
 #include "uh/controllers/haptic_session.hpp"
-#include "uh/service/web_socket_host.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 namespace uh::service {
+
+using net::Endpoint;
+using net::Peer;
+using net::same_token;
 
 struct HubOptions {
   std::string token;
@@ -31,7 +35,7 @@ struct HubOptions {
   bool raise_priority = false;
 };
 
-/// `uh serve`'s endpoint (web_socket_host.hpp).
+/// `uh serve`'s endpoint on the WebSocket host (uh/net/web_socket_host.hpp).
 class Hub final : public Endpoint {
  public:
   Hub(boost::asio::io_context& io, HubOptions options);

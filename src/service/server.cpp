@@ -3,13 +3,13 @@
 #include <utility>
 
 #include "hub.hpp"
-#include "uh/service/web_socket_host.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 namespace uh::service {
 
 // the network (WebSocketHost) with the hub as its endpoint
 struct Server::Impl {
-  std::unique_ptr<WebSocketHost> host;
+  std::unique_ptr<net::WebSocketHost> host;
   Hub* hub = nullptr;  // the host's endpoint: the network thread's
 };
 
@@ -25,7 +25,7 @@ Result<std::unique_ptr<Server>> Server::start(ServerOptions options) {
       .raise_priority = options.raise_priority};
   auto impl = std::make_unique<Impl>();
   Hub* hub = nullptr;
-  auto host = WebSocketHost::start(
+  auto host = net::WebSocketHost::start(
       {.host = options.host,
        .port = options.port,
        .has_token = !options.token.empty(),

@@ -40,7 +40,7 @@ TEST(ServerMessages, ReadsWhatTheServerWrites) {
   EXPECT_EQ(std::get<InHand>(*in_hands).item, 1);
   EXPECT_EQ(std::get<InHand>(*in_hands).kind, s.table[0].kind);
   EXPECT_EQ(std::get<InHand>(*in_hands).piece,
-            state.items[1].genuine ? museum_artifacts::Piece::genuine : museum_artifacts::Piece::forgery);
+            state.items[1].genuine ? museum::Piece::genuine : museum::Piece::forgery);
 
   const json welcome = {{"type", "welcome"},
                         {"role", "phantom"},

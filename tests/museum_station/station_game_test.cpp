@@ -13,6 +13,7 @@
 
 #include "../museum/test_levels.hpp"
 #include "test_paths.hpp"
+#include "uh/museum_artifacts/artifact.hpp"
 #include "uh/museum_service/game_server.hpp"
 #include "web_socket_test_client.hpp"
 

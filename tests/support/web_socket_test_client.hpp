@@ -1,11 +1,13 @@
 #pragma once
 // A WebSocket client for the tests of servers on the WebSocket host (uh serve, uh museum serve):
-// Boost.Beast on its own io_context over loopback, JSON messages, every wait bounded.
+// uh::net's client over loopback, JSON messages, every wait bounded; and a plain HTTP GET.
 
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -14,7 +16,10 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/system/system_error.hpp>
 #include <nlohmann/json.hpp>
+
+#include "uh/net/web_socket_client.hpp"
 
 namespace uh::test_support {
 
@@ -29,48 +34,37 @@ using namespace std::chrono_literals;
 // Guards against a server that never answers; not a measurement.
 constexpr auto kPatience = 60s;
 
-// A protocol client on its own io_context; every wait is bounded by kPatience.
+// A protocol client: uh::net's WebSocket client on loopback; every wait is bounded by kPatience.
 class Client {
  public:
   explicit Client(std::uint16_t port) {
-    tcp::resolver resolver(io_);
-    asio::connect(ws_.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
-    ws_.handshake("127.0.0.1", "/ws");
+    auto connected =
+        net::WebSocketClient::connect({.host = "127.0.0.1", .port = std::to_string(port), .path = "/ws"},
+                                      {.name = "the test's server", .step_limit = kPatience});
+    if (!connected) throw std::runtime_error(connected.error().message);
+    client_ = std::move(connected).value();
   }
 
   void send(const json& message) { send_text(message.dump()); }
-  void send_text(const std::string& text) {
-    ws_.text(true);
-    ws_.write(asio::buffer(text));
-  }
-  void send_binary(const std::string& bytes) {
-    ws_.binary(true);
-    ws_.write(asio::buffer(bytes));
-  }
+  /// Written before this returns, as a blocking write would; a failed write throws.
+  void send_text(const std::string& text) { write(text, net::WebSocketClient::Frame::text); }
+  void send_binary(const std::string& bytes) { write(bytes, net::WebSocketClient::Frame::binary); }
 
   /// The next message, or an error code when the connection ended.
   std::optional<json> read(beast::error_code* ended = nullptr) {
-    beast::flat_buffer buffer;
-    beast::error_code ec;
-    bool done = false;
-    ws_.async_read(buffer, [&](beast::error_code e, std::size_t) {
-      ec = e;
-      done = true;
-    });
-    io_.restart();
-    io_.run_for(kPatience);
-    if (!done) {
-      ADD_FAILURE() << "no message within the patience limit";
-      ws_.next_layer().close();
-      io_.restart();
-      io_.run();
-      return std::nullopt;
+    std::string text;
+    switch (client_->receive(text, kPatience)) {
+      case net::WebSocketClient::Received::message:
+        return json::parse(text);
+      case net::WebSocketClient::Received::ended:
+        if (ended != nullptr) *ended = client_->error();
+        return std::nullopt;
+      case net::WebSocketClient::Received::nothing:
+        break;
     }
-    if (ec) {
-      if (ended != nullptr) *ended = ec;
-      return std::nullopt;
-    }
-    return json::parse(beast::buffers_to_string(buffer.data()));
+    ADD_FAILURE() << "no message within the patience limit";
+    client_->drop();
+    return std::nullopt;
   }
 
   /// Reads until a message of `type` (others, e.g. state and session events, are skipped).
@@ -98,11 +92,18 @@ class Client {
     return request(h, "welcome");
   }
 
-  websocket::close_reason close_reason() const { return ws_.reason(); }
+  net::CloseReason close_reason() const { return client_->close_reason(); }
 
  private:
-  asio::io_context io_;
-  websocket::stream<tcp::socket> ws_{io_};
+  void write(const std::string& payload, net::WebSocketClient::Frame frame) {
+    client_->send(payload, frame);
+    if (!client_->flush(kPatience)) {
+      if (client_->error()) throw boost::system::system_error(client_->error());
+      ADD_FAILURE() << "a message was not written within the patience limit";
+    }
+  }
+
+  std::unique_ptr<net::WebSocketClient> client_;
 };
 
 // A plain HTTP GET on loopback: status and body.

@@ -20,6 +20,7 @@
 #include "uh/core/result.hpp"
 #include "uh/forcecomp/material.hpp"
 #include "uh/museum/level.hpp"
+#include "uh/museum/piece.hpp"
 
 namespace uh::museum_artifacts {
 
@@ -32,8 +33,8 @@ const char* to_string(ArtifactKind kind);
 /// The kind named `name` ("amphora", ...), or none.
 std::optional<ArtifactKind> artifact_kind(std::string_view name);
 
-enum class Piece : std::uint8_t { genuine, forgery };
-const char* to_string(Piece piece);
+using museum::Piece;  // genuine or forgery (uh/museum/piece.hpp)
+using museum::to_string;
 
 /// How a kind's forgery differs from its genuine piece at a difficulty.
 struct Tell {

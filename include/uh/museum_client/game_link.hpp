@@ -16,6 +16,7 @@
 
 #include "uh/core/result.hpp"
 #include "uh/museum_client/server_messages.hpp"
+#include "uh/net/ws_url.hpp"
 
 namespace uh::museum_client {
 
@@ -71,12 +72,9 @@ class GameLink {
   Welcome welcome_{};
 };
 
-/// HOST, PORT and the WebSocket path from a URL as LinkOptions::url takes it; an error names it.
-struct ServerAddress {
-  std::string host;
-  std::string port;
-  std::string path = "/ws";
-};
+/// HOST, PORT and the WebSocket path from a URL as LinkOptions::url takes it (net::parse_ws_url
+/// in the museum's forms); an error names it.
+using ServerAddress = net::WsUrl;
 Result<ServerAddress> parse_server_url(const std::string& url);
 
 }  // namespace uh::museum_client

@@ -12,8 +12,8 @@
 
 #include "uh/core/result.hpp"
 #include "uh/museum/level.hpp"
+#include "uh/museum/piece.hpp"
 #include "uh/museum/rules.hpp"
-#include "uh/museum_artifacts/artifact.hpp"
 
 namespace uh::museum_client {
 
@@ -71,7 +71,7 @@ struct GameEvent {
 struct InHand {
   int item = -1;
   std::string kind{};
-  museum_artifacts::Piece piece = museum_artifacts::Piece::genuine;
+  museum::Piece piece = museum::Piece::genuine;
 };
 
 /// Where a target's two pieces ended (`kept`, `rejected`, `in_case`, ... as museum::to_string

@@ -19,7 +19,7 @@
 #include "uh/core/result.hpp"
 #include "uh/museum/game_state.hpp"
 #include "uh/museum/level.hpp"
-#include "uh/service/web_socket_host.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 namespace uh::museum_service {
 
@@ -44,7 +44,7 @@ struct GameServerOptions {
   /// With a token: Phantom's seat is held this long [s] after its station dropped out; meanwhile
   /// only a hello with the station's `seat_key` takes it (token holders cannot). 0..3600.
   double seat_hold_s = 60.0;
-  std::vector<service::StaticFile> files{};  ///< the browser client's files, if any
+  std::vector<net::StaticFile> files{};  ///< the browser client's files, if any
 };
 
 class GameServer {

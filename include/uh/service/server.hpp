@@ -7,7 +7,7 @@
 /// client that opened it controls it (edits, start, stop); every other client may watch it (its
 /// scene, meshes, the state stream, contact events). When the controlling client disconnects, its
 /// session stops (zero force at once). The server runs its own network thread (a WebSocketHost,
-/// web_socket_host.hpp); sessions run their own haptic and collision threads.
+/// uh/net/web_socket_host.hpp); sessions run their own haptic and collision threads.
 
 #include <cstdint>
 #include <filesystem>
@@ -20,7 +20,7 @@
 
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/core/result.hpp"
-#include "uh/service/web_socket_host.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 namespace uh::service {
 
@@ -30,7 +30,7 @@ struct ServerOptions {
   std::uint16_t port = 7770;       ///< 0: any free port (see Server::port())
   /// Clients must present it in `hello`; required when `host` is not a loopback address.
   std::string token{};
-  std::vector<StaticFile> files{};      ///< the live view's page and script
+  std::vector<net::StaticFile> files{};  ///< the live view's page and script
   std::filesystem::path cache_dir{};    ///< where .ist builds are cached; empty: the default
   std::filesystem::path working_dir{};  ///< relative paths in requests; empty: the current folder
   bool raise_priority = false;          ///< sessions ask for SCHED_FIFO (as `uh run`)

@@ -1,4 +1,4 @@
-#include "uh/service/web_socket_host.hpp"
+#include "uh/net/web_socket_host.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -23,7 +23,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
-namespace uh::service {
+namespace uh::net {
 namespace {
 
 namespace asio = boost::asio;
@@ -397,4 +397,4 @@ void WebSocketHost::stop() {
   if (impl->thread.joinable()) impl->thread.join();
 }
 
-}  // namespace uh::service
+}  // namespace uh::net

@@ -24,7 +24,7 @@ namespace boost::asio {
 class io_context;
 }
 
-namespace uh::service {
+namespace uh::net {
 
 /// A file served over HTTP at `path` (e.g. "/index.html"). The text must outlive the server.
 struct StaticFile {
@@ -119,4 +119,4 @@ class WebSocketHost {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace uh::service
+}  // namespace uh::net
