@@ -29,15 +29,41 @@ void absolutise(json& holder, const char* key, const std::filesystem::path& dir)
   if (!p.empty() && p.is_relative()) *it = (dir / p).lexically_normal().string();
 }
 
+// Every file `scene` names is one the service may read.
+Status check_scene_files(const controllers::Scene& scene, const ReadableFolders& folders) {
+  if (folders.any_path()) return Ok{};
+  const auto check_shape = [&](const controllers::SceneShape& shape, const std::string& owner) -> Status {
+    if (!shape.mesh.empty())
+      if (Status s = folders.check(shape.mesh, owner + ": mesh"); !s) return s;
+    if (!shape.ist.empty())
+      if (Status s = folders.check(shape.ist, owner + ": ist"); !s) return s;
+    return Ok{};
+  };
+  for (const auto& object : scene.objects)
+    if (Status s = check_shape(object.shape, fmt::format("object '{}'", object.name)); !s) return s;
+  for (const auto& tool : scene.tools) {
+    const std::string owner = fmt::format("tool '{}'", tool.name);
+    if (Status s = check_shape(tool.shape, owner); !s) return s;
+    if (tool.device.config.has("file"))
+      if (Status s = folders.check(tool.device.config.text("file", ""), owner + ": device file"); !s)
+        return s;
+  }
+  return Ok{};
+}
+
 }  // namespace
 
-Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path) {
+Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path,
+                                               const ReadableFolders& folders) {
+  if (Status inside = folders.check(path, "scene"); !inside) return inside.error();
   auto text = controllers::read_scene_file(path);
   if (!text) return text.error();
   // the scene parser names what is wrong; the document is read only once it accepted the text
   auto scene = controllers::parse_scene(*text, path.string(), path.parent_path());
   if (!scene) return scene.error();
+  if (Status inside = check_scene_files(*scene, folders); !inside) return inside.error();
   SceneDocument d;
+  d.folders_ = folders;
   d.doc_ = json::parse(*text);
   d.source_ = path.string();
   d.base_dir_ = path.parent_path();
@@ -45,15 +71,17 @@ Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path
   return d;
 }
 
-Result<SceneDocument> SceneDocument::open_default(const std::filesystem::path& cache_dir) {
+Result<SceneDocument> SceneDocument::open_default(const std::filesystem::path& cache_dir,
+                                                  const ReadableFolders& folders) {
   auto file = controllers::write_default_scene(cache_dir);
   if (!file) return file.error();
-  return open_file(*file);
+  return open_file(*file, folders);
 }
 
 Status SceneDocument::apply(json candidate) {
   auto scene = controllers::parse_scene(candidate.dump(), source_, base_dir_);
   if (!scene) return scene.error();
+  if (Status inside = check_scene_files(*scene, folders_); !inside) return inside;
   doc_ = std::move(candidate);
   scene_ = std::move(scene).value();
   return Ok{};
