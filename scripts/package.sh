@@ -109,7 +109,7 @@ Architecture: $arch
 Maintainer: UnrealHaptics contributors
 Installed-Size: $(du -sk --exclude=DEBIAN "$root" | cut -f1)
 Depends: ${depends}${python:+, $python}
-Recommends: ${dev_recommends}
+Recommends: espeak-ng, ${dev_recommends}
 Section: science
 Priority: optional
 Description: haptic rendering for game engines (Inner Sphere Trees, penalty forces)
