@@ -96,6 +96,9 @@ package_deb() {
     --name "haptic rendering of closed meshes: sphere trees, sessions, the service" \
     "$root/usr/bin/uh" | gzip -9n >"$root/usr/share/man/man1/uh.1.gz"
 
+  # Debian's copyright file (machine-readable, packaging/copyright; docs/licenses.md explains it)
+  install -D -m 644 "$uh_root/packaging/copyright" "$root/usr/share/doc/unrealhaptics/copyright"
+
   mkdir -p "$root/DEBIAN"
   local depends
   depends=$(debian_depends "$root" | sed -n 's/^shlibs:Depends=//p')

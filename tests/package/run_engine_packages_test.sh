@@ -43,6 +43,10 @@ fi
 ldd_out=$(env -u LD_LIBRARY_PATH ldd "$plugins/libuh.so")
 grep -q "libassimp.so.5 => $plugins/libassimp.so.5" <<<"$ldd_out" || fail "libuh.so does not load the packaged assimp: $ldd_out"
 ! grep -q "not found" <<<"$ldd_out" || fail "libuh.so lacks a library: $ldd_out"
+# every library bundled beside libuh is in the licence inventory, for the Unity package
+bash "$source_dir/tests/package/check_licenses.sh" "$source_dir/docs/licenses.md" --bundled unity "$plugins" ||
+  fail "the Unity package bundles a library docs/licenses.md does not list for it"
+[ -d "$package/Licenses~" ] || fail "the tarball has no Licenses~ with its bundled libraries' copyright files"
 
 # the package's managed code, compiled from the tarball, and the console tests against it; mono
 # resolves DllImport("uh") through LD_LIBRARY_PATH: the packaged Plugins/x86_64 only
