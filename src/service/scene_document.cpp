@@ -8,6 +8,7 @@
 #include "uh/collette/ist_file.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "uh/core/atomic_file_writer.hpp"
+#include "uh/core/json_nesting.hpp"
 
 namespace uh::service {
 namespace {
@@ -29,23 +30,28 @@ void absolutise(json& holder, const char* key, const std::filesystem::path& dir)
   if (!p.empty() && p.is_relative()) *it = (dir / p).lexically_normal().string();
 }
 
-// Every file `scene` names is one the service may read.
-Status check_scene_files(const controllers::Scene& scene, const ReadableFolders& folders) {
-  if (folders.any_path()) return Ok{};
-  const auto check_shape = [&](const controllers::SceneShape& shape, const std::string& owner) -> Status {
-    if (!shape.mesh.empty())
-      if (Status s = folders.check(shape.mesh, owner + ": mesh"); !s) return s;
-    if (!shape.ist.empty())
-      if (Status s = folders.check(shape.ist, owner + ": ist"); !s) return s;
-    return Ok{};
-  };
-  for (const auto& object : scene.objects)
-    if (Status s = check_shape(object.shape, fmt::format("object '{}'", object.name)); !s) return s;
-  for (const auto& tool : scene.tools) {
-    const std::string owner = fmt::format("tool '{}'", tool.name);
-    if (Status s = check_shape(tool.shape, owner); !s) return s;
-    if (tool.device.config.has("file"))
-      if (Status s = folders.check(tool.device.config.text("file", ""), owner + ": device file"); !s)
+// Every file a scene document names (a `mesh`, `ist` or device `file` anywhere in it; a relative
+// one is relative to `base_dir`) is one the service may read: checked before the scene parser
+// opens any of them, so that nothing outside the folders is touched, nor its existence told.
+Status check_named_files(const json& node, const std::string& field, const std::filesystem::path& base_dir,
+                         const ReadableFolders& folders) {
+  if (node.is_object()) {
+    for (const auto& [key, value] : node.items()) {
+      const std::string inner = field.empty() ? key : field + "." + key;
+      if ((key == "mesh" || key == "ist" || key == "file") && value.is_string()) {
+        const std::filesystem::path named(value.get<std::string>());
+        if (named.empty()) continue;
+        if (Status s =
+                folders.check(named.is_absolute() ? named : base_dir / named, "field '" + inner + "':");
+            !s)
+          return s;
+      } else if (Status s = check_named_files(value, inner, base_dir, folders); !s) {
+        return s;
+      }
+    }
+  } else if (node.is_array()) {
+    for (std::size_t i = 0; i < node.size(); ++i)
+      if (Status s = check_named_files(node[i], fmt::format("{}[{}]", field, i), base_dir, folders); !s)
         return s;
   }
   return Ok{};
@@ -58,10 +64,17 @@ Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path
   if (Status inside = folders.check(path, "scene"); !inside) return inside.error();
   auto text = controllers::read_scene_file(path);
   if (!text) return text.error();
+  // the files it names, before the parser opens them (a text too deep or not JSON is the parser's
+  // to refuse, with its message)
+  if (!folders.any_path() && json_nesting_depth(*text) <= kMaxJsonNesting) {
+    const json named = json::parse(*text, nullptr, false);
+    if (!named.is_discarded())
+      if (Status inside = check_named_files(named, "", path.parent_path(), folders); !inside)
+        return inside.error();
+  }
   // the scene parser names what is wrong; the document is read only once it accepted the text
   auto scene = controllers::parse_scene(*text, path.string(), path.parent_path());
   if (!scene) return scene.error();
-  if (Status inside = check_scene_files(*scene, folders); !inside) return inside.error();
   SceneDocument d;
   d.folders_ = folders;
   d.doc_ = json::parse(*text);
@@ -79,9 +92,10 @@ Result<SceneDocument> SceneDocument::open_default(const std::filesystem::path& c
 }
 
 Status SceneDocument::apply(json candidate) {
+  if (!folders_.any_path())
+    if (Status inside = check_named_files(candidate, "", base_dir_, folders_); !inside) return inside;
   auto scene = controllers::parse_scene(candidate.dump(), source_, base_dir_);
   if (!scene) return scene.error();
-  if (Status inside = check_scene_files(*scene, folders_); !inside) return inside;
   doc_ = std::move(candidate);
   scene_ = std::move(scene).value();
   return Ok{};

@@ -200,8 +200,8 @@ TEST_F(ServerTest, PathsThatAreNotRegularFilesAreRefusedWithoutStoppingOthers) {
 // A client names files in the server's root folder (ServerOptions::working_dir, `uh serve --root`)
 // and its cache only: a scene, a mesh, an .ist, a device's trajectory outside it, a scene inside
 // that names a mesh outside, a link inside that points outside and /dev/zero are refused before
-// anything is read, named relative to the root; no error shows the root's or the cache's absolute
-// path. With allow_any_path (`--allow-any-path`) the same scene opens.
+// any of them is opened (a missing file outside is refused alike), named relative to the root; no error shows
+// the root's or the cache's absolute path. With allow_any_path (`--allow-any-path`) the same scene opens.
 TEST_F(ServerTest, PathsOutsideTheRootAreRefusedNamedRelativeToIt) {
   const std::filesystem::path outside = testing::scratch("server-outside");
   const std::filesystem::path outside_scene = testing::write_small_scene(outside);
@@ -228,20 +228,23 @@ TEST_F(ServerTest, PathsOutsideTheRootAreRefusedNamedRelativeToIt) {
   refused({{"type", "open"}, {"scene", outside_scene.string()}}, "scene '" + outside_named + "/small.json");
   refused({{"type", "open"}, {"scene", "/dev/zero"}}, "scene '../../dev/zero");
   const std::string far_bunny = outside_named + "/meshes/bunny_npm_3674.obj";
-  refused({{"type", "open"}, {"scene", "reaching.json"}}, "object 'bunny': mesh '" + far_bunny);
+  refused({{"type", "open"}, {"scene", "reaching.json"}}, "field 'objects[0].mesh': '" + far_bunny);
   c.request({{"type", "open"}, {"scene", scene_.filename().string()}}, "opened");
   const json mesh = {{"name", "far"}, {"mesh", outside_mesh}, {"spheres", 100}, {"meters_per_unit", 0.01}};
-  refused({{"type", "add_object"}, {"object", mesh}}, "object 'far': mesh '" + far_bunny);
+  refused({{"type", "add_object"}, {"object", mesh}}, "field 'objects[1].mesh': '" + far_bunny);
   refused(
       {{"type", "add_object"},
        {"object", {{"name", "up"}, {"mesh", "../" + outside.filename().string() + "/meshes/stylus.obj"}}}},
-      "object 'up': mesh '" + outside_named + "/meshes/stylus.obj");
+      "field 'objects[1].mesh': '" + outside_named + "/meshes/stylus.obj");
   refused({{"type", "add_object"}, {"object", {{"name", "link"}, {"mesh", "link.obj"}}}},
-          "object 'link': mesh '" + far_bunny);
-  refused({{"type", "set_tool"}, {"tool", {{"mesh", outside_mesh}}}}, "tool 'stylus': mesh '" + far_bunny);
+          "field 'objects[1].mesh': '" + far_bunny);
+  // a file outside that does not exist is refused the same way: nothing tells what is there
+  refused({{"type", "add_object"}, {"object", {{"name", "tree"}, {"ist", (outside / "none.ist").string()}}}},
+          "field 'objects[1].ist': '" + outside_named + "/none.ist");
+  refused({{"type", "set_tool"}, {"tool", {{"mesh", outside_mesh}}}}, "field 'tool.mesh': '" + far_bunny);
   refused({{"type", "set_device"},
            {"device", {{"driver", "sim-replay"}, {"config", {{"file", (outside / "moves.csv").string()}}}}}},
-          "tool 'stylus': device file '" + outside_named + "/moves.csv");
+          "field 'tool.device.config.file': '" + outside_named + "/moves.csv");
   // a file inside, missing: named relative to the root, without the root's path
   const std::string missing = c.request(
       {{"type", "add_object"}, {"object", {{"name", "gone"}, {"mesh", "gone.obj"}}}}, "error")["message"];
