@@ -130,6 +130,8 @@ package_windows() {
   DESTDIR="$root" cmake --install "$windows_dir" --prefix "/$name" >/dev/null
   mkdir -p "$root/$name/doc"
   cp "$uh_root/docs/capi.md" "$root/$name/doc/"
+  cp "$uh_root/LICENSE" "$root/$name/"
+  cp "$uh_root/docs/licenses.md" "$root/$name/doc/"
   (cd "$root" && zip -qrX "$out/$name.zip" "$name")
 }
 
@@ -182,6 +184,9 @@ package_unity() {
   echo "== $name =="
   mkdir -p "$root/Plugins/x86_64"
   cp "$uh_root/engines/unity/package.json" "$uh_root/engines/unity/README.md" "$root/"
+  # the licence and the third-party notices, under the names Unity's package layout gives them
+  cp "$uh_root/LICENSE" "$root/LICENSE.md"
+  cp "$uh_root/docs/licenses.md" "$root/Third Party Notices.md"
   cp -r "$uh_root/engines/unity/Runtime" "$root/"
   UH_PLUGIN_DIR="$staged" bash "$uh_root/engines/unreal/UnrealHaptics/stage-libuh.sh" "$build_dir" /nonexistent >/dev/null
   local lib="$staged/Source/ThirdParty/UhLibrary/lib/Linux"
@@ -203,6 +208,8 @@ package_godot() {
   echo "== $name =="
   mkdir -p "$root/addons"
   cp -r "$uh_root/engines/godot/addons/unrealhaptics" "$root/addons/"
+  cp "$uh_root/LICENSE" "$root/addons/unrealhaptics/LICENSE"
+  cp "$uh_root/docs/licenses.md" "$root/addons/unrealhaptics/THIRD_PARTY_NOTICES.md"
   mkdir -p "$root/addons/unrealhaptics/bin"
   cp "$build_dir/apps/uh/uh" "$root/addons/unrealhaptics/bin/uh"
   (cd "$root" && zip -qrX "$out/$name" addons)

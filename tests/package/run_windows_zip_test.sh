@@ -16,7 +16,7 @@ bash "$source_dir/scripts/package.sh" --windows-only --windows-build-dir "$build
 name="unrealhaptics-$version-windows-x64"
 (cd "$work/dist" && sha256sum --check --quiet SHA256SUMS) || fail "SHA256SUMS does not match"
 (cd "$work" && unzip -q "dist/$name.zip")
-for f in bin/uh.dll lib/libuh.dll.a include/uh/uh.h doc/capi.md; do
+for f in bin/uh.dll lib/libuh.dll.a include/uh/uh.h doc/capi.md LICENSE doc/licenses.md; do
   [ -f "$work/$name/$f" ] || fail "the zip has no $f"
 done
 # the DLLs uh.dll imports are in the licence inventory
