@@ -1,6 +1,7 @@
 #include "uh/core/regular_file.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <system_error>
 
 #include <fmt/format.h>
@@ -133,10 +134,20 @@ std::string ReadableFolders::shown(std::string message) const {
   std::sort(longest_first.begin(), longest_first.end(), [](const ReadableFolder* a, const ReadableFolder* b) {
     return a->path.native().size() > b->path.native().size();
   });
+  // `from` where a path ends there (not /srv/data in /srv/data-old) replaced by `to`
   const auto replace_all = [&message](const std::string& from, const std::string& to) {
-    for (std::size_t at = message.find(from); at != std::string::npos;
-         at = message.find(from, at + to.size()))
+    for (std::size_t at = message.find(from); at != std::string::npos; at = message.find(from, at)) {
+      const std::size_t end = at + from.size();
+      const bool name_goes_on = from.back() != '/' && end < message.size() &&
+                                (std::isalnum(static_cast<unsigned char>(message[end])) != 0 ||
+                                 std::string_view("._-").find(message[end]) != std::string_view::npos);
+      if (name_goes_on) {
+        at = end;
+        continue;
+      }
       message.replace(at, from.size(), to);
+      at += to.size();
+    }
   };
   for (const ReadableFolder* f : longest_first) {
     // a file in the folder, then the folder itself

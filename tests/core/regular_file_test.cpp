@@ -96,6 +96,9 @@ TEST_F(RegularFileTest, ReadableFoldersHoldWhatIsInsideAfterLinksAndDots) {
                                       (cache / "x.ist").string())),
             "m.obj: is a directory; <cache>/x.ist: bad");
   EXPECT_EQ(folders.shown(root.string() + ": is a directory"), ".: is a directory");
+  EXPECT_EQ(folders.shown((sibling / "x.obj").string() + " and " + root.string()),
+            (sibling / "x.obj").string() + " and .")
+      << "a folder whose name starts with the root's is not the root";
 }
 
 TEST(JsonNesting, CountsArraysAndObjectsButNotBracketsInStrings) {
