@@ -23,9 +23,8 @@ if(NOT TARGET uh_readerwriterqueue)
 endif()
 
 if(UH_BUILD_AUDIO)
+  # speech runs the espeak-ng program (GPL-3) at run time; nothing links its library
   find_package(OpenAL REQUIRED)
-  find_package(PkgConfig REQUIRED)
-  pkg_check_modules(ESPEAK_NG REQUIRED IMPORTED_TARGET espeak-ng)
 endif()
 if(UH_BUILD_APPS)
   find_package(CLI11 REQUIRED)

@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libassimp-dev libpng-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libreaderwriterqueue-dev
   libfcl-dev libbullet-dev libcairo2-dev
-  libopenal-dev libespeak-ng-dev  # uh::audio: the blind player's sound (HRTF data in libopenal-data)
+  libopenal-dev espeak-ng  # uh::audio: the blind player's sound (HRTF data in libopenal-data), speech from the espeak-ng program
   libboost-dev chromium python3-websockets
   clang libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy python3-pytest

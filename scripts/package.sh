@@ -96,6 +96,9 @@ package_deb() {
     --name "haptic rendering of closed meshes: sphere trees, sessions, the service" \
     "$root/usr/bin/uh" | gzip -9n >"$root/usr/share/man/man1/uh.1.gz"
 
+  # Debian's copyright file (machine-readable, packaging/copyright; docs/licenses.md explains it)
+  install -D -m 644 "$uh_root/packaging/copyright" "$root/usr/share/doc/unrealhaptics/copyright"
+
   mkdir -p "$root/DEBIAN"
   local depends
   depends=$(debian_depends "$root" | sed -n 's/^shlibs:Depends=//p')
@@ -109,7 +112,7 @@ Architecture: $arch
 Maintainer: UnrealHaptics contributors
 Installed-Size: $(du -sk --exclude=DEBIAN "$root" | cut -f1)
 Depends: ${depends}${python:+, $python}
-Recommends: ${dev_recommends}
+Recommends: espeak-ng, ${dev_recommends}
 Section: science
 Priority: optional
 Description: haptic rendering for game engines (Inner Sphere Trees, penalty forces)
@@ -127,6 +130,8 @@ package_windows() {
   DESTDIR="$root" cmake --install "$windows_dir" --prefix "/$name" >/dev/null
   mkdir -p "$root/$name/doc"
   cp "$uh_root/docs/capi.md" "$root/$name/doc/"
+  cp "$uh_root/LICENSE" "$root/$name/"
+  cp "$uh_root/docs/licenses.md" "$root/$name/doc/"
   (cd "$root" && zip -qrX "$out/$name.zip" "$name")
 }
 
@@ -179,6 +184,9 @@ package_unity() {
   echo "== $name =="
   mkdir -p "$root/Plugins/x86_64"
   cp "$uh_root/engines/unity/package.json" "$uh_root/engines/unity/README.md" "$root/"
+  # the licence and the third-party notices, under the names Unity's package layout gives them
+  cp "$uh_root/LICENSE" "$root/LICENSE.md"
+  cp "$uh_root/docs/licenses.md" "$root/Third Party Notices.md"
   cp -r "$uh_root/engines/unity/Runtime" "$root/"
   UH_PLUGIN_DIR="$staged" bash "$uh_root/engines/unreal/UnrealHaptics/stage-libuh.sh" "$build_dir" /nonexistent >/dev/null
   local lib="$staged/Source/ThirdParty/UhLibrary/lib/Linux"
@@ -200,6 +208,8 @@ package_godot() {
   echo "== $name =="
   mkdir -p "$root/addons"
   cp -r "$uh_root/engines/godot/addons/unrealhaptics" "$root/addons/"
+  cp "$uh_root/LICENSE" "$root/addons/unrealhaptics/LICENSE"
+  cp "$uh_root/docs/licenses.md" "$root/addons/unrealhaptics/THIRD_PARTY_NOTICES.md"
   mkdir -p "$root/addons/unrealhaptics/bin"
   cp "$build_dir/apps/uh/uh" "$root/addons/unrealhaptics/bin/uh"
   (cd "$root" && zip -qrX "$out/$name" addons)

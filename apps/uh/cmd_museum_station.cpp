@@ -17,6 +17,7 @@
 
 #include "commands.hpp"
 #include "progress_bar.hpp"
+#include "stop_signals.hpp"
 #include "uh/museum_client/game_link.hpp"
 #include "uh/museum_station/station.hpp"
 
@@ -33,8 +34,11 @@ struct StationArgs {
   bool no_sound = false;
 };
 
+// the first stop signal (stop_signals.hpp) names the stop; the loop below takes it to the zero force
 volatile std::sig_atomic_t g_station_signal = 0;
-extern "C" void on_station_signal(int signal_number) { g_station_signal = signal_number; }
+extern "C" void on_station_signal(int signal_number) {
+  if (g_station_signal == 0) g_station_signal = signal_number;
+}
 
 // The terminal in raw mode (keys without Enter, no echo; Ctrl-C still stops), restored on exit.
 class RawTerminal {
@@ -119,15 +123,9 @@ int museum_station_run(const StationArgs& args) {
               (*station)->sound() != nullptr ? ", with sound" : "", kKeysHelp);
   std::fflush(stdout);
 
-  struct sigaction action {};
-  action.sa_handler = &on_station_signal;
-  sigemptyset(&action.sa_mask);
-  struct sigaction previous_int {
-  }, previous_term{};
-  sigaction(SIGINT, &action, &previous_int);
-  sigaction(SIGTERM, &action, &previous_term);
   int code = 0;
   {
+    const ScopedStopHandlers stop_handlers(&on_station_signal);
     const RawTerminal terminal;
     bool input_open = true;
     auto last = std::chrono::steady_clock::now();
@@ -183,12 +181,10 @@ int museum_station_run(const StationArgs& args) {
     }
     (*station)->stop();
   }
-  sigaction(SIGINT, &previous_int, nullptr);
-  sigaction(SIGTERM, &previous_term, nullptr);
   (*link)->stop();
   if (code != 0)
     std::fprintf(stderr, "uh: stopped by %s; the device was sent zero force\n",
-                 code == 128 + SIGINT ? "SIGINT" : "SIGTERM");
+                 signal_name(code - 128).c_str());
   return code;
 }
 

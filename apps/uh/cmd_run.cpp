@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "progress_bar.hpp"
 #include "session_plot.hpp"
+#include "stop_signals.hpp"
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/atomic_file_writer.hpp"
@@ -27,13 +28,9 @@
 namespace uh::cli {
 namespace {
 
-// Every way a terminal, a shell or a pipe ends a run: SIGINT (Ctrl-C), SIGTERM, SIGHUP (the
-// terminal or SSH session closed), SIGQUIT and SIGPIPE (the reader of stdout went away). The handler
-// only records the signal and asks the session to stop (a sig_atomic_t store and one lock-free
-// atomic store, both async-signal-safe); the run then ends as if its time were up: zero force,
-// threads joined, trace renamed into place, summary printed, exit status 128 + signal.
-constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE};
-
+// The handler only records the signal and asks the session to stop (a sig_atomic_t store and one
+// lock-free atomic store, both async-signal-safe); the run then ends as if its time were up: zero
+// force, threads joined, trace renamed into place, summary printed, exit status 128 + signal.
 volatile std::sig_atomic_t g_stop_signal = 0;
 std::atomic<controllers::HapticSession*> g_running_session{nullptr};
 static_assert(std::atomic<controllers::HapticSession*>::is_always_lock_free);
@@ -44,37 +41,21 @@ extern "C" void on_stop_signal(int signal_number) {
   if (controllers::HapticSession* session = g_running_session.load()) session->request_stop();
 }
 
-// "SIGHUP" for SIGHUP (glibc's abbreviation, as the kernel's headers name it)
-std::string signal_name(int signal_number) {
-  const char* abbreviation = sigabbrev_np(signal_number);
-  return abbreviation != nullptr ? std::string("SIG") + abbreviation : std::string("a signal");
-}
-
-// Routes the stop signals to `session` while it lives; restores the previous handlers after,
-// except SIGPIPE, which stays ignored: the summary written to a closed pipe fails quietly instead of
-// ending the program before its exit status.
+// Routes the stop signals (stop_signals.hpp) to `session` while it lives.
 class StopOnSignals {
  public:
-  explicit StopOnSignals(controllers::HapticSession& session) {
-    g_running_session.store(&session);
-    struct sigaction action {};
-    action.sa_handler = &on_stop_signal;
-    sigemptyset(&action.sa_mask);
-    for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
-      sigaction(kStopSignals[i], &action, &previous_[i]);
-  }
-  ~StopOnSignals() {
-    for (std::size_t i = 0; i < std::size(kStopSignals); ++i) {
-      if (kStopSignals[i] == SIGPIPE) previous_[i].sa_handler = SIG_IGN;
-      sigaction(kStopSignals[i], &previous_[i], nullptr);
-    }
-    g_running_session.store(nullptr);
-  }
+  explicit StopOnSignals(controllers::HapticSession& session)
+      : session_(&session), handlers_(&on_stop_signal) {}
+  ~StopOnSignals() { g_running_session.store(nullptr); }
   StopOnSignals(const StopOnSignals&) = delete;
   StopOnSignals& operator=(const StopOnSignals&) = delete;
 
  private:
-  struct sigaction previous_[std::size(kStopSignals)]{};
+  // set before the handlers are installed: a signal that comes at once already stops the session
+  struct Registered {
+    explicit Registered(controllers::HapticSession* session) { g_running_session.store(session); }
+  } session_;
+  ScopedStopHandlers handlers_;
 };
 
 struct RunArgs {

@@ -1,6 +1,7 @@
-// uh serve [--host 127.0.0.1] [--port 7770] [--token T] [--no-realtime]
+// uh serve [--host 127.0.0.1] [--port 7770] [--token T] [--root DIR] [--allow-any-path] [--no-realtime]
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include <fmt/format.h>
@@ -16,17 +17,22 @@ struct ServeArgs {
   std::string host = "127.0.0.1";
   int port = 7770;
   std::string token;
+  std::string root;
+  bool allow_any_path = false;
   bool no_realtime = false;
 };
 
 int serve(const ServeArgs& args) {
   const sigset_t stop_signals = block_stop_signals();
 
-  auto server = service::Server::start({.host = args.host,
-                                        .port = static_cast<std::uint16_t>(args.port),
-                                        .token = args.token,
-                                        .files = view::static_files(),
-                                        .raise_priority = !args.no_realtime});
+  auto server = service::Server::start(
+      {.host = args.host,
+       .port = static_cast<std::uint16_t>(args.port),
+       .token = args.token,
+       .files = view::static_files(),
+       .working_dir = args.root.empty() ? std::filesystem::path{} : std::filesystem::absolute(args.root),
+       .allow_any_path = args.allow_any_path,
+       .raise_priority = !args.no_realtime});
   if (!server) {
     const std::string& m = server.error().message;
     return fail(m.find("token is required") != std::string::npos ? m + " (give --token)" : m);
@@ -70,6 +76,13 @@ void add_serve_command(CLI::App& app, CommandRunner& runner) {
       ->default_val(7770)
       ->check(CLI::Range(0, 65535));
   s->add_option("--token", args.token, "clients must send this token in their hello");
+  s->add_option(
+       "--root", args.root,
+       "the folder clients name files in (relative paths start there); they may name files in it and "
+       "in the cache only (default: the working folder)")
+      ->check(CLI::ExistingDirectory);
+  s->add_flag("--allow-any-path", args.allow_any_path,
+              "let clients name any file this user can read, outside --root and the cache");
   s->add_flag("--no-realtime", args.no_realtime,
               "do not ask for SCHED_FIFO for the sessions' haptic and collision threads");
   s->callback([&runner] { runner = [] { return serve(args); }; });

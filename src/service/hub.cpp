@@ -96,11 +96,10 @@ void Hub::receive(ClientId id, std::string_view text) {
     // the announced frame did not come: that add_object fails, this message is read as usual
     const auto pending = std::exchange(c.pending_mesh, std::nullopt);
     if (pending->add)
-      c.peer->send(
-          error_reply(pending->req_id, "add_object",
-                      fmt::format("{}: its mesh_binary frame ({} bytes) must be the next message, but "
-                                  "a text message came; the object was not added",
-                                  add_object_label(*pending->add), pending->add->mesh_binary->bytes())));
+      c.peer->send(refusal(pending->req_id, "add_object",
+                           fmt::format("{}: its mesh_binary frame ({} bytes) must be the next message, but "
+                                       "a text message came; the object was not added",
+                                       add_object_label(*pending->add), pending->add->mesh_binary->bytes())));
   }
   if (!c.greeted && ++c.messages_before_hello > kMaxMessagesBeforeHello) {
     c.closing = true;
@@ -109,17 +108,17 @@ void Hub::receive(ClientId id, std::string_view text) {
   }
   ParsedRequest req = parse_request(text);
   if (req.announces_binary) {
-    if (auto e = on_announce_mesh(id, c, req); !e.empty()) c.peer->send(error_reply(req.id, req.type, e));
+    if (auto e = on_announce_mesh(id, c, req); !e.empty()) c.peer->send(refusal(req.id, req.type, e));
     return;
   }
   if (!req.body) {
-    c.peer->send(error_reply(req.id, req.type, req.error));
+    c.peer->send(refusal(req.id, req.type, req.error));
     return;
   }
   if (!c.greeted && !std::holds_alternative<Hello>(*req.body)) {
-    c.peer->send(error_reply(
-        req.id, req.type,
-        fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{}}}", kProtocolVersion)));
+    c.peer->send(
+        refusal(req.id, req.type,
+                fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{}}}", kProtocolVersion)));
     return;
   }
   handle(id, c, req.id, req.type, *req.body);
@@ -155,15 +154,15 @@ void Hub::receive_binary(ClientId id, std::span<const std::byte> bytes) {
   Client& c = it->second;
   if (c.closing) return;
   if (!c.pending_mesh) {
-    c.peer->send(error_reply(nullptr, "",
-                             "a binary frame must follow an add_object that announces it with "
-                             "\"mesh_binary\"; none did, so this frame was dropped"));
+    c.peer->send(refusal(nullptr, "",
+                         "a binary frame must follow an add_object that announces it with "
+                         "\"mesh_binary\"; none did, so this frame was dropped"));
     return;
   }
   const auto pending = std::exchange(c.pending_mesh, std::nullopt);
   if (!pending->add) return;  // its request was refused, and said so
   if (auto e = on_mesh_frame(id, *pending, bytes); !e.empty())
-    send_to(id, error_reply(pending->req_id, "add_object", e));
+    send_to(id, refusal(pending->req_id, "add_object", e));
 }
 
 std::string Hub::on_mesh_frame(ClientId id, const Client::PendingMesh& pending,
@@ -199,7 +198,7 @@ void Hub::mesh_written(std::uint64_t generation, ClientId id, const Client::Pend
     return;
   }
   if (!written) {
-    send_to(id, error_reply(pending.req_id, "add_object", written.error().message));
+    send_to(id, refusal(pending.req_id, "add_object", written.error().message));
     return;
   }
   // the slot was closed or replaced, or the session started, while the mesh was checked
@@ -216,7 +215,7 @@ void Hub::mesh_written(std::uint64_t generation, ClientId id, const Client::Pend
     remove_inline_mesh(written->file, options_.cache_dir);
   }
   if (!refused.empty()) {
-    send_to(id, error_reply(pending.req_id, "add_object", refused));
+    send_to(id, refusal(pending.req_id, "add_object", refused));
     return;
   }
   const collette::MeshReport& report = written->report;
@@ -268,7 +267,7 @@ void Hub::handle(ClientId id, Client& c, const json& req_id, const std::string& 
   } else {
     error = on_edit(id, req_id, type, body);
   }
-  if (!error.empty()) c.peer->send(error_reply(req_id, type, error));
+  if (!error.empty()) c.peer->send(refusal(req_id, type, error));
 }
 
 std::string Hub::on_get_mesh(ClientId, Client& c, const json& req_id, const GetMesh& g) {
@@ -303,9 +302,9 @@ std::string Hub::on_hello(ClientId, Client& c, const json& req_id, const Hello& 
     // once per connection: the connection ends here
     log::warn("uh serve: {}: hello {}; the connection is closed", c.peer->address(),
               h.token.empty() ? "without the token" : "with a wrong token");
-    c.peer->send(error_reply(
-        req_id, "hello",
-        h.token.empty() ? "this service needs a token: send hello with \"token\"" : "wrong token"));
+    c.peer->send(
+        refusal(req_id, "hello",
+                h.token.empty() ? "this service needs a token: send hello with \"token\"" : "wrong token"));
     c.closing = true;
     c.peer->close(1008, "wrong or missing token");
     return {};
@@ -336,14 +335,21 @@ std::string Hub::check_control(ClientId id, bool needs_open) const {
   return {};
 }
 
+// every error a client is sent names files relative to the service's root, never where the
+// server keeps them
+std::string Hub::refusal(const json& id, std::string_view request_type, std::string_view message) const {
+  return error_reply(id, request_type, options_.folders.shown(std::string(message)));
+}
+
 std::string Hub::on_open(ClientId id, const json& req_id, const Open& o) {
   if (auto e = check_control(id, false); !e.empty()) return e;
   if (slot_ && slot_->phase != Phase::kOpen)
     return "the session is running; stop it before opening another scene";
   auto document = o.scene ? SceneDocument::open_file(std::filesystem::path(*o.scene).is_absolute()
                                                          ? std::filesystem::path(*o.scene)
-                                                         : options_.working_dir / *o.scene)
-                          : SceneDocument::open_default(options_.cache_dir);
+                                                         : options_.working_dir / *o.scene,
+                                                     options_.folders)
+                          : SceneDocument::open_default(options_.cache_dir, options_.folders);
   if (!document) return document.error().message;
   ++generation_;
   slot_.emplace();
@@ -388,7 +394,7 @@ void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<contro
   const json start_id = slot_->start_id;
   if (!built) {
     slot_->phase = Phase::kOpen;
-    send_to(controller, error_reply(start_id, "start", built.error().message));
+    send_to(controller, refusal(start_id, "start", built.error().message));
     broadcast_session("open");
     return;
   }
@@ -396,7 +402,7 @@ void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<contro
   if (auto started = slot_->owned->start(); !started) {
     slot_->owned.reset();
     slot_->phase = Phase::kOpen;
-    send_to(controller, error_reply(start_id, "start", started.error().message));
+    send_to(controller, refusal(start_id, "start", started.error().message));
     broadcast_session("open");
     return;
   }

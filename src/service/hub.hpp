@@ -32,6 +32,8 @@ struct HubOptions {
   std::string token;
   std::filesystem::path cache_dir;
   std::filesystem::path working_dir;
+  /// What clients may name: the working folder and the cache, or any path (ServerOptions).
+  ReadableFolders folders;
   bool raise_priority = false;
 };
 
@@ -61,6 +63,9 @@ class Hub final : public Endpoint {
   void shutdown() override;
 
  private:
+  // error_reply() with the message's paths as the client may see them (HubOptions::folders)
+  std::string refusal(const nlohmann::json& id, std::string_view request_type,
+                      std::string_view message) const;
   struct Client {
     Peer* peer = nullptr;
     bool greeted = false;

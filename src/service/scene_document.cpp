@@ -8,6 +8,7 @@
 #include "uh/collette/ist_file.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "uh/core/atomic_file_writer.hpp"
+#include "uh/core/json_nesting.hpp"
 
 namespace uh::service {
 namespace {
@@ -29,15 +30,53 @@ void absolutise(json& holder, const char* key, const std::filesystem::path& dir)
   if (!p.empty() && p.is_relative()) *it = (dir / p).lexically_normal().string();
 }
 
+// Every file a scene document names (a `mesh`, `ist` or device `file` anywhere in it; a relative
+// one is relative to `base_dir`) is one the service may read: checked before the scene parser
+// opens any of them, so that nothing outside the folders is touched, nor its existence told.
+Status check_named_files(const json& node, const std::string& field, const std::filesystem::path& base_dir,
+                         const ReadableFolders& folders) {
+  if (node.is_object()) {
+    for (const auto& [key, value] : node.items()) {
+      const std::string inner = field.empty() ? key : field + "." + key;
+      if ((key == "mesh" || key == "ist" || key == "file") && value.is_string()) {
+        const std::filesystem::path named(value.get<std::string>());
+        if (named.empty()) continue;
+        if (Status s =
+                folders.check(named.is_absolute() ? named : base_dir / named, "field '" + inner + "':");
+            !s)
+          return s;
+      } else if (Status s = check_named_files(value, inner, base_dir, folders); !s) {
+        return s;
+      }
+    }
+  } else if (node.is_array()) {
+    for (std::size_t i = 0; i < node.size(); ++i)
+      if (Status s = check_named_files(node[i], fmt::format("{}[{}]", field, i), base_dir, folders); !s)
+        return s;
+  }
+  return Ok{};
+}
+
 }  // namespace
 
-Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path) {
+Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path,
+                                               const ReadableFolders& folders) {
+  if (Status inside = folders.check(path, "scene"); !inside) return inside.error();
   auto text = controllers::read_scene_file(path);
   if (!text) return text.error();
+  // the files it names, before the parser opens them (a text too deep or not JSON is the parser's
+  // to refuse, with its message)
+  if (!folders.any_path() && json_nesting_depth(*text) <= kMaxJsonNesting) {
+    const json named = json::parse(*text, nullptr, false);
+    if (!named.is_discarded())
+      if (Status inside = check_named_files(named, "", path.parent_path(), folders); !inside)
+        return inside.error();
+  }
   // the scene parser names what is wrong; the document is read only once it accepted the text
   auto scene = controllers::parse_scene(*text, path.string(), path.parent_path());
   if (!scene) return scene.error();
   SceneDocument d;
+  d.folders_ = folders;
   d.doc_ = json::parse(*text);
   d.source_ = path.string();
   d.base_dir_ = path.parent_path();
@@ -45,13 +84,16 @@ Result<SceneDocument> SceneDocument::open_file(const std::filesystem::path& path
   return d;
 }
 
-Result<SceneDocument> SceneDocument::open_default(const std::filesystem::path& cache_dir) {
+Result<SceneDocument> SceneDocument::open_default(const std::filesystem::path& cache_dir,
+                                                  const ReadableFolders& folders) {
   auto file = controllers::write_default_scene(cache_dir);
   if (!file) return file.error();
-  return open_file(*file);
+  return open_file(*file, folders);
 }
 
 Status SceneDocument::apply(json candidate) {
+  if (!folders_.any_path())
+    if (Status inside = check_named_files(candidate, "", base_dir_, folders_); !inside) return inside;
   auto scene = controllers::parse_scene(candidate.dump(), source_, base_dir_);
   if (!scene) return scene.error();
   doc_ = std::move(candidate);

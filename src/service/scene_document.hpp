@@ -13,16 +13,21 @@
 
 #include "uh/collette/triangle_mesh.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/core/regular_file.hpp"
 #include "uh/core/result.hpp"
 
 namespace uh::service {
 
 class SceneDocument {
  public:
-  /// A scene file; relative paths inside it are relative to its folder.
-  static Result<SceneDocument> open_file(const std::filesystem::path& path);
+  /// A scene file; relative paths inside it are relative to its folder. The scene file and every
+  /// file the scene names (meshes, .ist files, a device's `file`), now and after each edit, must be
+  /// in `folders`: an edit naming another is refused.
+  static Result<SceneDocument> open_file(const std::filesystem::path& path,
+                                         const ReadableFolders& folders = {});
   /// The embedded default scene (written into `cache_dir`).
-  static Result<SceneDocument> open_default(const std::filesystem::path& cache_dir);
+  static Result<SceneDocument> open_default(const std::filesystem::path& cache_dir,
+                                            const ReadableFolders& folders = {});
 
   const controllers::Scene& scene() const { return scene_; }
 
@@ -49,6 +54,7 @@ class SceneDocument {
   nlohmann::json* find_object(nlohmann::json& doc, const std::string& name);
 
   nlohmann::json doc_;
+  ReadableFolders folders_;
   std::string source_;
   std::filesystem::path base_dir_;
   controllers::Scene scene_;

@@ -22,7 +22,11 @@ Result<std::unique_ptr<Server>> Server::start(ServerOptions options) {
       .token = options.token,
       .cache_dir = options.cache_dir.empty() ? controllers::default_cache_dir() : options.cache_dir,
       .working_dir = options.working_dir.empty() ? std::filesystem::current_path() : options.working_dir,
+      .folders = {},
       .raise_priority = options.raise_priority};
+  if (!options.allow_any_path)
+    hub_options.folders = ReadableFolders({{.path = hub_options.working_dir, .label = ""},
+                                           {.path = hub_options.cache_dir, .label = "<cache>"}});
   auto impl = std::make_unique<Impl>();
   Hub* hub = nullptr;
   auto host = net::WebSocketHost::start(

@@ -109,7 +109,8 @@ TEST_F(HostileTest, RunRefusesPathsThatAreNotRegularFiles) {
 // running session, no close for its clients. It stops as on SIGINT now.
 TEST_F(HostileTest, ServeStopsItsSessionAndClosesClientsOnSighup) {
   const fs::path scene = write_scene((fs::path(UH_TEST_DATA_DIR) / "meshes" / "bunny_npm_3674.obj").string());
-  auto serve = uh({"serve", "--port", "0", "--no-realtime"}, "serve");
+  // the scene's meshes are in the repository, outside the server's folders
+  auto serve = uh({"serve", "--port", "0", "--no-realtime", "--allow-any-path"}, "serve");
   const std::uint16_t port = wait_for_port(*serve, "listening on ws://127.0.0.1:");
   ASSERT_NE(port, 0) << serve->out() << serve->err();
   Client c(port);
@@ -128,6 +129,42 @@ TEST_F(HostileTest, ServeStopsItsSessionAndClosesClientsOnSighup) {
   ASSERT_TRUE(finished.exited) << "uh serve ended by the signal itself";
   EXPECT_EQ(finished.code, 0);
   EXPECT_NE(serve->out().find("uh serve: stopped"), std::string::npos) << serve->out();
+}
+
+// `uh serve` read any file a client named (a scene, a mesh, /etc/shadow as a scene). With --root
+// it reads only from that folder and its cache: a scene outside is refused, named relative to the
+// root; a relative path starts at the root; --allow-any-path lifts the limit.
+TEST_F(HostileTest, ServeReadsOnlyFromItsRootUnlessAllowedAnyPath) {
+  const fs::path root = dir_ / "root";
+  fs::create_directories(root);
+  const fs::path outside =
+      write_scene((fs::path(UH_TEST_DATA_DIR) / "meshes" / "bunny_npm_3674.obj").string());
+  auto serve = uh({"serve", "--port", "0", "--no-realtime", "--root", root.string()}, "serve-root");
+  const std::uint16_t port = wait_for_port(*serve, "listening on ws://127.0.0.1:");
+  ASSERT_NE(port, 0) << serve->out() << serve->err();
+  {
+    Client c(port);
+    c.hello();
+    const std::string refused =
+        c.request({{"type", "open"}, {"scene", outside.string()}}, "error")["message"];
+    EXPECT_EQ(refused,
+              "scene '../scene.json' is outside the folders this server reads from (its root and its cache)");
+    const std::string missing = c.request({{"type", "open"}, {"scene", "here.json"}}, "error")["message"];
+    EXPECT_EQ(missing.find(root.string()), std::string::npos) << missing;
+    EXPECT_NE(missing.find("here.json: cannot open the scene file"), std::string::npos) << missing;
+  }
+  ASSERT_TRUE(serve->signal(SIGTERM));
+  ASSERT_TRUE(serve->wait(60s).exited);
+
+  auto any =
+      uh({"serve", "--port", "0", "--no-realtime", "--root", root.string(), "--allow-any-path"}, "serve-any");
+  const std::uint16_t any_port = wait_for_port(*any, "listening on ws://127.0.0.1:");
+  ASSERT_NE(any_port, 0) << any->out() << any->err();
+  Client c(any_port);
+  c.hello();
+  c.request({{"type", "open"}, {"scene", outside.string()}}, "opened");
+  ASSERT_TRUE(any->signal(SIGTERM));
+  ASSERT_TRUE(any->wait(60s).exited);
 }
 
 // `uh museum serve --token`: one socket guessed 24,000 tokens in 3 s, each guess logged, and text a

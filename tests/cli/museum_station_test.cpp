@@ -2,8 +2,9 @@
 // ten times the clock), the station with the simulated hand and a trace, and the sighted bot as
 // Vive (`uh museum play --bot vive`), which brings a piece to Phantom's table. Once the piece is in
 // the station's hands and pressed on:
-// - SIGINT or SIGTERM stop the station with 128 + the signal number, the last force its device was
-//   sent is zero, and the server logs that Phantom dropped out and pauses the round;
+// - SIGINT, SIGTERM, SIGHUP, SIGQUIT or SIGPIPE stop the station with 128 + the signal number, the
+//   last force its device was sent is zero, and the server logs that Phantom dropped out and
+//   pauses the round;
 // - a dropped connection (a relay between the station and the server cut) takes the force to zero
 //   at once, the station connects again by itself and the round resumes with the force back.
 // And a bad --server or --device is refused at startup, naming it, before anything connects.
@@ -12,10 +13,12 @@
 
 #include <netinet/in.h>
 #include <poll.h>
+#include <string.h>
 #include <sys/socket.h>
 
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <mutex>
@@ -311,7 +314,7 @@ class MuseumStationSignal : public MuseumStationRound, public ::testing::WithPar
 
 TEST_P(MuseumStationSignal, StopsWithZeroForceAndTheServerPausesTheRound) {
   const int signal_number = GetParam();
-  const char* name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+  const std::string name = std::string("SIG") + sigabbrev_np(signal_number);
   const std::uint16_t port = start_server();
   ASSERT_NE(port, 0);
   start_station(port);
@@ -341,9 +344,14 @@ TEST_P(MuseumStationSignal, StopsWithZeroForceAndTheServerPausesTheRound) {
   EXPECT_TRUE(paused) << said();
 }
 
-INSTANTIATE_TEST_SUITE_P(Signals, MuseumStationSignal, ::testing::Values(SIGINT, SIGTERM),
+// every signal `uh run` stops on (RunSignalTest) reaches the same zero-force stop here
+INSTANTIATE_TEST_SUITE_P(Signals, MuseumStationSignal,
+                         ::testing::Values(SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE),
                          [](const ::testing::TestParamInfo<int>& p) {
-                           return std::string(p.param == SIGINT ? "Sigint" : "Sigterm");
+                           std::string name = std::string("Sig") + sigabbrev_np(p.param);
+                           for (std::size_t i = 4; i < name.size(); ++i)
+                             name[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[i])));
+                           return name;
                          });
 
 TEST_F(MuseumStationRound, ADroppedConnectionZeroesTheForceAndTheRoundResumesOnReconnect) {

@@ -12,8 +12,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -90,6 +92,38 @@ bool has_thread(pid_t pid, const std::string& name) {
     if (comm == name) return true;
   }
   return false;
+}
+
+// The largest |fx| + |fy| + |fz| in the rows the running program has written to its trace so far:
+// the temporary file beside `trace` (AtomicFileWriter's ".NAME.tmp..."), renamed into place at
+// the end. 0 while there is none.
+double largest_force_so_far(const fs::path& trace) {
+  std::error_code ec;
+  std::string prefix(".");
+  prefix.append(trace.filename().string()).append(".tmp");
+  for (const auto& entry : fs::directory_iterator(trace.parent_path(), ec)) {
+    if (entry.path().filename().string().rfind(prefix, 0) != 0) continue;
+    std::istringstream lines(read_text(entry.path()));
+    std::string line;
+    std::vector<std::size_t> force_columns;
+    if (std::getline(lines, line)) {
+      std::istringstream header(line);
+      std::size_t i = 0;
+      for (std::string name; std::getline(header, name, ','); ++i)
+        if (name == "fx" || name == "fy" || name == "fz") force_columns.push_back(i);
+    }
+    double largest = 0.0;
+    while (std::getline(lines, line)) {
+      std::vector<double> cells;
+      std::istringstream row(line);
+      for (std::string c; std::getline(row, c, ',');) cells.push_back(std::strtod(c.c_str(), nullptr));
+      double sum = 0.0;
+      for (const std::size_t c : force_columns) sum += c < cells.size() ? std::abs(cells[c]) : 0.0;
+      largest = std::max(largest, sum);
+    }
+    return largest;
+  }
+  return 0.0;
 }
 
 struct Interrupt {
@@ -208,7 +242,12 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
     std::this_thread::sleep_for(5ms);
   }
   ASSERT_TRUE(running()) << "uh run never started its haptic thread: " << read_text(err);
-  std::this_thread::sleep_for(400ms);
+  // in contact: the trace written so far holds a force (a wait for the event, not a time: a
+  // loaded machine or a sanitizer takes longer)
+  while (largest_force_so_far(trace) <= 0.1 && std::chrono::steady_clock::now() < deadline) {
+    if (waitpid(pid, nullptr, WNOHANG) != 0) FAIL() << "uh run ended before the signal: " << read_text(err);
+    std::this_thread::sleep_for(5ms);
+  }
   // the Inverse3's loop is clocked by the stand-in service's replies, which come slower on a loaded
   // machine (or under a sanitizer): wait for a few hundred ticks of contact rather than for a time
   while (haply_service && haply_service->replies() < 300 && std::chrono::steady_clock::now() < deadline)

@@ -243,8 +243,11 @@ TEST(HapticSessionThreaded, StartPollStopReadsContactAndForceAndEndsAtZero) {
   std::uint64_t last_ticks = 0;
   bool ticks_increase = true;
   std::vector<ContactEvent> events;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1500);
-  while (std::chrono::steady_clock::now() < until) {
+  // until the stylus has pressed into the bunny for a while (1500 ticks, about 1.5 s at 1 kHz),
+  // however long a loaded machine or a sanitizer takes; the deadline only guards against a hang
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < until &&
+         !(last_ticks >= 1500 && max_force > 0.1 && max_pairs > 0 && !events.empty())) {
     const SessionState s = session.state();
     ticks_increase = ticks_increase && s.haptic_ticks >= last_ticks;
     last_ticks = s.haptic_ticks;
@@ -261,8 +264,8 @@ TEST(HapticSessionThreaded, StartPollStopReadsContactAndForceAndEndsAtZero) {
   for (ContactEvent e; session.poll_event(e);) events.push_back(e);
 
   EXPECT_TRUE(ticks_increase);
-  EXPECT_GT(last_ticks, 300u) << "about 1500 ticks at 1 kHz; loose bound for sanitizer builds";
-  EXPECT_GT(max_force, 0.1) << "the stylus reaches the bunny within 1.5 s";
+  EXPECT_GE(last_ticks, 1500u);
+  EXPECT_GT(max_force, 0.1) << "the stylus reaches the bunny within 1500 ticks";
   EXPECT_LE(max_force, 6.0 + 1e-9);
   EXPECT_GT(max_pairs, 0);
   EXPECT_GT(watcher_reads, 10u);

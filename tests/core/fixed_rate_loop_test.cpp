@@ -33,6 +33,7 @@ TEST(FixedRateLoop, RunsNearItsRate) {
   std::atomic<std::uint64_t> calls{0};
   std::atomic<bool> indices_ok{true};
   std::uint64_t expected_index = 0;  // loop thread only
+  const auto begin = std::chrono::steady_clock::now();
   ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
     if (t.index != expected_index || t.grid_index < t.index + 1 || t.period_s != 1e-3 ||
         t.start_time < t.scheduled_time) {
@@ -42,18 +43,20 @@ TEST(FixedRateLoop, RunsNearItsRate) {
     calls.fetch_add(1, std::memory_order_relaxed);
   }));
   EXPECT_TRUE(loop.running());
-  std::this_thread::sleep_for(300ms);
+  // a few hundred ticks, however long a loaded machine (or a sanitizer) takes for them
+  EXPECT_TRUE(wait_for([&] { return calls.load() >= 300; }, 120s));
   loop.stop();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   EXPECT_FALSE(loop.running());
 
   const uh::FixedRateLoopStats s = loop.stats();
   EXPECT_TRUE(indices_ok.load());
   EXPECT_EQ(s.ticks, calls.load());
-  // sanity bounds only (speed is measured by the benchmarks): 300 ms at 1 kHz is ~300 ticks;
-  // a loaded machine may lose some, but the loop can never run more than the grid allows
-  EXPECT_GT(s.ticks, 30u);
-  EXPECT_LE(s.ticks, 310u);
-  EXPECT_GT(s.achieved_rate_hz, 100.0);
+  // no speed is asserted (the benchmarks measure it): only that the loop never runs more ticks
+  // than its grid has points
+  EXPECT_GE(s.ticks, 300u);
+  EXPECT_LE(static_cast<double>(s.ticks), wall_s * 1000.0 + 2.0) << "more ticks than the grid has points";
+  EXPECT_GT(s.achieved_rate_hz, 0.0);
   EXPECT_LT(s.achieved_rate_hz, 1100.0);
   EXPECT_DOUBLE_EQ(s.rate_hz, 1000.0);
   EXPECT_EQ(s.lateness.count, s.ticks);
@@ -72,7 +75,7 @@ TEST(FixedRateLoop, RunsAtEightKilohertz) {
   std::atomic<std::uint64_t> calls{0};
   const auto begin = std::chrono::steady_clock::now();
   ASSERT_TRUE(loop.start([&](const uh::TickInfo&) { calls.fetch_add(1, std::memory_order_relaxed); }));
-  std::this_thread::sleep_for(200ms);
+  EXPECT_TRUE(wait_for([&] { return calls.load() > 100; }, 120s));
   loop.stop();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   const uh::FixedRateLoopStats s = loop.stats();

@@ -70,6 +70,37 @@ TEST_F(RegularFileTest, ASparseFileAboveTheLimitIsRefusedWithoutReadingIt) {
   expect_refused(big, kMaxMeshFileBytes, "2147483648 bytes is larger than the limit of 1073741824 bytes");
 }
 
+// A server's folders: inside by whole path components and after links and `..` are resolved;
+// messages name files relative to the root and the cache by its label.
+TEST_F(RegularFileTest, ReadableFoldersHoldWhatIsInsideAfterLinksAndDots) {
+  const fs::path root = dir_ / "data", cache = dir_ / "cache", sibling = dir_ / "data-old";
+  for (const fs::path& d : {root, cache, sibling}) fs::create_directories(d);
+  fs::create_symlink(sibling / "secret.obj", root / "link.obj");
+  const ReadableFolders folders({{.path = root, .label = ""}, {.path = cache, .label = "<cache>"}});
+  EXPECT_TRUE(folders.check(root / "a.obj", "mesh"));
+  EXPECT_TRUE(folders.check(root / "sub" / ".." / "a.obj", "mesh"));
+  EXPECT_TRUE(folders.check(cache / "x.ist", "ist"));
+  const auto refused = [&](const fs::path& p) {
+    const Status s = folders.check(p, "mesh");
+    return s ? std::string("accepted") : s.error().message;
+  };
+  EXPECT_EQ(
+      refused(sibling / "secret.obj"),
+      "mesh '../data-old/secret.obj' is outside the folders this server reads from (its root and its cache)");
+  EXPECT_NE(refused(root / ".." / "data-old" / "a.obj").find("'../data-old/a.obj' is outside"),
+            std::string::npos);
+  EXPECT_NE(refused(root / "link.obj").find("'../data-old/secret.obj' is outside"), std::string::npos);
+  EXPECT_NE(refused("/dev/zero").find("is outside"), std::string::npos);
+  EXPECT_TRUE(ReadableFolders().check("/dev/zero", "mesh")) << "no folders: any path";
+  EXPECT_EQ(folders.shown(fmt::format("{}: is a directory; {}: bad", (root / "m.obj").string(),
+                                      (cache / "x.ist").string())),
+            "m.obj: is a directory; <cache>/x.ist: bad");
+  EXPECT_EQ(folders.shown(root.string() + ": is a directory"), ".: is a directory");
+  EXPECT_EQ(folders.shown((sibling / "x.obj").string() + " and " + root.string()),
+            (sibling / "x.obj").string() + " and .")
+      << "a folder whose name starts with the root's is not the root";
+}
+
 TEST(JsonNesting, CountsArraysAndObjectsButNotBracketsInStrings) {
   EXPECT_EQ(json_nesting_depth("{}"), 1);
   EXPECT_EQ(json_nesting_depth(R"({"a": [[1], {"b": 2}]})"), 3);

@@ -43,6 +43,11 @@ fi
 ldd_out=$(env -u LD_LIBRARY_PATH ldd "$plugins/libuh.so")
 grep -q "libassimp.so.5 => $plugins/libassimp.so.5" <<<"$ldd_out" || fail "libuh.so does not load the packaged assimp: $ldd_out"
 ! grep -q "not found" <<<"$ldd_out" || fail "libuh.so lacks a library: $ldd_out"
+# every library bundled beside libuh is in the licence inventory, for the Unity package
+bash "$source_dir/tests/package/check_licenses.sh" "$source_dir/docs/licenses.md" --bundled unity "$plugins" ||
+  fail "the Unity package bundles a library docs/licenses.md does not list for it"
+[ -d "$package/Licenses~" ] || fail "the tarball has no Licenses~ with its bundled libraries' copyright files"
+for f in LICENSE.md "Third Party Notices.md"; do [ -f "$package/$f" ] || fail "the tarball has no $f"; done
 
 # the package's managed code, compiled from the tarball, and the console tests against it; mono
 # resolves DllImport("uh") through LD_LIBRARY_PATH: the packaged Plugins/x86_64 only
@@ -66,6 +71,9 @@ rm -rf "$godot/engines/godot/demo/addons"
 (cd "$godot/engines/godot/demo" && unzip -q "$godot_zip")
 uh="$godot/engines/godot/demo/addons/unrealhaptics/bin/uh"
 [ -x "$uh" ] || fail "the Godot zip has no executable addons/unrealhaptics/bin/uh"
+for f in LICENSE THIRD_PARTY_NOTICES.md; do
+  [ -f "$godot/engines/godot/demo/addons/unrealhaptics/$f" ] || fail "the Godot zip has no addons/unrealhaptics/$f"
+done
 [ "$("$uh" --version)" = "uh $version" ] || fail "the Godot zip's uh is not version $version"
 grep -qx "version=\"$version\"" "$godot/engines/godot/demo/addons/unrealhaptics/plugin.cfg" || fail "plugin.cfg is not version $version"
 UH_PROGRAM="$uh" UH_GODOT_PROJECT="$godot/engines/godot/demo" UH_CACHE_DIR="$work/cache" \

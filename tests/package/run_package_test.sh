@@ -33,6 +33,23 @@ for f in bin/uh lib/libuh.so lib/libuh.so.0 include/uh/uh.h lib/cmake/UnrealHapt
          share/man/man1/uh.1.gz share/doc/unrealhaptics/README.md share/unrealhaptics/scenes/thin_wall.json; do
   [ -e "$usr/$f" ] || fail "the package has no /usr/$f"
 done
+# the copyright file is machine-readable: the format named, every License: of a Files stanza with
+# its own paragraph (or Debian's common licence text)
+copyright="$usr/share/doc/unrealhaptics/copyright"
+[ -f "$copyright" ] || fail "the package has no /usr/share/doc/unrealhaptics/copyright"
+/usr/bin/python3 - "$copyright" <<'PY' || fail "the copyright file is not machine-readable (DEP-5)"
+import re, sys
+paragraphs = [p for p in open(sys.argv[1]).read().split("\n\n") if p.strip()]
+assert paragraphs[0].startswith("Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/"), "no Format line"
+defined = {re.match(r"License: (.+)", p).group(1) for p in paragraphs if p.startswith("License: ") and "\n " in p}
+used = set()
+for p in paragraphs:
+    if p.startswith("Files: "):
+        names = re.search(r"^License: (.+)$", p, re.M).group(1)
+        used.update(n.strip() for n in names.split(" and "))
+missing = used - defined
+assert not missing, f"no License paragraph for {missing}"
+PY
 [ "$(readelf -d "$usr/lib/libuh.so.0" | sed -nE 's/.*SONAME.*\[(.*)\]/\1/p')" = libuh.so.0 ] || fail "libuh's soname is not libuh.so.0"
 # a shipped scene names only meshes the package holds
 for scene in "$usr"/share/unrealhaptics/scenes/*.json; do

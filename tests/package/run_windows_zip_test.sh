@@ -16,9 +16,12 @@ bash "$source_dir/scripts/package.sh" --windows-only --windows-build-dir "$build
 name="unrealhaptics-$version-windows-x64"
 (cd "$work/dist" && sha256sum --check --quiet SHA256SUMS) || fail "SHA256SUMS does not match"
 (cd "$work" && unzip -q "dist/$name.zip")
-for f in bin/uh.dll lib/libuh.dll.a include/uh/uh.h doc/capi.md; do
+for f in bin/uh.dll lib/libuh.dll.a include/uh/uh.h doc/capi.md LICENSE doc/licenses.md; do
   [ -f "$work/$name/$f" ] || fail "the zip has no $f"
 done
+# the DLLs uh.dll imports are in the licence inventory
+bash "$source_dir/tests/package/check_licenses.sh" "$source_dir/docs/licenses.md" uh.dll "$work/$name/bin/uh.dll" ||
+  fail "uh.dll imports a library docs/licenses.md does not list for it"
 cp "$test_program" "$work/$name/bin/"
 # the zip's uh.dll is the one beside the program: Windows loads a DLL from the program's folder first
 UH_CACHE_DIR="$work/cache" "$wine_run" "$work/$name/bin/$(basename "$test_program")" version ||

@@ -8,6 +8,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <optional>
 #include <set>
 #include <thread>
@@ -177,15 +179,15 @@ TEST_F(ServerTest, PathsThatAreNotRegularFilesAreRefusedWithoutStoppingOthers) {
             std::string::npos)
       << from_fifo;
   other.request({{"type", "ping"}}, "pong");
-  const json from_zero = c.request({{"type", "open"}, {"scene", "/dev/zero"}}, "error");
-  EXPECT_EQ(from_zero["message"], "/dev/zero: is a device, not a file");
   const json from_dir = c.request({{"type", "open"}, {"scene", dir_.string()}}, "error");
   EXPECT_NE(from_dir["message"].get<std::string>().find("is a directory, not a file"), std::string::npos);
   c.request({{"type", "open"}, {"scene", scene_.string()}}, "opened");
-  for (const std::string& mesh : {dir_.string(), std::string("/dev/zero"), fifo.string()}) {
+  // named relative to the server's root folder (dir_)
+  for (const auto& [mesh, named] : {std::pair{dir_.string(), std::string(".")},
+                                    std::pair{fifo.string(), std::string("scene-pipe.json")}}) {
     const json e =
         c.request({{"type", "add_object"}, {"object", {{"name", "bad"}, {"mesh", mesh}}}}, "error");
-    EXPECT_NE(e["message"].get<std::string>().find("field 'objects[1].mesh': " + mesh + ": is a"),
+    EXPECT_NE(e["message"].get<std::string>().find("field 'objects[1].mesh': " + named + ": is a"),
               std::string::npos)
         << e;
   }
@@ -193,6 +195,75 @@ TEST_F(ServerTest, PathsThatAreNotRegularFilesAreRefusedWithoutStoppingOthers) {
   EXPECT_NE(tool["message"].get<std::string>().find("is a directory, not a file"), std::string::npos) << tool;
   other.request({{"type", "ping"}}, "pong");
   std::filesystem::remove(fifo);
+}
+
+// A client names files in the server's root folder (ServerOptions::working_dir, `uh serve --root`)
+// and its cache only: a scene, a mesh, an .ist, a device's trajectory outside it, a scene inside
+// that names a mesh outside, a link inside that points outside and /dev/zero are refused before
+// any of them is opened (a missing file outside is refused alike), named relative to the root; no error shows
+// the root's or the cache's absolute path. With allow_any_path (`--allow-any-path`) the same scene opens.
+TEST_F(ServerTest, PathsOutsideTheRootAreRefusedNamedRelativeToIt) {
+  const std::filesystem::path outside = testing::scratch("server-outside");
+  const std::filesystem::path outside_scene = testing::write_small_scene(outside);
+  const std::string outside_mesh = (outside / "meshes" / "bunny_npm_3674.obj").string();
+  const std::string outside_named = "../" + outside.filename().string();
+  std::filesystem::create_symlink(outside_mesh, dir_ / "link.obj");
+  // a scene inside the root whose mesh is outside it
+  std::string reaching;
+  {
+    std::ifstream in(scene_);
+    reaching.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  reaching.replace(reaching.find("meshes/bunny_npm_3674.obj"),
+                   std::string("meshes/bunny_npm_3674.obj").size(), outside_mesh);
+  std::ofstream(dir_ / "reaching.json") << reaching;
+  Client c(port());
+  c.hello();
+  const auto refused = [&](const json& request, const std::string& expected) {
+    const std::string message = c.request(request, "error")["message"].get<std::string>();
+    EXPECT_NE(message.find(expected + "' is outside the folders this server reads from"), std::string::npos)
+        << request << " -> " << message;
+    EXPECT_EQ(message.find(dir_.string()), std::string::npos) << message;
+  };
+  refused({{"type", "open"}, {"scene", outside_scene.string()}}, "scene '" + outside_named + "/small.json");
+  refused({{"type", "open"}, {"scene", "/dev/zero"}}, "scene '../../dev/zero");
+  const std::string far_bunny = outside_named + "/meshes/bunny_npm_3674.obj";
+  refused({{"type", "open"}, {"scene", "reaching.json"}}, "field 'objects[0].mesh': '" + far_bunny);
+  c.request({{"type", "open"}, {"scene", scene_.filename().string()}}, "opened");
+  const json mesh = {{"name", "far"}, {"mesh", outside_mesh}, {"spheres", 100}, {"meters_per_unit", 0.01}};
+  refused({{"type", "add_object"}, {"object", mesh}}, "field 'objects[1].mesh': '" + far_bunny);
+  refused(
+      {{"type", "add_object"},
+       {"object", {{"name", "up"}, {"mesh", "../" + outside.filename().string() + "/meshes/stylus.obj"}}}},
+      "field 'objects[1].mesh': '" + outside_named + "/meshes/stylus.obj");
+  refused({{"type", "add_object"}, {"object", {{"name", "link"}, {"mesh", "link.obj"}}}},
+          "field 'objects[1].mesh': '" + far_bunny);
+  // a file outside that does not exist is refused the same way: nothing tells what is there
+  refused({{"type", "add_object"}, {"object", {{"name", "tree"}, {"ist", (outside / "none.ist").string()}}}},
+          "field 'objects[1].ist': '" + outside_named + "/none.ist");
+  refused({{"type", "set_tool"}, {"tool", {{"mesh", outside_mesh}}}}, "field 'tool.mesh': '" + far_bunny);
+  refused({{"type", "set_device"},
+           {"device", {{"driver", "sim-replay"}, {"config", {{"file", (outside / "moves.csv").string()}}}}}},
+          "field 'tool.device.config.file': '" + outside_named + "/moves.csv");
+  // a file inside, missing: named relative to the root, without the root's path
+  const std::string missing = c.request(
+      {{"type", "add_object"}, {"object", {{"name", "gone"}, {"mesh", "gone.obj"}}}}, "error")["message"];
+  EXPECT_NE(missing.find("field 'objects[1].mesh': file not found: gone.obj"), std::string::npos) << missing;
+  EXPECT_EQ(missing.find(dir_.string()), std::string::npos) << missing;
+  // the refused edits left the scene as it was
+  EXPECT_EQ(c.request({{"type", "get_scene"}}, "scene")["scene"]["objects"].size(), 1u);
+
+  // the same server with allow_any_path opens the scene outside
+  server_.reset();
+  ServerOptions options{.host = "127.0.0.1", .port = 0, .cache_dir = UH_TEST_CACHE_DIR, .working_dir = dir_};
+  options.allow_any_path = true;
+  auto any = Server::start(std::move(options));
+  ASSERT_TRUE(any.has_value()) << any.error().message;
+  Client d((*any)->port());
+  d.hello();
+  d.request({{"type", "open"}, {"scene", outside_scene.string()}}, "opened");
+  d.request({{"type", "open"}, {"scene", "reaching.json"}}, "opened");
+  std::filesystem::remove_all(outside);
 }
 
 // Before a successful hello the service holds nothing large for a client: an add_object that
@@ -446,7 +517,7 @@ TEST_F(ServerTest, EditsTheSceneBeforeStartAndRefusesEditsWhileRunning) {
   const json missing =
       c.request({{"type", "add_object"}, {"object", {{"name", "b2"}, {"mesh", "missing.obj"}}}}, "error");
   EXPECT_NE(missing["message"].get<std::string>().find("file not found"), std::string::npos) << missing;
-  const auto bunny = (testing::assets() / "meshes" / "bunny_npm_3674.obj").string();
+  const auto bunny = (dir_ / "meshes" / "bunny_npm_3674.obj").string();
   const json added = c.request({{"type", "add_object"},
                                 {"id", 5},
                                 {"object",

@@ -24,8 +24,13 @@ inline std::filesystem::path scratch(const std::string& name) {
   return dir;
 }
 
-/// Writes a scene into `dir`: the stylus goes down into the bunny and back (sim-line, 0.5 s).
+/// Writes a scene into `dir`: the stylus goes down into the bunny and back (sim-line, 0.5 s). Its
+/// meshes are copied into `dir`/meshes (a server reads only from its root folder and its cache).
 inline std::filesystem::path write_small_scene(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "meshes");
+  for (const char* mesh : {"bunny_npm_3674.obj", "stylus.obj"})
+    std::filesystem::copy_file(assets() / "meshes" / mesh, dir / "meshes" / mesh,
+                               std::filesystem::copy_options::overwrite_existing);
   const std::string text =
       fmt::format(R"({{
   "name": "small-service-test",
@@ -39,8 +44,7 @@ inline std::filesystem::path write_small_scene(const std::filesystem::path& dir)
                 "config": {{ "start": [0.0, 0.0, 0.10], "end": [0.0, 0.0, 0.045], "duration_s": 0.5, "bounce": true }} }}
   }}
 }})",
-                  fmt::arg("mesh", (assets() / "meshes" / "bunny_npm_3674.obj").string()),
-                  fmt::arg("stylus", (assets() / "meshes" / "stylus.obj").string()));
+                  fmt::arg("mesh", "meshes/bunny_npm_3674.obj"), fmt::arg("stylus", "meshes/stylus.obj"));
   const auto path = dir / "small.json";
   std::ofstream(path) << text;
   return path;

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
-/// Text to speech with espeak-ng (Debian's libespeak-ng1 and espeak-ng-data), rendered into a
-/// Sound rather than to a sound card, so that speech plays in the AudioScene like any other clip
+/// Text to speech with the espeak-ng program (Debian's espeak-ng package; run as a process of its
+/// own, never linked, because it is GPL-3: docs/licenses.md), rendered into a Sound rather than to
+/// a sound card, so that speech plays in the AudioScene like any other clip
 /// (ducking, volume, the offline render of the tests).
 
 #include <string_view>
@@ -17,9 +18,8 @@ struct SpeechDef {
 };
 
 /// Speaks the text into a mono Sound at espeak-ng's own sample rate (22,050 Hz).
-/// espeak-ng keeps process-wide state: calls from several threads take turns (a mutex); never
-/// call it from a real-time thread. An error names what espeak-ng could not do (no voice data,
-/// an unknown voice).
+/// Runs the program once per call (and once for its list of voices): any thread but a real-time
+/// one. An error names what went wrong (no espeak-ng program, an unknown voice).
 Result<Sound> synthesize_speech(std::string_view text, const SpeechDef& def = {});
 
 }  // namespace uh::audio

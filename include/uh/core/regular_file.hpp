@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "uh/core/result.hpp"
 
@@ -27,5 +29,36 @@ Result<std::string> read_regular_file(const std::filesystem::path& path, std::ui
 /// The same checks without reading, for readers that open the path themselves (a mesh library):
 /// the file's size in bytes, or the error read_regular_file() would give.
 Result<std::uint64_t> check_regular_file(const std::filesystem::path& path, std::uint64_t max_bytes);
+
+/// A folder files may be read from, and how messages name a file in it: `label/` and its path
+/// relative to the folder (an empty label: the relative path alone, as for a service's root).
+struct ReadableFolder {
+  std::filesystem::path path;
+  std::string label;
+};
+
+/// The folders a server reads the files its clients name from (`uh serve --root` and its cache),
+/// or any folder. A path is inside a folder when it is after its symbolic links and `..` are
+/// resolved, so a link inside that points outside is outside. The check is made before a file is
+/// read; a user who can change the folders' links between the check and the read is trusted.
+class ReadableFolders {
+ public:
+  /// Any path may be read (`uh serve --allow-any-path`, and every program but the servers).
+  ReadableFolders() = default;
+  /// Only paths in `folders` (made absolute and resolved here); messages name files outside
+  /// relative to the first.
+  explicit ReadableFolders(std::vector<ReadableFolder> folders);
+
+  bool any_path() const { return folders_.empty(); }
+  /// Ok when `path` (absolute) may be read; else "WHAT 'P' is outside the folders ..." with P named
+  /// relative to the first folder.
+  Status check(const std::filesystem::path& path, std::string_view what) const;
+  /// `message` with each folder's absolute path replaced by its label, so that errors name files
+  /// relative to the root and never show where the server keeps them.
+  std::string shown(std::string message) const;
+
+ private:
+  std::vector<ReadableFolder> folders_;
+};
 
 }  // namespace uh

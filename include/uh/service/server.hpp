@@ -33,7 +33,10 @@ struct ServerOptions {
   std::vector<net::StaticFile> files{};  ///< the live view's page and script
   std::filesystem::path cache_dir{};    ///< where .ist builds are cached; empty: the default
   std::filesystem::path working_dir{};  ///< relative paths in requests; empty: the current folder
-  bool raise_priority = false;          ///< sessions ask for SCHED_FIFO (as `uh run`)
+  /// Clients may name only files in `working_dir` and `cache_dir` (scenes, meshes, .ist files, a
+  /// device's trajectory, and the files a scene names); true: any file the server's user can read.
+  bool allow_any_path = false;
+  bool raise_priority = false;  ///< sessions ask for SCHED_FIFO (as `uh run`)
   /// Connections served at once; one more is answered with HTTP 503 (docs/protocol.md).
   int max_connections = 500;
 };
