@@ -40,13 +40,13 @@
 namespace uh::cli {
 namespace {
 
-using museum_client::GameEvent;
 using museum_client::GameLink;
-using museum_client::InHand;
 using museum_client::LinkNote;
-using museum_client::Snapshot;
-using museum_client::Summary;
-using museum_client::Welcome;
+using museum_protocol::GameEvent;
+using museum_protocol::InHand;
+using museum_protocol::Snapshot;
+using museum_protocol::Summary;
+using museum_protocol::Welcome;
 using nlohmann::json;
 
 // A bot's connection to the game server: it does not come back after a drop (the round is over
@@ -115,14 +115,14 @@ class ViveView {
       item.kind = s.target_kinds[static_cast<std::size_t>(i / 2)];
       item.place = museum::ItemPlace::kept;  // judged, unless seen below
     }
-    const auto see = [&](const museum_client::ItemView& it, museum::ItemPlace place) {
+    const auto see = [&](const museum_protocol::ItemView& it, museum::ItemPlace place) {
       if (it.item < 0 || it.item >= s.item_count) return -1;
       s.items[static_cast<std::size_t>(it.item)].place = place;
       return it.item;
     };
     s.case_count = static_cast<int>(std::min<std::size_t>(snapshot.cases.size(), museum::kMaxCases));
     for (int c = 0; c < s.case_count; ++c) {
-      const museum_client::CaseView& seen = snapshot.cases[static_cast<std::size_t>(c)];
+      const museum_protocol::CaseView& seen = snapshot.cases[static_cast<std::size_t>(c)];
       s.case_broken[static_cast<std::size_t>(c)] = seen.broken;
       s.case_item[static_cast<std::size_t>(c)] = -1;
       const int i = see(seen.item, museum::ItemPlace::in_case);
@@ -135,13 +135,13 @@ class ViveView {
     s.vive.running = snapshot.vive_running;
     s.vive.times_caught = snapshot.times_caught;
     s.vive.carried_count = 0;
-    for (const museum_client::ItemView& it : snapshot.carried) {
+    for (const museum_protocol::ItemView& it : snapshot.carried) {
       const int i = see(it, museum::ItemPlace::carried);
       if (i >= 0 && s.vive.carried_count < museum::kMaxCarried)
         s.vive.carried[static_cast<std::size_t>(s.vive.carried_count++)] = i;
     }
     s.table_count = 0;
-    for (const museum_client::ItemView& it : snapshot.table) {
+    for (const museum_protocol::ItemView& it : snapshot.table) {
       const int i = see(it, museum::ItemPlace::on_table);
       if (i >= 0 && s.table_count < museum::kMaxItems) s.table[static_cast<std::size_t>(s.table_count++)] = i;
     }
@@ -153,7 +153,7 @@ class ViveView {
   const museum::GameState& state() const { return state_; }
 
  private:
-  void infer_guard(int g, const museum_client::GuardView& seen) {
+  void infer_guard(int g, const museum_protocol::GuardView& seen) {
     museum::GuardState& guard = state_.guards[static_cast<std::size_t>(g)];
     guard.pos = seen.pos;
     guard.facing = seen.facing;
@@ -219,11 +219,13 @@ Status play_vive(GameLink& link, const Welcome& welcome) {
     if (s.paused) continue;
     const museum::ViveInput in = bot.decide(s);
     if (museum::distance(in.move, sent.move) > 1e-3 || in.run != sent.run) {
-      link.send(museum_client::move_text(in.move, in.run));
+      link.send(museum_protocol::write_message(museum_protocol::MoveMessage{in.move, in.run}));
       sent = in;
     }
-    for (const auto& [wanted, name] : {std::pair{in.break_case, "break"}, {in.take, "take"}, {in.deliver, "deliver"}})
-      if (wanted) link.send(museum_client::action_text(name));
+    using museum_protocol::Action;
+    for (const auto& [wanted, action] :
+         {std::pair{in.break_case, Action::break_case}, {in.take, Action::take}, {in.deliver, Action::deliver}})
+      if (wanted) link.send(museum_protocol::write_message(museum_protocol::ActionMessage{action}));
   }
 }
 
@@ -255,14 +257,14 @@ Status play_phantom(const std::string& url, std::uint64_t seed, std::vector<Blin
     deal = deal * 6364136223846793005ull + 1442695040888963407ull;
     return static_cast<double>(deal >> 11) * 0x1.0p-53;
   };
-  const auto explore = [&](museum_artifacts::ArtifactKind kind, Piece piece,
-                           bool on_the_table) -> Result<museum_players::PieceSurvey> {
+  const auto explore = [&](const museum::PieceForm& form, bool on_the_table) -> Result<museum_players::PieceSurvey> {
+    const auto kind = museum_artifacts::check_form(form);
+    if (!kind) return kind.error();
     // on the table a piece lies a few millimetres off the middle, a lathe piece turned any way
-    const double turn = on_the_table && museum_players::turned_on_the_table(kind) ? 2.0 * kPi * uniform() : 0.0;
+    const double turn = on_the_table && museum_players::turned_on_the_table(*kind) ? 2.0 * kPi * uniform() : 0.0;
     const double x = on_the_table ? (uniform() - 0.5) * 0.004 : 0.0, y = on_the_table ? (uniform() - 0.5) * 0.004 : 0.0;
     const Pose pose{quat_from_axis_angle({0, 0, 1}, turn), {x, y, 0.0}};
-    auto object = museum_artifacts::artifact_object(kind, difficulty, piece, cache,
-                                                    museum_artifacts::to_string(kind), pose);
+    auto object = museum_artifacts::artifact_object(form, cache, form.kind, pose);
     if (!object) return object.error();
     museum_players::SurveyOptions options;
     options.seed = static_cast<std::uint64_t>(uniform() * 0x1.0p52);
@@ -273,9 +275,10 @@ Status play_phantom(const std::string& url, std::uint64_t seed, std::vector<Blin
   const auto study = [&](museum_artifacts::ArtifactKind kind) -> Status {
     const std::string name = museum_artifacts::to_string(kind);
     if (references.contains(name)) return Ok{};
-    auto reference = explore(kind, Piece::genuine, false);
+    const museum::PieceForm genuine = museum_artifacts::piece_form(kind, difficulty, Piece::genuine);
+    auto reference = explore(genuine, false);
     if (!reference) return reference.error();
-    auto again = explore(kind, Piece::genuine, true);
+    auto again = explore(genuine, true);
     if (!again) return again.error();
     references.emplace(name, std::pair{std::move(*reference), std::move(*again)});
     return Ok{};
@@ -302,18 +305,18 @@ Status play_phantom(const std::string& url, std::uint64_t seed, std::vector<Blin
     const auto kind = museum_artifacts::artifact_kind(kind_name);
     if (!kind) return Error{fmt::format("the server handed Phantom a '{}', which is no artifact kind", kind_name)};
     if (const Status studied = study(*kind); !studied) return studied;
-    // the piece under the device: the server says which (as the station loads it); the bot's
+    // the piece under the device: the form the server sent (as the station builds it); the bot's
     // verdict reads only the trace of exploring it
-    auto survey = explore(*kind, in_hands->piece, true);
+    auto survey = explore(in_hands->form, true);
     if (!survey) return survey.error();
     const auto& [reference, again] = references.at(kind_name);
     BlindVerdict v{.item = item,
                    .kind = kind_name,
                    .judgement = museum_players::judge_piece(*survey, reference, again),
                    .simulated_s = survey->simulated_s};
-    link.send(museum_client::verdict_text(item, v.judgement.verdict == museum_players::Verdict::genuine
-                                                    ? museum::Verdict::genuine
-                                                    : museum::Verdict::forgery));
+    link.send(museum_protocol::write_message(museum_protocol::VerdictMessage{
+        item, v.judgement.verdict == museum_players::Verdict::genuine ? museum::Verdict::genuine
+                                                                      : museum::Verdict::forgery}));
     const std::lock_guard lock(verdicts_mutex);
     verdicts.push_back(std::move(v));
   }
@@ -375,6 +378,7 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   museum::Level level =
       museum::make_level(args.level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy);
   if (args.minutes > 0.0) level.rules.round_s = args.minutes * 60.0;
+  level.pieces = museum_artifacts::piece_pairs(level);
   // the watcher below prints what happens; the server's own notes would repeat it (or break the JSON)
   log::set_level(args.json ? log::Level::error : log::Level::warn);
   auto server = museum_service::GameServer::start(
@@ -460,7 +464,7 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   }
   std::printf("uh museum play: the round ended%s after %.0f s of game time (%.0f s on the clock)\n",
               summary->ended_early ? " early, every target settled," : "", summary->seconds_played, wall_s);
-  for (const museum_client::TargetView& t : summary->targets)
+  for (const museum_protocol::TargetView& t : summary->targets)
     std::printf("  %-8s genuine: %-8s forgery: %s\n", t.kind.c_str(), t.genuine.c_str(), t.forgery.c_str());
   for (const BlindVerdict& v : verdicts) {
     const auto& e = v.judgement.evidence;

@@ -15,9 +15,12 @@
 #include <string>
 
 #include "uh/core/result.hpp"
-#include "uh/museum_client/server_messages.hpp"
+#include "uh/museum_protocol/messages.hpp"
 
 namespace uh::museum_client {
+
+using museum_protocol::ServerMessage;
+using museum_protocol::Welcome;
 
 struct LinkOptions {
   /// ws://HOST:PORT/ws, http://HOST:PORT/ (what `uh museum serve` prints) or HOST:PORT.
