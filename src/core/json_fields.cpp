@@ -12,11 +12,16 @@ namespace uh {
 using nlohmann::json;
 
 Result<json> parse_json_document(std::string_view text) {
+  // nothing below (the parser, a dump, a destructor) recurses deeply on a file's or a client's text
   if (json_nesting_depth(text) > kMaxJsonNesting)
-    return Error{fmt::format("nested deeper than {} levels", kMaxJsonNesting)};
-  json document = json::parse(text, nullptr, false);
-  if (document.is_discarded()) return Error{"not JSON"};
-  return document;
+    return Error{fmt::format("the JSON is nested deeper than {} levels", kMaxJsonNesting)};
+  try {
+    return json::parse(text);
+  } catch (const json::exception& e) {
+    // parse_error for bad syntax, out_of_range for a number too large for a double (found by the
+    // scene fuzzer): both are the text's fault
+    return Error{fmt::format("not valid JSON: {}", e.what())};
+  }
 }
 
 const json* JsonFields::field(const json& object, std::string_view name, std::string_view path) {

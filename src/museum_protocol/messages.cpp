@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "uh/core/json_fields.hpp"
-#include "uh/core/json_nesting.hpp"
 
 namespace uh::museum_protocol {
 
@@ -48,10 +47,14 @@ namespace {
 
 json xy(museum::Vec2 v) { return json::array({v.x, v.y}); }
 
-// the document behind the nesting guard, or why there is none (the messages' own words)
+// a message's text; what a client sent (an id, a type, the parser's words on its text) may hold
+// bytes that are not UTF-8: they are written replaced, never thrown on
+std::string text(const json& message) { return message.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+// the document behind the nesting guard, or why there is none
 Result<json> read_object(std::string_view text) {
   auto document = parse_json_document(text);
-  if (!document) return Error{"the message is " + document.error().message};
+  if (!document) return Error{"the message: " + document.error().message};
   return document;
 }
 
@@ -162,19 +165,19 @@ std::string write_message(const HelloMessage& m) {
   json hello = {{"type", "hello"}, {"protocol", m.protocol}, {"role", to_string(m.role)}};
   if (!m.token.empty()) hello["token"] = m.token;
   if (!m.seat_key.empty()) hello["seat_key"] = m.seat_key;
-  return hello.dump();
+  return text(hello);
 }
 
 std::string write_message(const MoveMessage& m) {
-  return json{{"type", "move"}, {"move", xy(m.move)}, {"run", m.run}}.dump();
+  return text(json{{"type", "move"}, {"move", xy(m.move)}, {"run", m.run}});
 }
 
 std::string write_message(const ActionMessage& m) {
-  return json{{"type", "action"}, {"action", to_string(m.action)}}.dump();
+  return text(json{{"type", "action"}, {"action", to_string(m.action)}});
 }
 
 std::string write_message(const VerdictMessage& m) {
-  return json{{"type", "verdict"}, {"item", m.item}, {"verdict", museum::to_string(m.verdict)}}.dump();
+  return text(json{{"type", "verdict"}, {"item", m.item}, {"verdict", museum::to_string(m.verdict)}});
 }
 
 // ---- server to client
@@ -513,7 +516,7 @@ std::string write_message(const Welcome& m) {
                   {"level", level_json(m.level)},
                   {"targets", m.targets}};
   if (!m.seat_key.empty()) welcome["seat_key"] = m.seat_key;
-  return welcome.dump();
+  return text(welcome);
 }
 
 namespace {
@@ -535,58 +538,56 @@ std::string write_message(const Snapshot& s) {
   json cases = json::array();
   for (const CaseView& c : s.cases)
     cases.push_back({{"broken", c.broken}, {"item", c.item.item >= 0 ? item_json(c.item) : json(nullptr)}});
-  return json{{"type", "snapshot"},
-              {"tick", s.tick},
-              {"time_left_s", s.time_left_s},
-              {"phase", s.phase},
-              {"players", {{"vive", s.vive_connected}, {"phantom", s.phantom_connected}}},
-              {"targets", s.targets},
-              {"vive",
-               {{"pos", xy(s.vive_pos)},
-                {"facing", xy(s.vive_facing)},
-                {"running", s.vive_running},
-                {"carried", items_json(s.carried)},
-                {"times_caught", s.times_caught}}},
-              {"guards", guards},
-              {"cases", cases},
-              {"table", items_json(s.table)},
-              {"judged", s.judged}}
-      .dump();
+  return text(json{{"type", "snapshot"},
+                   {"tick", s.tick},
+                   {"time_left_s", s.time_left_s},
+                   {"phase", s.phase},
+                   {"players", {{"vive", s.vive_connected}, {"phantom", s.phantom_connected}}},
+                   {"targets", s.targets},
+                   {"vive",
+                    {{"pos", xy(s.vive_pos)},
+                     {"facing", xy(s.vive_facing)},
+                     {"running", s.vive_running},
+                     {"carried", items_json(s.carried)},
+                     {"times_caught", s.times_caught}}},
+                   {"guards", guards},
+                   {"cases", cases},
+                   {"table", items_json(s.table)},
+                   {"judged", s.judged}});
 }
 
-std::string write_message(const GameEvent& m) { return event_json(m.event).dump(); }
+std::string write_message(const GameEvent& m) { return text(event_json(m.event)); }
 
 std::string write_message(const InHand& m) {
   json form = {{"difficulty", museum::to_string(m.form.difficulty)}};
   for (const auto& [name, value] : kFormNumbers) form[name] = m.form.*value;
-  return json{{"type", "in_hands"}, {"item", m.item}, {"kind", m.kind}, {"form", form}}.dump();
+  return text(json{{"type", "in_hands"}, {"item", m.item}, {"kind", m.kind}, {"form", form}});
 }
 
 std::string write_message(const Summary& s) {
   json targets = json::array();
   for (const TargetView& t : s.targets)
     targets.push_back({{"kind", t.kind}, {"genuine", t.genuine}, {"forgery", t.forgery}});
-  return json{{"type", "summary"},
-              {"targets", targets},
-              {"score",
-               {{"points", s.points},
-                {"genuine_kept", s.genuine_kept},
-                {"forgeries_kept", s.forgeries_kept},
-                {"genuine_rejected", s.genuine_rejected},
-                {"forgeries_rejected", s.forgeries_rejected},
-                {"time_bonus", s.time_bonus}}},
-              {"times_caught", s.times_caught},
-              {"seconds_played", s.seconds_played},
-              {"ended_early", s.ended_early}}
-      .dump();
+  return text(json{{"type", "summary"},
+                   {"targets", targets},
+                   {"score",
+                    {{"points", s.points},
+                     {"genuine_kept", s.genuine_kept},
+                     {"forgeries_kept", s.forgeries_kept},
+                     {"genuine_rejected", s.genuine_rejected},
+                     {"forgeries_rejected", s.forgeries_rejected},
+                     {"time_bonus", s.time_bonus}}},
+                   {"times_caught", s.times_caught},
+                   {"seconds_played", s.seconds_played},
+                   {"ended_early", s.ended_early}});
 }
 
 std::string write_message(const ServerError& m) {
-  return json{{"type", "error"}, {"id", m.id}, {"request", m.request}, {"message", m.message}}.dump();
+  return text(json{{"type", "error"}, {"id", m.id}, {"request", m.request}, {"message", m.message}});
 }
 
 std::string write_message(const Pong& m) {
-  return json{{"type", "pong"}, {"id", m.id}, {"tick", m.tick}}.dump();
+  return text(json{{"type", "pong"}, {"id", m.id}, {"tick", m.tick}});
 }
 
 }  // namespace uh::museum_protocol

@@ -15,10 +15,12 @@ TEST(JsonFields, TheGuardRefusesDeepNestingBeforeParsing) {
   EXPECT_TRUE(parse_json_document(R"({"a": [1, {"b": 2}]})"));
   const auto deep = parse_json_document(std::string(100000, '[') + std::string(100000, ']'));
   ASSERT_FALSE(deep);
-  EXPECT_EQ(deep.error().message, "nested deeper than 32 levels");
+  EXPECT_EQ(deep.error().message, "the JSON is nested deeper than 32 levels");
   const auto bad = parse_json_document("{nope");
   ASSERT_FALSE(bad);
-  EXPECT_EQ(bad.error().message, "not JSON");
+  EXPECT_EQ(bad.error().message.rfind("not valid JSON: [json.exception.parse_error", 0), 0u) << bad.error().message;
+  // a number no double holds is the text's fault too
+  EXPECT_FALSE(parse_json_document(R"({"x": 1e999})"));
 }
 
 TEST(JsonFields, ReadsTypedFieldsAndNamesTheFirstOneWrong) {

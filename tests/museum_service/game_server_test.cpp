@@ -76,7 +76,7 @@ TEST(MuseumServer, BadMessagesGetErrorsNamingTheProblemAndTheConnectionStaysUsab
     std::string expected;
   };
   const std::vector<Case> before_hello = {
-      {"{not json", "not JSON"},
+      {"{not json", "not valid JSON"},
       {"[1, 2]", "must be a JSON object"},
       {R"({"id": 1})", "'type' is missing"},
       {R"({"type": "dance"})", "unknown message type 'dance'"},

@@ -14,8 +14,9 @@
 
 namespace uh {
 
-/// Parses one JSON document: refused when nested deeper than kMaxJsonNesting (before parsing)
-/// or when it is not JSON. Never throws.
+/// Parses one JSON document, the first step of every parser (scene files, the service's and the
+/// game's messages): "the JSON is nested deeper than 32 levels" (checked before parsing) or
+/// "not valid JSON: <the parser's message>". Never throws.
 Result<nlohmann::json> parse_json_document(std::string_view text);
 
 /// Reads the fields of parsed JSON and keeps the first thing wrong; once something is wrong, later
