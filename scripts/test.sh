@@ -12,8 +12,8 @@
 #      wine64 (cmake/mingw-w64-x86_64.cmake);
 #   5. libFuzzer (clang): short fuzz runs of the .ist loader (generated seeds), the scene
 #      parser (the repository's scenes as seeds), the CSV reader (fuzz/csv_seeds), the service's
-#      message parser (fuzz/protocol_seeds) and its inline-mesh frames (fuzz/mesh_binary_seeds), and
-#      the in-tree OBJ/STL reader (fuzz/mesh_seeds).
+#      message parser (fuzz/protocol_seeds) and its inline-mesh frames (fuzz/mesh_binary_seeds),
+#      the in-tree OBJ/STL reader (fuzz/mesh_seeds) and the museum's messages (fuzz/museum_seeds).
 # Ends with one summary line: "tests: N passed, N failed".
 set -uo pipefail
 source "$(dirname "$0")/common.sh"
@@ -123,9 +123,9 @@ fi
 
 echo "== build (libFuzzer, clang) =="
 if command -v clang++ >/dev/null 2>&1; then
-  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz uh_csv_reader_fuzz uh_service_protocol_fuzz uh_service_mesh_binary_fuzz uh_mesh_reader_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz uh_csv_reader_fuzz uh_service_protocol_fuzz uh_service_mesh_binary_fuzz uh_mesh_reader_fuzz uh_museum_protocol_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
        -DUH_BUILD_FUZZERS=ON -DUH_BUILD_APPS=OFF -DUH_BUILD_BENCHMARKS=OFF; then
-    run_ctest fuzz build/fuzz -R '^(ist_|scene_parser_fuzz|csv_reader_fuzz|service_protocol_fuzz|service_mesh_binary_fuzz|mesh_reader_fuzz)'
+    run_ctest fuzz build/fuzz -R '^(ist_|scene_parser_fuzz|csv_reader_fuzz|service_protocol_fuzz|service_mesh_binary_fuzz|mesh_reader_fuzz|museum_protocol_fuzz)'
   else
     echo "test: fuzzer build failed"; status=1; failed=$((failed + 1))
   fi

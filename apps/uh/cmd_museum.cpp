@@ -16,6 +16,7 @@
 #include "progress_bar.hpp"
 #include "uh/museum/level.hpp"
 #include "uh/museum_players/blind_player.hpp"
+#include "uh/museum_artifacts/artifact.hpp"
 #include "uh/museum_service/game_server.hpp"
 
 namespace uh::cli {
@@ -36,6 +37,7 @@ int museum_serve(const MuseumServeArgs& args) {
   museum::Level level =
       museum::make_level(args.level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy);
   if (args.minutes > 0.0) level.rules.round_s = args.minutes * 60.0;
+  level.pieces = museum_artifacts::piece_pairs(level);  // what Phantom's station is told to build
   // the seed deals where the forgeries are: a fixed default would let a player deal the same round
   // offline and read the answers, so an unseeded round draws one from the system
   const std::uint64_t seed =

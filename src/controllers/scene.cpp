@@ -15,7 +15,7 @@
 #include "uh/collette/mesh_import.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/core/atomic_file_writer.hpp"
-#include "uh/core/json_nesting.hpp"
+#include "uh/core/json_fields.hpp"
 #include "uh/core/regular_file.hpp"
 
 namespace uh::controllers {
@@ -523,16 +523,9 @@ Status read_tools(const FieldReader& r, const json& root, const std::filesystem:
 }
 
 Result<json> parse_json(std::string_view json_text, const std::string& source) {
-  // the same guard as the service's messages: nothing below recurses deeply on a file's text
-  if (json_nesting_depth(json_text) > kMaxJsonNesting)
-    return Error{fmt::format("{}: the JSON is nested deeper than {} levels", source, kMaxJsonNesting)};
-  try {
-    return json::parse(json_text);
-  } catch (const json::exception& e) {
-    // parse_error for bad syntax, out_of_range for a number too large for a double (found by the
-    // scene fuzzer): both are the text's fault
-    return Error{fmt::format("{}: not valid JSON: {}", source, e.what())};
-  }
+  auto document = parse_json_document(json_text);
+  if (!document) return Error{fmt::format("{}: {}", source, document.error().message)};
+  return document;
 }
 
 }  // namespace

@@ -152,30 +152,23 @@ Status validate(const Level& level) {
     }
   }
   const RuleNumbers& r = level.rules;
-  const std::pair<const char*, double> positive[] = {
-      {"tick_s", r.tick_s},
-      {"round_s", r.round_s},
-      {"walk_speed", r.walk_speed},
-      {"run_speed", r.run_speed},
-      {"reach", r.reach},
-      {"run_hear_radius", r.run_hear_radius},
-      {"glass_hear_radius", r.glass_hear_radius},
-      {"view_range", r.view_range},
-      {"view_half_angle_deg", r.view_half_angle_deg},
-      {"patrol_speed", r.patrol_speed},
-      {"investigate_speed", r.investigate_speed},
-  };
-  for (const auto& [field, value] : positive) {
-    if (!(value > 0.0) || !std::isfinite(value))
-      return Error{fmt::format("{}: rules.{} is {}, must be positive", name, field, value)};
+  for (const RuleField& f : kRuleFields) {
+    const double value = r.*f.value;
+    if (f.positive && (!(value > 0.0) || !std::isfinite(value)))
+      return Error{fmt::format("{}: rules.{} is {}, must be positive", name, f.name, value)};
+    if (!f.positive && (!(value >= 0.0) || !std::isfinite(value)))
+      return Error{fmt::format("{}: rules.{} is {}, must be 0 or more", name, f.name, value)};
   }
-  const std::pair<const char*, double> non_negative[] = {{"linger_s", r.linger_s},
-                                                         {"caught_penalty_s", r.caught_penalty_s},
-                                                         {"caught_grace_s", r.caught_grace_s},
-                                                         {"time_bonus_per_s", r.time_bonus_per_s}};
-  for (const auto& [field, value] : non_negative) {
-    if (!(value >= 0.0) || !std::isfinite(value))
-      return Error{fmt::format("{}: rules.{} is {}, must be 0 or more", name, field, value)};
+  if (!level.pieces.empty() && level.pieces.size() != level.artifact_kinds.size())
+    return Error{fmt::format("{}: {} piece pairs for {} artifact kinds", name, level.pieces.size(),
+                             level.artifact_kinds.size())};
+  for (std::size_t k = 0; k < level.pieces.size(); ++k) {
+    for (const PieceForm* form : {&level.pieces[k].genuine, &level.pieces[k].forgery}) {
+      if (form->kind != level.artifact_kinds[k] || form->difficulty != level.difficulty)
+        return Error{fmt::format("{}: the pieces of kind {} are {} ({}), not {} ({})", name, k, form->kind,
+                                 to_string(form->difficulty), level.artifact_kinds[k],
+                                 to_string(level.difficulty))};
+    }
   }
   if (r.view_half_angle_deg > 180.0)
     return Error{fmt::format("{}: rules.view_half_angle_deg {} is over 180", name, r.view_half_angle_deg)};

@@ -141,6 +141,17 @@ collette::TriangleMesh relief_slab(int nx, int ny, double w, double d, Height he
 
 bool easy(Difficulty d) { return d == Difficulty::easy; }
 
+// a piece's surface: the gradient law's stiffness [N/m^2] and Coulomb friction
+forcecomp::Material surface_material(double stiffness, double friction_static, double friction_dynamic) {
+  forcecomp::Material m;
+  m.has_stiffness = true;
+  m.stiffness = stiffness;
+  m.has_friction = true;
+  m.friction_static = friction_static;
+  m.friction_dynamic = friction_dynamic;
+  return m;
+}
+
 // grooves of depth 1 every `spacing`, each `width` wide (standard deviation), across [-half, half]
 double grooves(double x, double spacing, double width, double half) {
   double g = 0.0;
@@ -250,12 +261,7 @@ forcecomp::Material artifact_material(ArtifactKind kind, Difficulty difficulty, 
     }
     return {1.5e5, 0.4, 0.3};
   }();
-  forcecomp::Material m;
-  m.has_stiffness = true;
-  m.stiffness = g.stiffness;
-  m.has_friction = true;
-  m.friction_static = g.friction_static;
-  m.friction_dynamic = g.friction_dynamic;
+  forcecomp::Material m = surface_material(g.stiffness, g.friction_static, g.friction_dynamic);
   if (piece == Piece::forgery) {
     const MaterialTell t = material_tell(kind, difficulty);
     if (t.property == "stiffness") m.stiffness *= t.ratio;
@@ -267,16 +273,18 @@ forcecomp::Material artifact_material(ArtifactKind kind, Difficulty difficulty, 
   return m;
 }
 
-collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, Piece piece) {
-  const Tell t = tell(kind, difficulty);
-  const bool genuine = piece == Piece::genuine;
+namespace {
+
+// the mesh of a form check_form() accepted
+collette::TriangleMesh mesh_of(ArtifactKind kind, const museum::PieceForm& form) {
+  const Tell t = tell(kind, form.difficulty);
+  const double feature = form.feature;
   collette::TriangleMesh mesh;
   switch (kind) {
     case ArtifactKind::amphora: {
       const Profile p{{{0.0, 0.025}, {0.05, 0.045}, {0.10, 0.015}, {0.12, 0.02}}};
-      mesh = lathe(240, 128, 0.0, 0.12, [&](double z, double) {
-        return p(z) + (genuine ? t.depth * bump(z - 0.075, t.width / 2.0) : 0.0);
-      });
+      mesh = lathe(240, 128, 0.0, 0.12,
+                   [&](double z, double) { return p(z) + feature * bump(z - 0.075, t.width / 2.0); });
       break;
     }
     case ArtifactKind::bowl: {
@@ -284,13 +292,13 @@ collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, P
       mesh = lathe(100, 192, 0.0, 0.05, [&](double z, double theta) {
         // the dent faces +x, halfway up
         const double arc = std::remainder(theta, 2.0 * kPi) * p(z);
-        const double dent = genuine ? 0.0 : t.depth * bump(std::hypot(z - 0.025, arc), t.width / 2.0);
+        const double dent = feature * bump(std::hypot(z - 0.025, arc), t.width / 2.0);
         return p(z) - dent;
       });
       break;
     }
     case ArtifactKind::coin: {
-      const int count = genuine ? 24 : (easy(difficulty) ? 14 : 18);
+      const auto count = static_cast<int>(std::lround(feature));
       mesh = lathe(32, 384, 0.0, 0.008, [&](double z, double theta) {
         // rounded rims, the reeding on the band between them
         const double rim = 0.0008 * (1.0 - smooth_step(z, 0.0, 0.0015) * smooth_step(0.008 - z, 0.0, 0.0015));
@@ -301,7 +309,7 @@ collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, P
       break;
     }
     case ArtifactKind::tablet: {
-      const double spacing = genuine ? 0.008 : (easy(difficulty) ? 0.014 : 0.011);
+      const double spacing = feature;
       mesh = relief_slab(180, 60, 0.09, 0.06, [&](double x, double y) {
         // grooves across the tablet, fading out 6 mm before its edges
         const double inside =
@@ -315,8 +323,7 @@ collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, P
         const double e2 = (x / 0.036) * (x / 0.036) + (y / 0.026) * (y / 0.026);
         const double dome = 0.016 * std::sqrt(std::max(0.0, 1.0 - e2));
         // the ridge between the wing cases runs along x on the dome's back
-        const double ridge =
-            genuine ? t.depth * bump(y, t.width / 2.0) * smooth_step(1.0 - e2, 0.0, 0.3) : 0.0;
+        const double ridge = feature * bump(y, t.width / 2.0) * smooth_step(1.0 - e2, 0.0, 0.3);
         return 0.004 + dome + ridge;
       });
       break;
@@ -327,26 +334,109 @@ collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, P
       mesh = lathe(220, 256, 0.0, 0.11, [&](double z, double theta) {
         // the seam runs up the cup on the -x side
         const double arc = std::remainder(theta - kPi, 2.0 * kPi) * p(z);
-        const double seam = genuine ? 0.0 : t.depth * bump(arc, t.width / 2.0) * smooth_step(z, 0.065, 0.075);
+        const double seam = feature * bump(arc, t.width / 2.0) * smooth_step(z, 0.065, 0.075);
         return p(z) + seam;
       });
       break;
     }
   }
+  // named by its kind and form only: the file a station writes never says which piece it holds
   mesh.source_name =
-      fmt::format("{} {} ({})", to_string(piece), to_string(kind), museum::to_string(difficulty));
+      fmt::format("{} ({}, feature {:.4g})", to_string(kind), museum::to_string(form.difficulty), feature);
   return mesh;
 }
 
-Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, Difficulty difficulty, Piece piece,
+}  // namespace
+
+museum::PieceForm piece_form(ArtifactKind kind, Difficulty difficulty, Piece piece) {
+  const bool genuine = piece == Piece::genuine;
+  const double h = tell(kind, difficulty).depth;
+  double feature = 0.0;
+  switch (kind) {
+    case ArtifactKind::amphora:
+    case ArtifactKind::scarab:
+      feature = genuine ? h : 0.0;  // the genuine piece's ridge
+      break;
+    case ArtifactKind::bowl:
+    case ArtifactKind::goblet:
+      feature = genuine ? 0.0 : h;  // the forgery's dent or seam
+      break;
+    case ArtifactKind::coin:
+      feature = genuine ? 24 : (easy(difficulty) ? 14 : 18);  // reeds
+      break;
+    case ArtifactKind::tablet:
+      feature = genuine ? 0.008 : (easy(difficulty) ? 0.014 : 0.011);  // groove spacing [m]
+      break;
+  }
+  const forcecomp::Material m = artifact_material(kind, difficulty, piece);
+  return {.kind = to_string(kind),
+          .difficulty = difficulty,
+          .feature = feature,
+          .stiffness = m.stiffness,
+          .friction_static = m.friction_static,
+          .friction_dynamic = m.friction_dynamic};
+}
+
+std::vector<museum::PiecePair> piece_pairs(const museum::Level& level) {
+  std::vector<museum::PiecePair> pairs;
+  for (const std::string& name : level.artifact_kinds) {
+    const auto kind = artifact_kind(name);
+    if (!kind) return {};
+    pairs.push_back({piece_form(*kind, level.difficulty, Piece::genuine),
+                     piece_form(*kind, level.difficulty, Piece::forgery)});
+  }
+  return pairs;
+}
+
+Result<ArtifactKind> check_form(const museum::PieceForm& form) {
+  const auto kind = artifact_kind(form.kind);
+  if (!kind) return Error{fmt::format("'{}' is no artifact kind", form.kind)};
+  struct Range {
+    double lo, hi;
+    const char* what;
+  };
+  const Range feature = [&]() -> Range {
+    switch (*kind) {
+      case ArtifactKind::coin:
+        return {4.0, 64.0, "reeds"};
+      case ArtifactKind::tablet:
+        return {0.004, 0.03, "groove spacing [m]"};
+      default:
+        return {0.0, 0.01, "feature height [m]"};
+    }
+  }();
+  const auto outside = [](double v, double lo, double hi) { return !(v >= lo && v <= hi); };
+  if (outside(form.feature, feature.lo, feature.hi))
+    return Error{fmt::format("the {}'s {} {} is not within {}..{}", form.kind, feature.what, form.feature,
+                             feature.lo, feature.hi)};
+  if (outside(form.stiffness, 1e3, 1e7))
+    return Error{
+        fmt::format("the {}'s stiffness {} N/m^2 is not within 1e3..1e7", form.kind, form.stiffness)};
+  if (outside(form.friction_static, 0.0, 2.0) || outside(form.friction_dynamic, 0.0, 2.0))
+    return Error{fmt::format("the {}'s friction {} / {} is not within 0..2", form.kind, form.friction_static,
+                             form.friction_dynamic)};
+  return *kind;
+}
+
+Result<collette::TriangleMesh> artifact_mesh(const museum::PieceForm& form) {
+  const auto kind = check_form(form);
+  if (!kind) return kind.error();
+  return mesh_of(*kind, form);
+}
+
+collette::TriangleMesh artifact_mesh(ArtifactKind kind, Difficulty difficulty, Piece piece) {
+  return mesh_of(kind, piece_form(kind, difficulty, piece));
+}
+
+Result<controllers::SceneShape> artifact_shape(const museum::PieceForm& form,
                                                const std::filesystem::path& cache_dir, std::int64_t spheres) {
-  const collette::TriangleMesh mesh = artifact_mesh(kind, difficulty, piece);
+  auto mesh = artifact_mesh(form);
+  if (!mesh) return mesh.error();
   const std::string obj = collette::obj_text(
-      mesh, fmt::format("{}: a museum artifact generated by UnrealHaptics (metres)", mesh.source_name));
+      *mesh, fmt::format("{}: a museum artifact generated by UnrealHaptics (metres)", mesh->source_name));
   const std::uint64_t hash = collette::ist_hash_bytes(std::as_bytes(std::span<const char>(obj)));
   const auto path = cache_dir / "museum-artifacts" /
-                    fmt::format("{}-{}-{}-{:016x}.obj", to_string(kind), museum::to_string(difficulty),
-                                to_string(piece), hash);
+                    fmt::format("{}-{}-{:016x}.obj", form.kind, museum::to_string(form.difficulty), hash);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     std::filesystem::create_directories(path.parent_path(), ec);
@@ -358,14 +448,29 @@ Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, Difficulty dif
   return controllers::SceneShape{.mesh = path, .spheres = spheres, .meters_per_unit = 1.0};
 }
 
+Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, Difficulty difficulty, Piece piece,
+                                               const std::filesystem::path& cache_dir, std::int64_t spheres) {
+  return artifact_shape(piece_form(kind, difficulty, piece), cache_dir, spheres);
+}
+
+Result<controllers::SceneObject> artifact_object(const museum::PieceForm& form,
+                                                 const std::filesystem::path& cache_dir,
+                                                 const std::string& name, const Pose& pose,
+                                                 std::int64_t spheres) {
+  auto shape = artifact_shape(form, cache_dir, spheres);
+  if (!shape) return shape.error();
+  return controllers::SceneObject{
+      .name = name,
+      .shape = *shape,
+      .pose = pose,
+      .material = surface_material(form.stiffness, form.friction_static, form.friction_dynamic)};
+}
+
 Result<controllers::SceneObject> artifact_object(ArtifactKind kind, Difficulty difficulty, Piece piece,
                                                  const std::filesystem::path& cache_dir,
                                                  const std::string& name, const Pose& pose,
                                                  std::int64_t spheres) {
-  auto shape = artifact_shape(kind, difficulty, piece, cache_dir, spheres);
-  if (!shape) return shape.error();
-  return controllers::SceneObject{
-      .name = name, .shape = *shape, .pose = pose, .material = artifact_material(kind, difficulty, piece)};
+  return artifact_object(piece_form(kind, difficulty, piece), cache_dir, name, pose, spheres);
 }
 
 }  // namespace uh::museum_artifacts

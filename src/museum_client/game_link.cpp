@@ -66,7 +66,8 @@ struct GameLink::Impl {
   void note(LinkNote n) {
     flush_backlog();
     if (backlog.empty() && inbox.try_push(std::move(n))) return;
-    if (n.kind == LinkNote::Kind::message && std::holds_alternative<Snapshot>(n.message)) return;
+    if (n.kind == LinkNote::Kind::message && std::holds_alternative<museum_protocol::Snapshot>(n.message))
+      return;
     backlog.push_back(std::move(n));
   }
   void flush_backlog() {
@@ -86,11 +87,14 @@ struct GameLink::Impl {
     if (ever_connected) note({.kind = LinkNote::Kind::reconnected});
     ever_connected = true;
     told_dropped = false;
-    client->send(hello_text(options.role, options.token, seat_key));
+    client->send(museum_protocol::write_message(museum_protocol::HelloMessage{
+        .role = museum_protocol::role_named(options.role).value_or(museum_protocol::Role::none),
+        .token = options.token,
+        .seat_key = seat_key}));
   }
 
   void take(std::string text) {
-    auto parsed = parse_server_message(text);
+    auto parsed = museum_protocol::read_server_message(text);
     // the seat this link took is taken again with its key after a dropped connection
     if (parsed)
       if (const auto* w = std::get_if<Welcome>(&*parsed); w != nullptr && !w->seat_key.empty())
@@ -170,7 +174,7 @@ Result<std::unique_ptr<GameLink>> GameLink::connect(const LinkOptions& options) 
       return Error{
           fmt::format("museum server at {}: {} (is `uh museum serve` running there?)", options.url, n.text)};
     if (n.kind != LinkNote::Kind::message) continue;
-    if (const auto* e = std::get_if<ServerError>(&n.message)) {
+    if (const auto* e = std::get_if<museum_protocol::ServerError>(&n.message)) {
       if (e->request == "hello" || e->request.empty())
         return Error{fmt::format("museum server at {} refused {}: {}{}", options.url, options.role,
                                  e->message,

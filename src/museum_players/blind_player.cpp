@@ -37,8 +37,8 @@ constexpr int kTopPresses = 24;
 constexpr double kTopPressRingsM[2] = {0.004, 0.008};  // every other press on the outer ring
 constexpr double kPressReadDepthM = 0.0008;
 constexpr double kPressMaxForceN = 20.0;
-constexpr double kSlideForceN = 1.5;      // normal force held on the survey's long strokes and contours
-constexpr double kEdgeClearM = 0.006;     // side contours stay this far from the base and the top
+constexpr double kSlideForceN = 1.5;   // normal force held on the survey's long strokes and contours
+constexpr double kEdgeClearM = 0.006;  // side contours stay this far from the base and the top
 
 struct Bounds {
   Vec3 lo{1e300, 1e300, 1e300};
@@ -306,7 +306,7 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
 
 namespace {
 
-constexpr double kSurfaceFloorM = 0.0003;    // a surface difference under 0.3 mm is not told apart
+constexpr double kSurfaceFloorM = 0.0003;  // a surface difference under 0.3 mm is not told apart
 // nor stiffness under 25 % (a hand's Weber fraction for stiffness is about 23 %, Jones and Hunter 1990;
 // a pad press also reads the packing's grain under it)
 constexpr double kStiffnessFloor = 0.25;
@@ -418,7 +418,8 @@ double surface_difference(const SurfaceTrack& a, const SurfaceTrack& b, bool wal
     const std::ptrdiff_t from = std::max(trim, trim - k), to = std::min(na - trim, nb - trim - k);
     if (to - from < need) continue;
     const auto n = static_cast<std::size_t>(to - from);
-    std::vector<double> d = detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step);
+    std::vector<double> d =
+        detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step);
     if (wall_only) {
       // only where b's surface rises more steeply than it turns in or out (a wall, not a shelf)
       const auto& h = b.height;
@@ -463,7 +464,8 @@ bool shelf_near(const SurfaceTrack& profile, double z) {
   };
   const std::ptrdiff_t lo = at(z - kSteepWindowM), hi = at(z + kSteepWindowM);
   if (lo < 0 || hi >= n || hi <= lo) return true;
-  return std::fabs(profile.height[static_cast<std::size_t>(hi)] - profile.height[static_cast<std::size_t>(lo)]) >
+  return std::fabs(profile.height[static_cast<std::size_t>(hi)] -
+                   profile.height[static_cast<std::size_t>(lo)]) >
          kContourSteepest * static_cast<double>(hi - lo) * profile.step;
 }
 
@@ -566,6 +568,46 @@ bool turned_on_the_table(museum_artifacts::ArtifactKind kind) {
   return kind != ArtifactKind::tablet && kind != ArtifactKind::scarab;
 }
 
+Placement place_on_table(museum_artifacts::ArtifactKind kind, core::SplitMix64& deal) {
+  Placement at;
+  at.turn_rad = turned_on_the_table(kind) ? 2.0 * kPi * deal.uniform() : 0.0;
+  at.x = (deal.uniform() - 0.5) * 0.004;
+  at.y = (deal.uniform() - 0.5) * 0.004;
+  return at;
+}
+
+Result<PieceSurvey> survey_form(const museum::PieceForm& form, const Placement& at,
+                                const SurveyOptions& options, const std::filesystem::path& cache_dir) {
+  const Pose pose{quat_from_axis_angle({0, 0, 1}, at.turn_rad), {at.x, at.y, 0.0}};
+  auto object = museum_artifacts::artifact_object(form, cache_dir, form.kind, pose);
+  if (!object) return object.error();
+  return survey_piece(*object, options, cache_dir);
+}
+
+Result<Reference> study_reference(museum_artifacts::ArtifactKind kind, museum::Difficulty difficulty,
+                                  const SurveyOptions& options, const std::filesystem::path& cache_dir,
+                                  core::SplitMix64& deal, const std::function<void()>& before_each) {
+  const museum::PieceForm genuine =
+      museum_artifacts::piece_form(kind, difficulty, museum_artifacts::Piece::genuine);
+  SurveyOptions first_options = options;
+  first_options.seed = deal.next();
+  if (before_each) before_each();
+  auto first = survey_form(genuine, {}, first_options, cache_dir);
+  if (!first) return first.error();
+  // the judge's rounds have always drawn the second study in this order: its seed, then the shift
+  // (y before x), then the turn
+  SurveyOptions again_options = options;
+  again_options.seed = deal.next();
+  Placement at;
+  at.y = (deal.uniform() - 0.5) * 0.004;
+  at.x = (deal.uniform() - 0.5) * 0.004;
+  at.turn_rad = turned_on_the_table(kind) ? 2.0 * kPi * deal.uniform() : 0.0;
+  if (before_each) before_each();
+  auto again = survey_form(genuine, at, again_options, cache_dir);
+  if (!again) return again.error();
+  return Reference{std::move(*first), std::move(*again)};
+}
+
 Result<JudgeReport> run_judge(const JudgeOptions& options) {
   using museum_artifacts::Piece;
   JudgeReport report;
@@ -579,29 +621,17 @@ Result<JudgeReport> run_judge(const JudgeOptions& options) {
   std::size_t correct = 0, judged = 0;
   for (const museum_artifacts::ArtifactKind kind : options.kinds) {
     const std::string kind_name = museum_artifacts::to_string(kind);
-    const auto explore = [&](Piece piece, double turn, double offset_x, double offset_y,
-                             std::uint64_t seed) -> Result<PieceSurvey> {
+    const auto progress = [&] {
       if (options.progress)
-        options.progress(fmt::format("{} {}", kind_name, done < 2 ? "reference" : "piece"),
+        options.progress(fmt::format("{} {}", kind_name, done % 4 < 2 ? "reference" : "piece"),
                          static_cast<double>(done) / static_cast<double>(total));
-      const Pose pose{quat_from_axis_angle({0, 0, 1}, turn), {offset_x, offset_y, 0.0}};
-      auto object =
-          museum_artifacts::artifact_object(kind, options.difficulty, piece, cache, kind_name, pose);
-      if (!object) return object.error();
-      SurveyOptions survey = options.survey;
-      survey.seed = seed;
-      auto result = survey_piece(*object, survey, cache);
       ++done;
-      return result;
     };
-    const auto turn = [&] { return turned_on_the_table(kind) ? 2.0 * kPi * deal.uniform() : 0.0; };
-    const auto off = [&] { return (deal.uniform() - 0.5) * 0.004; };
     done = static_cast<std::size_t>(&kind - options.kinds.data()) * 4;
-    // the genuine reference, explored twice (two turns, two seeds): how much it differs from itself
-    auto reference = explore(Piece::genuine, 0.0, 0.0, 0.0, deal.next());
-    if (!reference) return reference.error();
-    auto again = explore(Piece::genuine, turn(), off(), off(), deal.next());
-    if (!again) return again.error();
+    auto studied = study_reference(kind, options.difficulty, options.survey, cache, deal, progress);
+    if (!studied) return studied.error();
+    const PieceSurvey& reference = studied->first;
+    const PieceSurvey& again = studied->again;
     PairResult pair;
     pair.kind = kind;
     pair.tell = museum_artifacts::tell(kind, options.difficulty).description;
@@ -611,18 +641,22 @@ Result<JudgeReport> run_judge(const JudgeOptions& options) {
          {genuine_first ? Piece::genuine : Piece::forgery, genuine_first ? Piece::forgery : Piece::genuine}) {
       PieceResult r;
       r.truth = truth;
-      r.turn_rad = turn();
-      const double x = off(), y = off();
-      auto survey = explore(truth, r.turn_rad, x, y, deal.next());
+      const Placement at = place_on_table(kind, deal);
+      r.turn_rad = at.turn_rad;
+      SurveyOptions survey_options = options.survey;
+      survey_options.seed = deal.next();
+      progress();
+      auto survey = survey_form(museum_artifacts::piece_form(kind, options.difficulty, truth), at,
+                                survey_options, cache);
       if (!survey) return survey.error();
-      r.judgement = judge_piece(*survey, *reference, *again);
+      r.judgement = judge_piece(*survey, reference, again);
       r.simulated_s = survey->simulated_s;
       report.simulated_s += survey->simulated_s;
       correct += r.correct() ? 1 : 0;
       ++judged;
       pair.pieces.push_back(std::move(r));
     }
-    report.simulated_s += reference->simulated_s + again->simulated_s;
+    report.simulated_s += reference.simulated_s + again.simulated_s;
     report.pairs.push_back(std::move(pair));
   }
   if (options.progress) options.progress("done", 1.0);

@@ -11,14 +11,24 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
 
-#include "game_messages.hpp"
 #include "uh/core/log.hpp"
 #include "uh/museum/rules.hpp"
+#include "uh/museum_protocol/messages.hpp"
+#include "uh/museum_protocol/views.hpp"
 
 namespace uh::museum_service {
 namespace {
 
 namespace asio = boost::asio;
+namespace protocol = museum_protocol;
+using nlohmann::json;
+using protocol::Action;
+using protocol::ActionMessage;
+using protocol::HelloMessage;
+using protocol::MoveMessage;
+using protocol::PingMessage;
+using protocol::Role;
+using protocol::VerdictMessage;
 using net::Peer;
 using Clock = std::chrono::steady_clock;
 
@@ -122,12 +132,12 @@ class GameHub final : public net::Endpoint {
     if (it == clients_.end() || shut_down_) return;
     Client& c = it->second;
     if (c.failed_hellos >= kMaxFailedHellos) return;  // being closed
-    const ParsedMessage m = parse_message(text);
+    const protocol::ParsedClientMessage m = protocol::read_client_message(text);
     if (!m.body) return refuse(id, c, m.id, m.type, m.error);
     if (!c.greeted && !std::holds_alternative<HelloMessage>(*m.body)) {
       return refuse(id, c, m.id, m.type,
                     fmt::format("send hello first: {{\"type\":\"hello\",\"protocol\":{},\"role\":\"vive\"}}",
-                                kGameProtocolVersion));
+                                protocol::kProtocolVersion));
     }
     std::visit([&](const auto& body) { handle(id, c, m.id, m.type, body); }, *m.body);
   }
@@ -185,7 +195,8 @@ class GameHub final : public net::Endpoint {
           "museum: client {} ({}): refused {}: {}{}", id, c.peer->address(),
           type.empty() ? std::string("a message") : loggable(type), loggable(message),
           c.refusals == kLoggedRefusalsPerClient ? " (further refusals of this client are not logged)" : "");
-    c.peer->send(error_message(req_id, type, message).dump());
+    c.peer->send(protocol::write_message(
+        protocol::ServerError{.id = req_id, .request = std::string(type), .message = message}));
   }
 
   // a failed hello: refused, and the client closed after a few (or at once when many clients fail)
@@ -233,10 +244,10 @@ class GameHub final : public net::Endpoint {
     if (!c.greeted && !may_try_hello(c)) return;
     if (c.greeted)
       return refuse(id, c, req_id, type, fmt::format("already greeted as {}", to_string(c.role)));
-    if (h.protocol != kGameProtocolVersion)
+    if (h.protocol != protocol::kProtocolVersion)
       return refuse(id, c, req_id, type,
                     fmt::format("protocol {} is not supported; this server speaks {}", h.protocol,
-                                kGameProtocolVersion));
+                                protocol::kProtocolVersion));
     if (!token_.empty() && !net::same_token(h.token, token_))
       return refuse_hello(id, c, req_id,
                           h.token.empty() ? "this server needs a token" : "the token is wrong");
@@ -256,26 +267,19 @@ class GameHub final : public net::Endpoint {
     if (h.role == Role::phantom && !same_station) phantom_seat_key_ = make_seat_key();
     c.greeted = true;
     c.role = h.role;
-    json targets = json::array();
-    for (int t = 0; t < state_.target_count; ++t)
-      targets.push_back(
-          level_.artifact_kinds[static_cast<std::size_t>(state_.target_kinds[static_cast<std::size_t>(t)])]);
     // no seed: a client given it could deal the round itself and know every genuine piece
-    json welcome = {{"type", "welcome"},
-                    {"id", req_id},
-                    {"protocol", kGameProtocolVersion},
-                    {"role", to_string(h.role)},
-                    {"level", level_json(level_)},
-                    {"targets", targets}};
-    if (h.role == Role::phantom) welcome["seat_key"] = phantom_seat_key_;
-    c.peer->send(welcome.dump());
+    protocol::Welcome welcome = protocol::welcome_of(level_, state_, h.role);
+    welcome.id = req_id;
+    if (h.role == Role::phantom) welcome.seat_key = phantom_seat_key_;
+    c.peer->send(protocol::write_message(welcome));
     if (h.role == Role::vive || h.role == Role::phantom) {
       log_players("{} joined ({})", to_string(h.role), c.peer->address());
       update_pause();
     }
-    c.peer->send(snapshot().dump());
+    c.peer->send(snapshot());
     if (h.role == Role::phantom) send_in_hands(c);
-    if (summary_sent_) c.peer->send(summary_json(level_, museum::summarize(level_, state_)).dump());
+    if (summary_sent_)
+      c.peer->send(protocol::write_message(protocol::summary_of(level_, museum::summarize(level_, state_))));
   }
 
   void handle(ClientId id, Client& c, const json& req_id, const std::string& type, const MoveMessage& m) {
@@ -307,7 +311,7 @@ class GameHub final : public net::Endpoint {
   }
 
   void handle(ClientId, Client& c, const json& req_id, const std::string&, const PingMessage&) {
-    c.peer->send(json{{"type", "pong"}, {"id", req_id}, {"tick", state_.tick}}.dump());
+    c.peer->send(protocol::write_message(protocol::Pong{.id = req_id, .tick = state_.tick}));
   }
 
   // the round plays while both players are connected; after a pause it resumes resume_delay_ after
@@ -340,15 +344,16 @@ class GameHub final : public net::Endpoint {
     return state_.paused ? "paused" : "playing";
   }
 
-  json snapshot() const {
-    return snapshot_json(level_, state_, phase(), role_connected(Role::vive), role_connected(Role::phantom));
+  std::string snapshot() const {
+    return protocol::write_message(protocol::snapshot_of(level_, state_, phase(), role_connected(Role::vive),
+                                                         role_connected(Role::phantom)));
   }
 
   void broadcast(const std::string& text, bool is_state = false) {
     for (auto& [id, c] : clients_)
       if (c.greeted) c.peer->send(text, is_state);
   }
-  void broadcast_snapshot() { broadcast(snapshot().dump(), true); }
+  void broadcast_snapshot() { broadcast(snapshot(), true); }
 
   void schedule() {
     timer_.expires_at(next_tick_);
@@ -387,13 +392,13 @@ class GameHub final : public net::Endpoint {
     }
     museum::step(level_, state_, input, events_);
     for (int i = 0; i < events_.count; ++i)
-      broadcast(event_json(events_.list[static_cast<std::size_t>(i)]).dump());
+      broadcast(protocol::write_message(protocol::GameEvent{events_.list[static_cast<std::size_t>(i)]}));
     if (state_.phase == museum::Phase::ended && !summary_sent_) {
       summary_sent_ = true;
       const museum::RoundSummary summary = museum::summarize(level_, state_);
       log::info("museum: the round ended: {} points", summary.score.points);
       broadcast_snapshot();
-      broadcast(summary_json(level_, summary).dump());
+      broadcast(protocol::write_message(protocol::summary_of(level_, summary)));
     }
     if (++server_ticks_ % snapshot_every_ == 0) broadcast_snapshot();
     const int front = state_.table_count > 0 ? state_.table[0] : -1;
@@ -407,7 +412,7 @@ class GameHub final : public net::Endpoint {
   // the artifact now in Phantom's hands, to Phantom only (nothing when the table is empty)
   void send_in_hands(Client& c) {
     if (state_.table_count == 0 || state_.phase == museum::Phase::ended) return;
-    c.peer->send(in_hands_json(level_, state_, state_.table[0]).dump());
+    c.peer->send(protocol::write_message(protocol::in_hand_of(level_, state_, state_.table[0])));
   }
 
   museum::Level level_;
@@ -453,6 +458,10 @@ GameServer::~GameServer() { stop(); }
 Result<std::unique_ptr<GameServer>> GameServer::start(GameServerOptions options) {
   if (const Status valid = museum::validate(options.level); !valid)
     return Error{"level: " + valid.error().message};
+  if (options.level.pieces.empty())
+    return Error{
+        "level: no pieces: Phantom's station is told the form of each piece it holds "
+        "(museum_artifacts::piece_pairs)"};
   if (!(options.snapshot_hz >= 20.0 && options.snapshot_hz <= 30.0))
     return Error{fmt::format("snapshot rate {} Hz is not within 20..30 Hz", options.snapshot_hz)};
   if (!(options.speed >= 0.1 && options.speed <= 20.0))

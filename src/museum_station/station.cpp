@@ -13,9 +13,8 @@
 
 namespace uh::museum_station {
 
-using museum_client::GuardView;
-using museum_client::ServerError;
-using museum_client::verdict_text;
+using museum_protocol::GuardView;
+using museum_protocol::ServerError;
 
 namespace {
 
@@ -185,7 +184,7 @@ void Station::on_snapshot(const Snapshot& s) {
   const bool was_playing = have_snapshot_ && last_snapshot_.phase == "playing";
   last_snapshot_ = s;
   have_snapshot_ = true;
-  for (const museum_client::CaseView& c : s.cases) remember_items({c.item});
+  for (const museum_protocol::CaseView& c : s.cases) remember_items({c.item});
   remember_items(s.carried);
   remember_items(s.table);
   view_.table_count = 0;
@@ -254,10 +253,10 @@ void Station::on_in_hand(const InHand& h) {
 }
 
 Status Station::load_piece(const InHand& h) {
-  const auto kind = museum_artifacts::artifact_kind(h.kind);
-  if (!kind) return Error{fmt::format("'{}' is no artifact kind this station knows", h.kind)};
-  auto object = museum_artifacts::artifact_object(*kind, level_.difficulty, h.piece, options_.cache_dir,
-                                                  h.kind, Pose{});
+  // the station builds the form it is sent: which piece that is, only the server knows
+  if (h.form.kind != h.kind)
+    return Error{fmt::format("the server sent the form of a '{}' for a '{}'", h.form.kind, h.kind)};
+  auto object = museum_artifacts::artifact_object(h.form, options_.cache_dir, h.kind, Pose{});
   if (!object) return object.error();
   auto tree = controllers::load_shape_tree(object->shape, options_.cache_dir, options_.build_progress);
   if (!tree) return tree.error();
@@ -351,7 +350,8 @@ void Station::give_verdict(museum::Verdict verdict) {
   for (const auto& [item, v] : verdicts_sent_)
     if (item == in_hand_.item)
       return say("You already gave your verdict on this piece.", "Already judged", false);
-  if (link_ == nullptr || !link_->send(verdict_text(in_hand_.item, verdict)))
+  if (link_ == nullptr ||
+      !link_->send(museum_protocol::write_message(museum_protocol::VerdictMessage{in_hand_.item, verdict})))
     return say("The verdict could not be sent; try again.", "Verdict not sent", true);
   verdicts_sent_.emplace_back(in_hand_.item, verdict);
   if (sound_) sound_->earcon(kVerdictSentEarcon);

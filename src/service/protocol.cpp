@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "uh/core/json_nesting.hpp"
+#include "uh/core/json_fields.hpp"
 
 namespace uh::service {
 namespace {
@@ -225,18 +225,12 @@ std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_hand
 
 ParsedRequest parse_request(std::string_view text) {
   ParsedRequest out;
-  if (json_nesting_depth(text) > kMaxJsonNesting) {
-    out.error = fmt::format("message nested deeper than {} levels", kMaxJsonNesting);
+  auto document = parse_json_document(text);
+  if (!document) {
+    out.error = document.error().message;
     return out;
   }
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {
-    // parse_error for bad syntax, out_of_range for a number too large for a double
-    out.error = fmt::format("not valid JSON: {}", e.what());
-    return out;
-  }
+  const json& j = *document;
   if (!j.is_object()) {
     out.error = fmt::format("expected a JSON object, got {}", j.type_name());
     return out;

@@ -10,6 +10,8 @@
 #include <thread>
 
 #include "../museum/test_levels.hpp"
+#include "uh/museum_artifacts/artifact.hpp"
+#include "uh/museum_protocol/messages.hpp"
 #include "web_socket_test_client.hpp"
 
 namespace uh::museum_service {
@@ -35,7 +37,9 @@ std::optional<json> next_snapshot(Client& c) {
 
 // a round on the open hall: one target, its two pieces side by side, no guards
 GameServerOptions open_hall_round(std::uint64_t seed = 3) {
-  return {.host = "127.0.0.1", .port = 0, .level = museum::test::open_hall(2), .seed = seed};
+  museum::Level level = museum::test::open_hall(2);
+  level.pieces = museum_artifacts::piece_pairs(level);
+  return {.host = "127.0.0.1", .port = 0, .level = level, .seed = seed};
 }
 
 std::unique_ptr<GameServer> start(GameServerOptions options) {
@@ -50,7 +54,7 @@ TEST(MuseumServer, WelcomeCarriesTheLevelAndTheTargets) {
   Client vive(server->port());
   const json w = vive.request(hello_as("vive", {{"id", 7}}), "welcome");
   EXPECT_EQ(w["id"], 7);
-  EXPECT_EQ(w["protocol"], kGameProtocolVersion);
+  EXPECT_EQ(w["protocol"], museum_protocol::kProtocolVersion);
   EXPECT_EQ(w["role"], "vive");
   EXPECT_EQ(w["level"]["rooms"].size(), 1u);
   EXPECT_EQ(w["level"]["cases"].size(), 2u);
@@ -72,7 +76,7 @@ TEST(MuseumServer, BadMessagesGetErrorsNamingTheProblemAndTheConnectionStaysUsab
     std::string expected;
   };
   const std::vector<Case> before_hello = {
-      {"{not json", "not JSON"},
+      {"{not json", "not valid JSON"},
       {"[1, 2]", "must be a JSON object"},
       {R"({"id": 1})", "'type' is missing"},
       {R"({"type": "dance"})", "unknown message type 'dance'"},
@@ -405,6 +409,7 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
   ASSERT_TRUE(server);
   json summary;                             // written by Phantom's thread, read after the join
   std::vector<json> in_hands;               // the same
+  std::vector<json> phantom_heard;          // the same: every message before the summary
   std::atomic<bool> summary_arrived{false};  // what Vive's loop may look at meanwhile
   std::thread phantom_thread([&] {
     Client phantom(server->port());
@@ -421,6 +426,7 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
         summary_arrived.store(true, std::memory_order_release);
         return;
       }
+      phantom_heard.push_back(*m);
       if ((*m)["type"] == "in_hands") in_hands.push_back(*m);
       if ((*m)["type"] != "snapshot" || (*m)["table"].empty()) continue;
       const int item = (*m)["table"][0]["item"];
@@ -476,8 +482,21 @@ TEST(MuseumServer, ScriptedPlayersFinishARoundThroughLatencyAndLoss) {
   EXPECT_NE(in_hands[0]["item"], in_hands[1]["item"]);
   for (const json& h : in_hands) {
     const museum::ItemState& item = end.items[h["item"].get<std::size_t>()];
-    EXPECT_EQ(h["piece"], item.genuine ? "genuine" : "forgery");
     EXPECT_EQ(h["kind"], level.artifact_kinds[static_cast<std::size_t>(item.kind)]);
+    // the form of the piece the server holds it to be, and no word of which piece that is
+    const museum::PiecePair& pair = level.pieces[static_cast<std::size_t>(item.kind)];
+    EXPECT_EQ(h["form"]["feature"].get<double>(), (item.genuine ? pair.genuine : pair.forgery).feature);
+    EXPECT_FALSE(h.contains("piece")) << h.dump();
+    EXPECT_EQ(h.dump().find("genuine"), std::string::npos) << h.dump();
+    EXPECT_EQ(h.dump().find("forgery"), std::string::npos) << h.dump();
+  }
+  // one genuine piece and its forgery came: told in the same fields
+  EXPECT_EQ(in_hands[0]["form"].size(), in_hands[1]["form"].size());
+  // before the summary, nothing Phantom was told names a piece genuine or forged (but its own verdicts)
+  for (const json& m : phantom_heard) {
+    if (m["type"] == "event" && m["event"] == "verdict") continue;
+    EXPECT_EQ(m.dump().find("genuine"), std::string::npos) << m.dump();
+    EXPECT_EQ(m.dump().find("forgery"), std::string::npos) << m.dump();
   }
 }
 

@@ -69,9 +69,17 @@ bool run_station_until(GameLink& link, Station& station, Done done) {
   return false;
 }
 
+// the open hall with its pieces' forms, as a server needs them
+museum::Level hall_with_pieces() {
+  museum::Level level = museum::test::open_hall(2);
+  level.pieces = museum_artifacts::piece_pairs(level);
+  return level;
+}
+
 TEST(MuseumStation, FeelsTheDeliveredPieceSendsAVerdictAndDropsTheForceWithTheServer) {
   // two targets, four cases side by side: Vive takes the pieces of cases 0 and 1
-  const museum::Level level = museum::test::open_hall(4);
+  museum::Level level = museum::test::open_hall(4);
+  level.pieces = museum_artifacts::piece_pairs(level);
   auto server =
       museum_service::GameServer::start({.host = "127.0.0.1", .port = 0, .level = level, .seed = 5});
   ASSERT_TRUE(server) << server.error().message;
@@ -127,8 +135,10 @@ TEST(MuseumStation, FeelsTheDeliveredPieceSendsAVerdictAndDropsTheForceWithTheSe
   const museum::GameState before = (*server)->state();
   ASSERT_GT(before.table_count, 0);
   EXPECT_EQ(before.table[0], first);
-  EXPECT_EQ(before.items[static_cast<std::size_t>(first)].genuine,
-            (*station)->in_hand().piece == museum_artifacts::Piece::genuine);
+  // the form it built is that piece's (the station itself is never told which piece it is)
+  const museum::ItemState& held = before.items[static_cast<std::size_t>(first)];
+  const museum::PiecePair& pair = level.pieces[static_cast<std::size_t>(held.kind)];
+  EXPECT_EQ((*station)->in_hand().form.feature, (held.genuine ? pair.genuine : pair.forgery).feature);
   EXPECT_EQ(
       (*station)->in_hand().kind,
       level.artifact_kinds[static_cast<std::size_t>(before.items[static_cast<std::size_t>(first)].kind)]);
@@ -177,8 +187,8 @@ TEST(MuseumStation, SaysWhenTheServerIsUnreachableOrTheAddressIsWrong) {
   // a port nobody listens on: bind one, note it, close it
   std::uint16_t port = 0;
   {
-    auto server = museum_service::GameServer::start(
-        {.host = "127.0.0.1", .port = 0, .level = museum::test::open_hall(2)});
+    auto server =
+        museum_service::GameServer::start({.host = "127.0.0.1", .port = 0, .level = hall_with_pieces()});
     ASSERT_TRUE(server);
     port = (*server)->port();
   }
@@ -194,7 +204,7 @@ TEST(MuseumStation, SaysWhenTheServerIsUnreachableOrTheAddressIsWrong) {
 
 TEST(MuseumStation, ABadTokenIsRefusedByName) {
   auto server = museum_service::GameServer::start(
-      {.host = "127.0.0.1", .port = 0, .token = "secret", .level = museum::test::open_hall(2)});
+      {.host = "127.0.0.1", .port = 0, .token = "secret", .level = hall_with_pieces()});
   ASSERT_TRUE(server) << server.error().message;
   const std::string url = fmt::format("ws://127.0.0.1:{}/ws", (*server)->port());
   auto wrong = GameLink::connect({.url = url, .token = "guess"});

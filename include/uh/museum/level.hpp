@@ -54,6 +54,28 @@ inline Vec2 normalized(const Vec2& a) {
 enum class Difficulty : std::uint8_t { easy, hard };
 const char* to_string(Difficulty difficulty);
 
+/// One artifact piece as numbers: what Phantom's station needs to build the piece in its hands
+/// (the kind, the difficulty, the size of the kind's surface feature, the material) and nothing
+/// that says whether it is genuine. Only the server, which dealt the round, knows which form is
+/// which piece; museum_artifacts makes the forms (piece_pairs) and builds meshes from them.
+struct PieceForm {
+  std::string kind{};  ///< as in Level::artifact_kinds
+  Difficulty difficulty = Difficulty::easy;
+  /// The kind's surface feature: the height of the amphora's and the scarab's ridge, the depth of
+  /// the bowl's dent, the height of the goblet's seam [m] (0: none); the spacing of the tablet's
+  /// grooves [m]; the number of the coin's reeds.
+  double feature = 0.0;
+  double stiffness = 0.0;         ///< the gradient law's coefficient [N/m^2]
+  double friction_static = 0.0;   ///< Coulomb coefficient
+  double friction_dynamic = 0.0;  ///< Coulomb coefficient
+};
+
+/// The two pieces of one artifact kind.
+struct PiecePair {
+  PieceForm genuine{};
+  PieceForm forgery{};
+};
+
 /// An axis-aligned rectangle of floor [m]; a room or a doorway.
 struct Room {
   std::string name{};
@@ -92,6 +114,32 @@ struct RuleNumbers {
   double time_bonus_per_s = 1.0;      ///< points per second left when every target is settled early
 };
 
+/// The rule numbers by name, listed once: validate() checks each (`positive`: > 0, else >= 0) and
+/// the welcome message tells clients those `told` (the browser draws its rings and cones from them).
+struct RuleField {
+  const char* name;
+  double RuleNumbers::*value;
+  bool positive;
+  bool told;
+};
+inline constexpr RuleField kRuleFields[] = {
+    {"tick_s", &RuleNumbers::tick_s, true, true},
+    {"round_s", &RuleNumbers::round_s, true, true},
+    {"walk_speed", &RuleNumbers::walk_speed, true, true},
+    {"run_speed", &RuleNumbers::run_speed, true, true},
+    {"reach", &RuleNumbers::reach, true, true},
+    {"run_hear_radius", &RuleNumbers::run_hear_radius, true, true},
+    {"glass_hear_radius", &RuleNumbers::glass_hear_radius, true, true},
+    {"view_range", &RuleNumbers::view_range, true, true},
+    {"view_half_angle_deg", &RuleNumbers::view_half_angle_deg, true, true},
+    {"patrol_speed", &RuleNumbers::patrol_speed, true, false},
+    {"investigate_speed", &RuleNumbers::investigate_speed, true, false},
+    {"linger_s", &RuleNumbers::linger_s, false, false},
+    {"caught_penalty_s", &RuleNumbers::caught_penalty_s, false, false},
+    {"caught_grace_s", &RuleNumbers::caught_grace_s, false, false},
+    {"time_bonus_per_s", &RuleNumbers::time_bonus_per_s, false, false},
+};
+
 /// The museum of one round: floor plan, cases, routes, artifacts and rule numbers.
 struct Level {
   std::string name{};
@@ -106,6 +154,9 @@ struct Level {
   std::vector<std::string> artifact_kinds{};
   int target_count = 3;  ///< how many targets Falcon names
   RuleNumbers rules{};
+  /// The two pieces of each kind, in the order of artifact_kinds (museum_artifacts::piece_pairs);
+  /// the server needs them to tell Phantom's station what to build, the rules do not.
+  std::vector<PiecePair> pieces{};
 };
 
 /// Capacities of the game state (game_state.hpp); validate() checks a level fits them.

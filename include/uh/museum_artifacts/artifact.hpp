@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "uh/collette/triangle_mesh.hpp"
 #include "uh/controllers/scene.hpp"
@@ -66,17 +67,40 @@ MaterialTell material_tell(ArtifactKind kind, museum::Difficulty difficulty);
 /// changed by material_tell() on a forgery.
 forcecomp::Material artifact_material(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
 
+/// The piece as the numbers a station builds it from (museum::PieceForm: no label); the mesh and
+/// the material built from it are the piece's, to the bit.
+museum::PieceForm piece_form(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
+/// The two pieces of each of the level's kinds, in its order (for museum::Level::pieces); empty when
+/// a kind is not one of the artifact set.
+std::vector<museum::PiecePair> piece_pairs(const museum::Level& level);
+/// The form's kind when the form is one a station builds: a known kind and its numbers within
+/// bounds (a feature of at most 1 cm, 4..64 reeds, grooves 4..30 mm apart, a stiffness of
+/// 1e3..1e7 N/m^2, friction within 0..2); else an error naming the number. A form comes from the
+/// server: nothing it says makes the station build without bound.
+Result<ArtifactKind> check_form(const museum::PieceForm& form);
+/// The piece a form describes, once check_form() accepts it.
+Result<collette::TriangleMesh> artifact_mesh(const museum::PieceForm& form);
+
 /// Writes the piece's mesh as an OBJ file into `cache_dir`/museum-artifacts (named by kind,
-/// difficulty, piece and a hash of its content; an existing file is kept) and returns the scene
+/// difficulty and a hash of its content, never by piece; an existing file is kept) and returns the scene
 /// shape that packs it with `spheres`: controllers::load_shape_tree() then builds and caches its
 /// .ist as it does for any scene object.
 Result<controllers::SceneShape> artifact_shape(ArtifactKind kind, museum::Difficulty difficulty, Piece piece,
                                                const std::filesystem::path& cache_dir,
                                                std::int64_t spheres = 10000);
 
+Result<controllers::SceneShape> artifact_shape(const museum::PieceForm& form,
+                                               const std::filesystem::path& cache_dir,
+                                               std::int64_t spheres = 10000);
+
 /// The piece as a scene object named `name` standing at `pose`: artifact_shape() and artifact_material().
 Result<controllers::SceneObject> artifact_object(ArtifactKind kind, museum::Difficulty difficulty,
                                                  Piece piece, const std::filesystem::path& cache_dir,
+                                                 const std::string& name, const Pose& pose = {},
+                                                 std::int64_t spheres = 10000);
+/// The piece a form describes (Phantom's station: the form the server sent) as a scene object.
+Result<controllers::SceneObject> artifact_object(const museum::PieceForm& form,
+                                                 const std::filesystem::path& cache_dir,
                                                  const std::string& name, const Pose& pose = {},
                                                  std::int64_t spheres = 10000);
 

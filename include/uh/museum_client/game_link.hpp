@@ -15,10 +15,13 @@
 #include <string>
 
 #include "uh/core/result.hpp"
-#include "uh/museum_client/server_messages.hpp"
+#include "uh/museum_protocol/messages.hpp"
 #include "uh/net/ws_url.hpp"
 
 namespace uh::museum_client {
+
+using museum_protocol::ServerMessage;
+using museum_protocol::Welcome;
 
 struct LinkOptions {
   /// ws://HOST:PORT/ws, http://HOST:PORT/ (what `uh museum serve` prints) or HOST:PORT.

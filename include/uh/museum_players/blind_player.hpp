@@ -22,6 +22,7 @@
 #include "uh/controllers/exploration.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/result.hpp"
+#include "uh/core/split_mix.hpp"
 #include "uh/museum/level.hpp"
 #include "uh/museum_artifacts/artifact.hpp"
 
@@ -107,6 +108,32 @@ Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
 /// Whether a piece of this kind may lie on the table turned any way about its vertical axis
 /// (pieces made on the lathe); slabs lie as they were made.
 bool turned_on_the_table(museum_artifacts::ArtifactKind kind);
+
+/// Where a piece lies before the blind player: turned about its vertical axis, shifted on the table.
+struct Placement {
+  double turn_rad = 0.0;
+  double x = 0.0;  ///< [m]
+  double y = 0.0;  ///< [m]
+};
+/// A place on the table dealt by `deal`: a lathe piece turned any way (turned_on_the_table), every
+/// piece up to 2 mm off the middle. Draws the turn, then x, then y.
+Placement place_on_table(museum_artifacts::ArtifactKind kind, core::SplitMix64& deal);
+
+/// Explores the piece a form describes (museum_artifacts::check_form), lying at `at`.
+Result<PieceSurvey> survey_form(const museum::PieceForm& form, const Placement& at,
+                                const SurveyOptions& options, const std::filesystem::path& cache_dir);
+
+/// A kind's genuine reference explored twice: how much it differs from itself.
+struct Reference {
+  PieceSurvey first;  ///< as made: no turn, no shift
+  PieceSurvey again;  ///< placed as on the table
+};
+/// The reference study of the judge and the blind bot alike: the genuine piece explored as made,
+/// then as on the table, the seeds and the placement drawn from `deal`. `before_each` (if set) is
+/// called before each exploration (progress).
+Result<Reference> study_reference(museum_artifacts::ArtifactKind kind, museum::Difficulty difficulty,
+                                  const SurveyOptions& options, const std::filesystem::path& cache_dir,
+                                  core::SplitMix64& deal, const std::function<void()>& before_each = {});
 
 /// The judge: every artifact kind of a level, its genuine piece and its forgery put before the
 /// blind player in an order and at turns dealt by the seed.

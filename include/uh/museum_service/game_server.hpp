@@ -7,8 +7,9 @@
 /// over `ws://HOST:PORT/ws` and sends every client snapshots (20-30 Hz), events and the end
 /// summary, in the versioned JSON messages of docs/museum.md. The round plays while a Vive and a
 /// Phantom are connected; when either drops out it pauses (the station zeroes Phantom's force on
-/// the paused snapshot) and a reconnect in that role resumes it. Phantom alone is told which
-/// piece it holds (`in_hands`): its station puts that piece under the device. A bad message gets an error
+/// the paused snapshot) and a reconnect in that role resumes it. Phantom alone is told the piece
+/// it holds (`in_hands`: its form, never whether it is genuine): its station builds that piece
+/// under the device. The messages are uh::museum_protocol's. A bad message gets an error
 /// naming what is wrong and is logged; the connection stays usable.
 
 #include <cstdint>
@@ -23,16 +24,14 @@
 
 namespace uh::museum_service {
 
-/// The message format this build speaks (`hello.protocol`, `welcome.protocol`).
-inline constexpr int kGameProtocolVersion = 1;
-
 /// How the server listens and which round it plays (aggregate; Box2D-style defaults).
 struct GameServerOptions {
   std::string host = "127.0.0.1";  ///< an IP address or "localhost"
   std::uint16_t port = 7780;       ///< 0: any free port (see GameServer::port())
   /// Clients must present it in `hello`; required when `host` is not a loopback address.
   std::string token{};
-  museum::Level level = museum::make_level(museum::Difficulty::easy);  ///< must validate
+  /// Must validate and carry its pieces (museum_artifacts::piece_pairs).
+  museum::Level level = museum::make_level(museum::Difficulty::easy);
   std::uint64_t seed = 1;
   double snapshot_hz = 20.0;                 ///< snapshots per second of game time, 20..30
   /// Game seconds per second of the wall clock, 0.1..20: 1 for people; a round of bots only may

@@ -30,15 +30,15 @@
 namespace uh::museum_station {
 
 // the server's messages and the connection, as every client of the game server has them
-using museum_client::GameEvent;
+using museum_protocol::GameEvent;
 using museum_client::GameLink;
-using museum_client::InHand;
-using museum_client::ItemView;
+using museum_protocol::InHand;
+using museum_protocol::ItemView;
 using museum_client::LinkNote;
-using museum_client::ServerMessage;
-using museum_client::Snapshot;
-using museum_client::Summary;
-using museum_client::Welcome;
+using museum_protocol::ServerMessage;
+using museum_protocol::Snapshot;
+using museum_protocol::Summary;
+using museum_protocol::Welcome;
 
 /// The home spring: beyond `free_radius_m` from home the stylus is pulled back with a soft spring
 /// whose force never exceeds `max_force_n` (and then passes the session's limit chain like every
