@@ -184,7 +184,8 @@ Status ForceDimensionDevice::open_selected() {
         return Error{
             fmt::format("forcedimension: the device with serial {} is open already (another tool of this "
                         "program drives it)",
-                        selection_.serial)};
+                        selection_.serial),
+            ErrorKind::kBusy};
       seen += fmt::format("{}serial {} (in use)", seen.empty() ? "" : ", ", sn);
       continue;
     }
