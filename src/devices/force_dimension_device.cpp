@@ -165,7 +165,8 @@ Status ForceDimensionDevice::open_selected() {
     if (held_devices().id_of(library_.path(), selection_.index) >= 0)
       return Error{
           fmt::format("forcedimension: device {} is open already (another tool of this program drives it)",
-                      selection_.index)};
+                      selection_.index),
+          ErrorKind::kBusy};
     const int id = api.dhdOpenID(static_cast<char>(selection_.index));
     if (id < 0)
       return Error{fmt::format("forcedimension: opening device {} failed: {}", selection_.index,
