@@ -80,13 +80,13 @@ struct QueryResult {
 
 class Ist {
  public:
-  explicit Ist(uh_tree* tree) : tree_(tree) {}
-  ~Ist() { uh_tree_free(tree_); }
+  explicit Ist(uh_tree_id tree) : tree_(tree) {}
+  ~Ist() { uh_tree_destroy(tree_); }
   Ist(const Ist&) = delete;
   Ist& operator=(const Ist&) = delete;
 
   static std::unique_ptr<Ist> load(const std::string& path) {
-    uh_tree* tree = nullptr;
+    uh_tree_id tree{0};
     call_released([&] { return uh_tree_load(path.c_str(), &tree); });
     return std::make_unique<Ist>(tree);
   }
@@ -96,7 +96,7 @@ class Ist {
     uh_tree_build_def def = uh_default_tree_build_def();
     def.spheres = spheres;
     def.meters_per_unit = meters_per_unit;
-    uh_tree* tree = nullptr;
+    uh_tree_id tree{0};
     call_released([&] { return uh_tree_build(mesh_path.c_str(), &def, &tree); });
     return std::make_unique<Ist>(tree);
   }
@@ -112,7 +112,7 @@ class Ist {
     uh_tree_build_def def = uh_default_tree_build_def();
     def.spheres = spheres;
     def.meters_per_unit = meters_per_unit;
-    uh_tree* tree = nullptr;
+    uh_tree_id tree{0};
     const double* v = vertices.data();
     const std::int32_t* t = triangles.data();
     const auto nv = static_cast<int32_t>(vertices.shape(0));
@@ -141,10 +141,10 @@ class Ist {
     return QueryResult{r.volume, r.volume_estimate, vector_array(r.direction, 3), r.pair_count, r.distance};
   }
 
-  const uh_tree* handle() const { return tree_; }
+  uh_tree_id handle() const { return tree_; }
 
  private:
-  uh_tree* tree_;
+  uh_tree_id tree_;
 };
 
 // ----- scenes -----
@@ -196,27 +196,27 @@ ShapeArgs shape_args(const py::object& mesh, const py::object& ist, const py::ob
 
 class Scene {
  public:
-  explicit Scene(uh_scene* scene) : scene_(scene) {}
-  ~Scene() { uh_scene_free(scene_); }
+  explicit Scene(uh_scene_id scene) : scene_(scene) {}
+  ~Scene() { uh_scene_destroy(scene_); }
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;
 
   static std::unique_ptr<Scene> create(const std::string& name) {
-    uh_scene* scene = nullptr;
+    uh_scene_id scene{0};
     check(uh_scene_create(name.c_str(), &scene));
     return std::make_unique<Scene>(scene);
   }
   static std::unique_ptr<Scene> load(const py::object& path) {
     const std::optional<std::string> p =
         path.is_none() ? std::nullopt : std::optional(py::str(path).cast<std::string>());
-    uh_scene* scene = nullptr;
+    uh_scene_id scene{0};
     call_released([&] { return uh_scene_load(p ? p->c_str() : nullptr, &scene); });
     return std::make_unique<Scene>(scene);
   }
   static std::unique_ptr<Scene> parse(const std::string& json_text, const py::object& base_dir) {
     const std::optional<std::string> b =
         base_dir.is_none() ? std::nullopt : std::optional(py::str(base_dir).cast<std::string>());
-    uh_scene* scene = nullptr;
+    uh_scene_id scene{0};
     check(uh_scene_parse(json_text.c_str(), b ? b->c_str() : nullptr, &scene));
     return std::make_unique<Scene>(scene);
   }
@@ -249,7 +249,27 @@ class Scene {
 
   void watch(const std::string& name, bool on) { check(uh_scene_watch(scene_, name.c_str(), on ? 1 : 0)); }
 
-  void set_tool(const py::kwargs& kwargs);
+  void set_tool(const py::kwargs& kwargs) {
+    with_tool_def(kwargs, [&](const uh_tool_def& def) {
+      call_released([&] { return uh_scene_set_tool(scene_, &def); });
+    });
+  }
+
+  int add_tool(const py::kwargs& kwargs) {
+    int32_t index = -1;
+    with_tool_def(kwargs, [&](const uh_tool_def& def) {
+      call_released([&] { return uh_scene_add_tool(scene_, &def, &index); });
+    });
+    return index;
+  }
+
+  void remove_tool(const std::string& name) { check(uh_scene_remove_tool(scene_, name.c_str())); }
+
+  int tool_count() const {
+    int32_t n = 0;
+    check(uh_scene_tool_count(scene_, &n));
+    return n;
+  }
 
   void set_rates(double haptic_hz, double collision_hz) {
     check(uh_scene_set_rates(scene_, haptic_hz, collision_hz));
@@ -261,13 +281,19 @@ class Scene {
     return n;
   }
 
-  const uh_scene* handle() const { return scene_; }
+  uh_scene_id handle() const { return scene_; }
 
  private:
-  uh_scene* scene_;
+  // the tool def of set_tool's / add_tool's keyword arguments, handed to `use` while the strings
+  // and arrays it points into are alive
+  template <typename Use>
+  static void with_tool_def(const py::kwargs& kwargs, Use&& use);
+
+  uh_scene_id scene_;
 };
 
-void Scene::set_tool(const py::kwargs& kwargs) {
+template <typename Use>
+void Scene::with_tool_def(const py::kwargs& kwargs, Use&& use) {
   static const char* const known[] = {"name",
                                       "mesh",
                                       "ist",
@@ -290,12 +316,13 @@ void Scene::set_tool(const py::kwargs& kwargs) {
                                       "config",
                                       "workspace_scale",
                                       "workspace_offset",
-                                      "workspace_rotation"};
+                                      "workspace_rotation",
+                                      "tool_offset"};
   for (const auto& [key, value] : kwargs) {
     const std::string k = py::str(key);
     if (std::find_if(std::begin(known), std::end(known), [&](const char* n) { return k == n; }) ==
         std::end(known))
-      throw py::type_error("set_tool() got an unexpected keyword argument '" + k + "'");
+      throw py::type_error("got an unexpected keyword argument '" + k + "' for a tool");
   }
   const auto get = [&](const char* key) -> py::object {
     if (kwargs.contains(key)) return kwargs[key];
@@ -351,6 +378,10 @@ void Scene::set_tool(const py::kwargs& kwargs) {
     const auto c = quat_of(kwargs["workspace_rotation"], "workspace_rotation");
     std::copy(c.begin(), c.end(), def.workspace_rotation);
   }
+  if (kwargs.contains("tool_offset")) {
+    const auto c = vec3_of(kwargs["tool_offset"], "tool_offset");
+    std::copy(c.begin(), c.end(), def.tool_offset);
+  }
   const std::string driver = kwargs.contains("device") ? kwargs["device"].cast<std::string>() : "sim-line";
   def.device_driver = driver.c_str();
   std::string config;
@@ -360,7 +391,7 @@ void Scene::set_tool(const py::kwargs& kwargs) {
                                         : py::module_::import("json").attr("dumps")(c).cast<std::string>();
     def.device_config_json = config.c_str();
   }
-  call_released([&] { return uh_scene_set_tool(scene_, &def); });
+  use(def);
 }
 
 // ----- sessions -----
@@ -377,13 +408,14 @@ struct State {
 struct ContactEvent {
   std::string kind;  // "begin" or "end"
   int object = -1;
+  int tool = -1;
   double time_s = 0.0, volume = 0.0;
   int pairs = 0;
 };
 
 class Session {
  public:
-  explicit Session(uh_session* s) : session_(s) {}
+  explicit Session(uh_session_id s) : session_(s) {}
   ~Session() { close(); }
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
@@ -405,20 +437,20 @@ class Session {
                                        double collision_hz, bool raise_priority) {
     std::string cache;
     const uh_session_def def = session_def(cache_dir, haptic_hz, collision_hz, raise_priority, cache);
-    uh_session* s = nullptr;
+    uh_session_id s{0};
     if (py::isinstance<Scene>(scene)) {
-      const uh_scene* sc = scene.cast<const Scene&>().handle();
+      const uh_scene_id sc = scene.cast<const Scene&>().handle();
       call_released([&] { return uh_session_create(sc, &def, &s); });
     } else {
       // a file (or the default scene), opened with the session's settings
-      uh_scene* sc = nullptr;
+      uh_scene_id sc{0};
       const std::optional<std::string> path =
           scene.is_none() ? std::nullopt : std::optional(py::str(scene).cast<std::string>());
       call_released([&] { return uh_scene_load(path ? path->c_str() : nullptr, &sc); });
       const uh_status status = [&] {
         py::gil_scoped_release release;
         const uh_status created = uh_session_create(sc, &def, &s);
-        uh_scene_free(sc);
+        uh_scene_destroy(sc);
         return created;
       }();
       check(status);
@@ -454,7 +486,8 @@ class Session {
     for (int32_t has = 1;;) {
       check(uh_session_poll_event(session_, &e, &has));
       if (has == 0) break;
-      out.push_back({e.kind == UH_CONTACT_BEGIN ? "begin" : "end", e.object, e.time_s, e.volume, e.pairs});
+      out.push_back(
+          {e.kind == UH_CONTACT_BEGIN ? "begin" : "end", e.object, e.tool, e.time_s, e.volume, e.pairs});
     }
     return out;
   }
@@ -487,8 +520,8 @@ class Session {
   }
 
   // the session's objects' or tools' names, by their count and name functions
-  std::vector<std::string> names(uh_status (*count)(uh_session*, int32_t*),
-                                 uh_status (*name_of)(uh_session*, int32_t, const char**)) const {
+  std::vector<std::string> names(uh_status (*count)(uh_session_id, int32_t*),
+                                 uh_status (*name_of)(uh_session_id, int32_t, const char**)) const {
     int32_t n = 0;
     check(count(session_, &n));
     std::vector<std::string> out;
@@ -502,18 +535,18 @@ class Session {
 
   // stops (zero force, joins every thread) and frees; idempotent
   void close() {
-    if (session_ == nullptr) return;
-    uh_session* s = std::exchange(session_, nullptr);
+    if (session_.bits == 0) return;
+    const uh_session_id s = std::exchange(session_, uh_session_id{0});
     if (PyGILState_Check() != 0) {
       py::gil_scoped_release release;
-      uh_session_close(s);
+      uh_session_destroy(s);
     } else {
-      uh_session_close(s);
+      uh_session_destroy(s);
     }
   }
 
  private:
-  uh_session* session_;
+  uh_session_id session_;
 };
 
 }  // namespace
@@ -577,15 +610,21 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def("set_object_pose", &Scene::set_object_pose, py::arg("name"), py::arg("position"),
            py::arg("orientation"))
       .def("watch", &Scene::watch, py::arg("name"), py::arg("on") = true)
+      .def("add_tool", &Scene::add_tool,
+           "Adds a tool after the scene's tools, each on its own device (the keywords of set_tool); "
+           "returns its index.")
+      .def("remove_tool", &Scene::remove_tool, py::arg("name"))
+      .def_property_readonly("tool_count", &Scene::tool_count)
       .def("set_tool", &Scene::set_tool,
-           "Sets the tool: shape (mesh=/ist=/tree=/vertices=+triangles=, spheres=, meters_per_unit=), force "
+           "Sets the first tool: shape (mesh=/ist=/tree=/vertices=+triangles=, spheres=, meters_per_unit=), "
+           "force "
            "law "
            "(mode='6dof'|'3dof', law='gradient'|'paper', stiffness= [N/m^2, gradient], force_scale= [N/m^3, "
            "paper], damping=, damping_full_volume=, mass_kg=, center_of_mass=, "
            "max_force_n=, "
            "max_torque_nm=), device=driver name, config=dict or JSON text, workspace_scale=, "
            "workspace_offset=, "
-           "workspace_rotation=.")
+           "workspace_rotation=, tool_offset= (the tool's origin in the handle frame [m]).")
       .def("set_rates", &Scene::set_rates, py::arg("haptic_hz"), py::arg("collision_hz"))
       .def_property_readonly("object_count", &Scene::object_count);
 
@@ -602,10 +641,10 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def_readonly("collision_rate_hz", &State::collision_rate_hz)
       .def_readonly("buttons", &State::buttons, "the device's buttons (bit i: button i)");
 
-  py::class_<ContactEvent>(m, "ContactEvent",
-                           "A contact between the tool and a watched object began or ended.")
+  py::class_<ContactEvent>(m, "ContactEvent", "A contact between a tool and a watched object began or ended.")
       .def_readonly("kind", &ContactEvent::kind, "'begin' or 'end'")
       .def_readonly("object", &ContactEvent::object, "index of the object in the scene")
+      .def_readonly("tool", &ContactEvent::tool, "index of the tool in the scene")
       .def_readonly("time_s", &ContactEvent::time_s)
       .def_readonly("volume", &ContactEvent::volume, "[m^3] (0 at 'end')")
       .def_readonly("pairs", &ContactEvent::pairs)

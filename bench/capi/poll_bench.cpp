@@ -15,9 +15,10 @@ namespace {
 
 // the small scene of the tests: 600 + 150 spheres, a stylus going in and out (scenes/ has no
 // scene this small; a large scene would only load the machine while state() is measured)
-uh_scene* small_scene() {
-  uh_scene* scene = nullptr;
-  if (uh_scene_create("bench", &scene) != UH_OK) return nullptr;
+// zero on failure
+uh_scene_id small_scene() {
+  uh_scene_id scene{0};
+  if (uh_scene_create("bench", &scene) != UH_OK) return uh_scene_id{0};
   uh_object_def bunny = uh_default_object_def();
   bunny.name = "bunny";
   bunny.shape.mesh_path = UH_ASSET_DIR "/meshes/bunny_npm_3674.obj";
@@ -33,14 +34,14 @@ uh_scene* small_scene() {
   tool.device_config_json =
       R"({"start": [0, 0, 0.10], "end": [0, 0, 0.045], "duration_s": 0.5, "bounce": true, "dof_actuated": 6, "max_force_n": 6})";
   if (uh_scene_add_object(scene, &bunny, nullptr) != UH_OK || uh_scene_set_tool(scene, &tool) != UH_OK)
-    return nullptr;
+    return uh_scene_id{0};
   return scene;
 }
 
 void BM_CApiPoll(benchmark::State& state) {
-  uh_scene* scene = small_scene();
-  uh_session* s = nullptr;
-  if (scene == nullptr || uh_session_create(scene, nullptr, &s) != UH_OK || uh_session_start(s) != UH_OK) {
+  const uh_scene_id scene = small_scene();
+  uh_session_id s{0};
+  if (scene.bits == 0 || uh_session_create(scene, nullptr, &s) != UH_OK || uh_session_start(s) != UH_OK) {
     state.SkipWithError(uh_last_error());
     return;
   }
@@ -51,8 +52,8 @@ void BM_CApiPoll(benchmark::State& state) {
     benchmark::ClobberMemory();
   }
   state.counters["haptic_ticks"] = static_cast<double>(st.haptic_ticks);
-  uh_session_close(s);
-  uh_scene_free(scene);
+  uh_session_destroy(s);
+  uh_scene_destroy(scene);
 }
 BENCHMARK(BM_CApiPoll)->UseRealTime();
 

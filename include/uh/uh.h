@@ -2,19 +2,25 @@
  * uh.h: the UnrealHaptics C API (plain C99, library libuh, CMake target uh::capi).
  *
  * One header for engines (Unreal, Unity's P/Invoke, Godot), other languages and plain C programs:
- * open a haptic session (a scene: objects, a tool bound to a device, watched pairs), start its
+ * open a haptic session (a scene: objects, tools each bound to a device, watched objects), start its
  * haptic and collision threads, poll its newest state and its contact events, stop it; and query
  * Inner Sphere Trees directly.
  *
  * Rules that hold for every function:
- *  - Every call returns a uh_status; UH_OK (0) is success. After a failure, uh_last_error()
- *    returns a message for the calling thread that names what was wrong (a file, a field, a
- *    handle). No C++ exception ever leaves the library.
- *  - Objects are handles (uh_scene*, uh_session*, uh_tree*). A handle is never dereferenced by the
- *    caller; it carries a generation, so a handle that was closed or freed is refused with
- *    UH_ERROR_STALE_HANDLE, not a crash. Closing or freeing NULL or a stale handle does nothing.
+ *  - Every call that can fail returns a uh_status; UH_OK (0) is success, each failure has its own
+ *    status (a file, a mesh, a device, a thread, ...). After a failure, uh_last_error() returns a
+ *    message for the calling thread that names what was wrong (a file, a field, an id). No C++
+ *    exception ever leaves the library.
+ *  - Objects are ids passed by value (uh_tree_id, uh_scene_id, uh_session_id; after Box2D v3): a
+ *    fixed-width integer holding a slot index, the slot's generation and the kind, never an
+ *    address. A destroyed or made-up id is refused with UH_ERROR_STALE_HANDLE, not a crash;
+ *    uh_*_is_valid() tells whether an id is live. Destroying a zero or stale id does nothing.
  *  - Structs that cross the boundary start with `struct_size`: set it to sizeof(the struct) (the
- *    uh_default_*() functions do). A struct_size smaller than this version's struct is refused.
+ *    uh_default_*() functions do). Structs only grow, at their end: a program built against an
+ *    older uh.h of this UH_API_VERSION passes its smaller struct_size, the library reads the fields
+ *    that struct has and takes the defaults for the rest, and writes into it only the fields it
+ *    has. A struct_size this library does not know (a newer header's, or a wrong one) is refused
+ *    with UH_ERROR_INVALID_ARGUMENT. docs/capi.md states the promise.
  *  - There is no global state a call depends on: any number of sessions, scenes and trees may
  *    exist in one process; each call names the one it works on.
  *  - Units are SI: metres, seconds, newtons; quaternions are (w, x, y, z), unit length.
@@ -28,9 +34,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* The API version this header describes. Raised on every incompatible change; a program built
- * against one version is refused at open by a library of another (UH_ERROR_VERSION). */
-#define UH_API_VERSION 1
+/* The API version this header describes. Raised on every incompatible change (a function renamed
+ * or removed, a field moved); a program built against one version is refused at open by a library
+ * of another (UH_ERROR_VERSION). Growing a struct at its end or adding a function or a status is
+ * compatible and keeps the version. */
+#define UH_API_VERSION 2
 
 #if defined(_WIN32) || defined(__CYGWIN__)
 #if defined(UH_CAPI_BUILDING)
@@ -44,6 +52,8 @@
 #define UH_API
 #endif
 
+#include <string.h> /* memset, for the uh_default_*() inline functions */
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -56,12 +66,19 @@ extern "C" {
 typedef int32_t uh_status;
 enum {
   UH_OK = 0,                      /* success */
-  UH_ERROR_INVALID_ARGUMENT = 1,  /* NULL where a value is needed, a number out of range, a bad struct_size */
-  UH_ERROR_STALE_HANDLE = 2,      /* the handle was closed or freed, or is not a handle of that kind */
+  UH_ERROR_INVALID_ARGUMENT = 1,  /* NULL where a value is needed, a number out of range, a bad struct_size,
+                                     a scene that cannot run (no tool, nothing watched) */
+  UH_ERROR_STALE_HANDLE = 2,      /* the id was destroyed, never made, or is an id of another kind */
   UH_ERROR_WRONG_STATE = 3,       /* not possible now: start twice, start after stop, a callback set while running */
   UH_ERROR_VERSION = 4,           /* the program was compiled against another UH_API_VERSION */
-  UH_ERROR_FAILED = 5,            /* the work failed: a file, a mesh, a device, a thread; see uh_last_error() */
-  UH_ERROR_INTERNAL = 6           /* an unexpected failure inside the library (out of memory, a bug) */
+  /* 5 was API version 1's UH_ERROR_FAILED; never returned */
+  UH_ERROR_INTERNAL = 6,          /* an unexpected failure inside the library (out of memory, a bug) */
+  UH_ERROR_FILE = 7,              /* a file could not be found, read or written, or its content is wrong
+                                     (a damaged .ist, a scene file's field, a mesh format the build does not read) */
+  UH_ERROR_MESH = 8,              /* a mesh cannot be used: open, non-manifold, degenerate, no volume, not packable */
+  UH_ERROR_DEVICE = 9,            /* a device: unknown driver, bad settings, would not open, faulted while running */
+  UH_ERROR_THREAD = 10,           /* a haptic or collision thread could not start, or ended on its own */
+  UH_ERROR_BUSY = 11              /* in use or full: a device another tool holds, too many ids of a kind open */
 };
 
 /* The library's version, e.g. "0.1.0". Static storage; any thread. */
@@ -78,14 +95,32 @@ UH_API const char* uh_last_error(void);
 UH_API const char* uh_status_name(uh_status status);
 
 /* ---------------------------------------------------------------------------------------------
+ * Ids and defaults
+ *
+ * An id is a value: copy it, compare its `bits`, keep it in any struct; zero is no id. Every
+ * descriptor struct has a uh_X_init(def) that fills the fields that fit in def->struct_size with
+ * their defaults (set struct_size first), and a uh_default_X() inline function below that does
+ * both, compiled into the caller with the caller's uh.h, so that an older program's smaller
+ * struct is never written past its end.
+ * ------------------------------------------------------------------------------------------- */
+
+typedef struct uh_tree_id { uint64_t bits; } uh_tree_id;       /* an Inner Sphere Tree */
+typedef struct uh_scene_id { uint64_t bits; } uh_scene_id;     /* a scene description */
+typedef struct uh_session_id { uint64_t bits; } uh_session_id; /* a session (a scene running) */
+
+/* 1 while the id refers to a live object of its kind, 0 once destroyed, for zero or a made-up id
+ * (generation-checked: a stale id is never dereferenced). Any thread. */
+UH_API int32_t uh_tree_is_valid(uh_tree_id tree);
+UH_API int32_t uh_scene_is_valid(uh_scene_id scene);
+UH_API int32_t uh_session_is_valid(uh_session_id session);
+
+/* ---------------------------------------------------------------------------------------------
  * Inner Sphere Trees: load, build, query
  *
  * A tree is immutable once made; it may be queried from several threads at once and shared with
- * scenes (a scene keeps its own reference, so the tree may be freed after adding it). Lengths are
- * metres: a .ist's meters_per_unit is applied on load, the build settings' on build.
+ * scenes (a scene keeps its own reference, so the tree may be destroyed after adding it). Lengths
+ * are metres: a .ist's meters_per_unit is applied on load, the build settings' on build.
  * ------------------------------------------------------------------------------------------- */
-
-typedef struct uh_tree uh_tree;
 
 /* How to pack a mesh with spheres. */
 typedef struct uh_tree_build_def {
@@ -94,24 +129,32 @@ typedef struct uh_tree_build_def {
   double meters_per_unit;  /* length of one mesh unit [m], > 0 (default 1) */
 } uh_tree_build_def;
 
-UH_API uh_tree_build_def uh_default_tree_build_def(void);
+UH_API uh_status uh_tree_build_def_init(uh_tree_build_def* def);
+static inline uh_tree_build_def uh_default_tree_build_def(void) {
+  uh_tree_build_def def;
+  memset(&def, 0, sizeof def);
+  def.struct_size = (uint32_t)sizeof def;
+  (void)uh_tree_build_def_init(&def);
+  return def;
+}
 
-/* Loads a .ist file (checksummed; a damaged file is refused with the reason). */
-UH_API uh_status uh_tree_load(const char* ist_path, uh_tree** out);
+/* Loads a .ist file (checksummed; a damaged file is refused with the reason: UH_ERROR_FILE). */
+UH_API uh_status uh_tree_load(const char* ist_path, uh_tree_id* out);
 
 /* Loads a closed mesh (OBJ, STL, PLY, OFF, ...; the Windows build reads OBJ and STL only),
- * validates it (an open or non-manifold mesh is refused with the counts of bad edges), packs it
- * and builds the tree. Takes about a second per 10,000 spheres. `def` may be NULL (defaults). */
-UH_API uh_status uh_tree_build(const char* mesh_path, const uh_tree_build_def* def, uh_tree** out);
+ * validates it (an open or non-manifold mesh is refused with the counts of bad edges:
+ * UH_ERROR_MESH), packs it and builds the tree. Takes about a second per 10,000 spheres. `def`
+ * may be NULL (defaults). */
+UH_API uh_status uh_tree_build(const char* mesh_path, const uh_tree_build_def* def, uh_tree_id* out);
 
 /* Same from arrays: `vertices` holds vertex_count * 3 coordinates (x, y, z, in mesh units),
  * `indices` triangle_count * 3 vertex indices, counter-clockwise seen from outside. The arrays
  * are copied; the mesh must be closed and manifold. */
 UH_API uh_status uh_tree_build_from_arrays(const double* vertices, int32_t vertex_count, const int32_t* indices,
-                                           int32_t triangle_count, const uh_tree_build_def* def, uh_tree** out);
+                                           int32_t triangle_count, const uh_tree_build_def* def, uh_tree_id* out);
 
 /* Writes the tree as a .ist file (lengths in metres, meters_per_unit 1). */
-UH_API uh_status uh_tree_save(const uh_tree* tree, const char* ist_path);
+UH_API uh_status uh_tree_save(uh_tree_id tree, const char* ist_path);
 
 /* What a tree holds. */
 typedef struct uh_tree_info {
@@ -123,10 +166,10 @@ typedef struct uh_tree_info {
   double radius;          /* [m] */
 } uh_tree_info;
 
-UH_API uh_status uh_tree_get_info(const uh_tree* tree, uh_tree_info* out);
+UH_API uh_status uh_tree_get_info(uh_tree_id tree, uh_tree_info* out);
 
-/* Frees the tree (scenes that hold it keep their reference). NULL or a stale handle: nothing. */
-UH_API void uh_tree_free(uh_tree* tree);
+/* Destroys the tree (scenes that hold it keep their reference). Zero or a stale id: nothing. */
+UH_API void uh_tree_destroy(uh_tree_id tree);
 
 /* The overlap of two trees at one pose. */
 typedef struct uh_query_result {
@@ -141,24 +184,24 @@ typedef struct uh_query_result {
 
 /* Queries B placed at (position, orientation) in A's frame against A. Any thread; a thread's
  * first query allocates its scratch (about 2 MB), later ones do not. */
-UH_API uh_status uh_tree_query(const uh_tree* a, const uh_tree* b, const double position[3],
-                               const double orientation[4], uh_query_result* out);
+UH_API uh_status uh_tree_query(uh_tree_id a, uh_tree_id b, const double position[3], const double orientation[4],
+                               uh_query_result* out);
 
 /* ---------------------------------------------------------------------------------------------
  * Scenes: what a session runs, from a file or built through calls
  *
- * A scene is a description (objects, the tool and its device, watched pairs, rates); sessions
- * copy it when they open, so it may be changed or freed afterwards. One thread at a time.
+ * A scene is a description (objects, tools and their devices, watched objects, rates); sessions
+ * copy it when they open, so it may be changed or destroyed afterwards. One thread at a time.
  * ------------------------------------------------------------------------------------------- */
 
-typedef struct uh_scene uh_scene;
-
-/* Where a shape's tree comes from: exactly one of mesh_path, ist_path, tree or the arrays. */
+/* Where a shape's tree comes from: exactly one of mesh_path, ist_path, tree or the arrays. It is
+ * embedded in uh_object_def and uh_tool_def, so it never grows (new shape settings go at the end
+ * of those). */
 typedef struct uh_shape_def {
   uint32_t struct_size;      /* sizeof(uh_shape_def) */
   const char* mesh_path;     /* a closed mesh, packed on first use and cached (see uh_session_def.cache_dir) */
   const char* ist_path;      /* a .ist file */
-  const uh_tree* tree;       /* a tree made by uh_tree_load/uh_tree_build (shared, not copied) */
+  uh_tree_id tree;           /* a tree made by uh_tree_load/uh_tree_build (shared, not copied); zero: none */
   const double* vertices;    /* or a closed mesh as arrays (see uh_tree_build_from_arrays) */
   int32_t vertex_count;
   const int32_t* indices;
@@ -174,7 +217,7 @@ typedef struct uh_object_def {
   uh_shape_def shape;
   double position[3];        /* world_from_object [m] */
   double orientation[4];     /* (w, x, y, z) */
-  int32_t watch;             /* nonzero (default): the tool is watched against this object */
+  int32_t watch;             /* nonzero (default): every tool is watched against this object */
 } uh_object_def;
 
 /* How forces are rendered on the tool. */
@@ -187,10 +230,10 @@ enum { UH_FORCE_6DOF = 0, UH_FORCE_3DOF = 1 };
 typedef int32_t uh_force_law;
 enum { UH_FORCE_LAW_GRADIENT = 0, UH_FORCE_LAW_PAPER = 1 };
 
-/* The tool: a shape moved by a device, with its force law and limits. */
+/* A tool: a shape moved by its own device, with its force law and limits. */
 typedef struct uh_tool_def {
   uint32_t struct_size;        /* sizeof(uh_tool_def) */
-  const char* name;            /* default "tool" */
+  const char* name;            /* unique among the scene's tools; default "tool" */
   uh_shape_def shape;
   uh_force_mode mode;          /* default UH_FORCE_6DOF */
   uh_force_law law;            /* default UH_FORCE_LAW_GRADIENT */
@@ -208,45 +251,75 @@ typedef struct uh_tool_def {
   double workspace_scale;      /* world metres per device metre (default 1) */
   double workspace_offset[3];  /* the device base in the world [m] */
   double workspace_rotation[4];/* (w, x, y, z) */
+  /* --- added in API version 2's second layout (older callers get the default) --- */
+  double tool_offset[3];       /* the tool's mesh origin in the device handle's frame [m] (a scene file's
+                                  workspace.tool_offset; default 0) */
 } uh_tool_def;
 
-UH_API uh_shape_def uh_default_shape_def(void);
-UH_API uh_object_def uh_default_object_def(void);
-UH_API uh_tool_def uh_default_tool_def(void);
+UH_API uh_status uh_shape_def_init(uh_shape_def* def);
+UH_API uh_status uh_object_def_init(uh_object_def* def);
+UH_API uh_status uh_tool_def_init(uh_tool_def* def);
+static inline uh_shape_def uh_default_shape_def(void) {
+  uh_shape_def def;
+  memset(&def, 0, sizeof def);
+  def.struct_size = (uint32_t)sizeof def;
+  (void)uh_shape_def_init(&def);
+  return def;
+}
+static inline uh_object_def uh_default_object_def(void) {
+  uh_object_def def;
+  memset(&def, 0, sizeof def);
+  def.struct_size = (uint32_t)sizeof def;
+  (void)uh_object_def_init(&def);
+  return def;
+}
+static inline uh_tool_def uh_default_tool_def(void) {
+  uh_tool_def def;
+  memset(&def, 0, sizeof def);
+  def.struct_size = (uint32_t)sizeof def;
+  (void)uh_tool_def_init(&def);
+  return def;
+}
 
 /* An empty scene (no objects, no tool yet; rates 1 kHz haptic and collision). */
-UH_API uh_status uh_scene_create(const char* name, uh_scene** out);
+UH_API uh_status uh_scene_create(const char* name, uh_scene_id* out);
 /* A scene file (docs/pipeline.md); NULL: the embedded default scene. */
-UH_API uh_status uh_scene_load(const char* scene_path, uh_scene** out);
+UH_API uh_status uh_scene_load(const char* scene_path, uh_scene_id* out);
 /* Scene JSON text; relative paths resolve against base_dir (NULL: the current folder). */
-UH_API uh_status uh_scene_parse(const char* json_text, const char* base_dir, uh_scene** out);
-/* Frees the scene. NULL or a stale handle: nothing. */
-UH_API void uh_scene_free(uh_scene* scene);
+UH_API uh_status uh_scene_parse(const char* json_text, const char* base_dir, uh_scene_id* out);
+/* Destroys the scene. Zero or a stale id: nothing. */
+UH_API void uh_scene_destroy(uh_scene_id scene);
 
 /* Adds an object; `out_index` (may be NULL) gets its index, which sessions use for it. The
  * shape's files must exist now (the tree is loaded or built when a session opens). */
-UH_API uh_status uh_scene_add_object(uh_scene* scene, const uh_object_def* def, int32_t* out_index);
+UH_API uh_status uh_scene_add_object(uh_scene_id scene, const uh_object_def* def, int32_t* out_index);
 /* Removes the object named `name`; later objects move down one index. */
-UH_API uh_status uh_scene_remove_object(uh_scene* scene, const char* name);
+UH_API uh_status uh_scene_remove_object(uh_scene_id scene, const char* name);
 /* Sets the pose of the object named `name`. */
-UH_API uh_status uh_scene_set_object_pose(uh_scene* scene, const char* name, const double position[3],
+UH_API uh_status uh_scene_set_object_pose(uh_scene_id scene, const char* name, const double position[3],
                                           const double orientation[4]);
-/* Watches the pair (object, tool) or stops watching it. */
-UH_API uh_status uh_scene_watch(uh_scene* scene, const char* name, int32_t watch);
-/* Sets the tool and its device. The device config is checked when a session opens. */
-UH_API uh_status uh_scene_set_tool(uh_scene* scene, const uh_tool_def* def);
+/* Watches the object named `name` against every tool, or stops watching it. */
+UH_API uh_status uh_scene_watch(uh_scene_id scene, const char* name, int32_t watch);
+/* Sets the first tool (the only one of a one-tool scene; added when the scene has none). The
+ * device config is checked when a session opens. */
+UH_API uh_status uh_scene_set_tool(uh_scene_id scene, const uh_tool_def* def);
+/* Adds a tool after the scene's tools, each on its own device and haptic thread (two hands, two
+ * users); `out_index` (may be NULL) gets its index, which sessions use for it. Tools pass through
+ * each other. */
+UH_API uh_status uh_scene_add_tool(uh_scene_id scene, const uh_tool_def* def, int32_t* out_index);
+/* Removes the tool named `name`; later tools move down one index. */
+UH_API uh_status uh_scene_remove_tool(uh_scene_id scene, const char* name);
+UH_API uh_status uh_scene_tool_count(uh_scene_id scene, int32_t* out);
 /* Haptic rate in [1, 10000] Hz; collision rate in [0, 10000] Hz (0 = free-running). */
-UH_API uh_status uh_scene_set_rates(uh_scene* scene, double haptic_hz, double collision_hz);
-UH_API uh_status uh_scene_object_count(const uh_scene* scene, int32_t* out);
+UH_API uh_status uh_scene_set_rates(uh_scene_id scene, double haptic_hz, double collision_hz);
+UH_API uh_status uh_scene_object_count(uh_scene_id scene, int32_t* out);
 
 /* ---------------------------------------------------------------------------------------------
  * Sessions: a scene running
  *
- * open -> start -> poll ... -> stop -> close, or open -> run_stepped -> close. A session runs
- * once. stop() is idempotent; close() stops first and works from any state.
+ * open -> start -> poll ... -> stop -> destroy, or open -> run_stepped -> destroy. A session runs
+ * once. stop() is idempotent; destroy() stops first and works from any state.
  * ------------------------------------------------------------------------------------------- */
-
-typedef struct uh_session uh_session;
 
 /* Settings of one session (0 / NULL fields keep the scene's value). */
 typedef struct uh_session_def {
@@ -257,7 +330,14 @@ typedef struct uh_session_def {
   const char* cache_dir;   /* where packed meshes are cached (NULL: $UH_CACHE_DIR or ~/.cache/unrealhaptics) */
 } uh_session_def;
 
-UH_API uh_session_def uh_default_session_def(void);
+UH_API uh_status uh_session_def_init(uh_session_def* def);
+static inline uh_session_def uh_default_session_def(void) {
+  uh_session_def def;
+  memset(&def, 0, sizeof def);
+  def.struct_size = (uint32_t)sizeof def;
+  (void)uh_session_def_init(&def);
+  return def;
+}
 
 /* The newest state of a tool, as its haptic thread sent it in its last tick. */
 typedef struct uh_state {
@@ -275,7 +355,7 @@ typedef struct uh_state {
   uint32_t buttons;            /* the device's buttons as read that tick (bit i: button i) */
 } uh_state;
 
-/* A contact between the tool and a watched object began or ended. */
+/* A contact between a tool and a watched object began or ended. */
 typedef int32_t uh_contact_kind;
 enum { UH_CONTACT_BEGIN = 0, UH_CONTACT_END = 1 };
 
@@ -286,6 +366,8 @@ typedef struct uh_contact_event {
   double time_s;         /* time of the collision step that saw it, since start [s] */
   double volume;         /* overlap volume then [m^3] (0 for UH_CONTACT_END) */
   int32_t pairs;         /* overlapping sphere pairs then (0 for UH_CONTACT_END) */
+  /* --- added in API version 2's second layout --- */
+  int32_t tool;          /* index of the tool in the scene */
 } uh_contact_event;
 
 /* Called on the haptic thread after every tick (on the calling thread in stepped runs) with that
@@ -294,67 +376,69 @@ typedef struct uh_contact_event {
 typedef void (*uh_tick_fn)(void* user, const uh_state* state);
 
 /* Opens a session of the scene file `scene_path` (NULL: the embedded default scene): loads or
- * builds the trees, creates and opens the device; starts no thread. Called through a macro that
+ * builds the trees, creates and opens the devices; starts no thread. Called through a macro that
  * passes this header's UH_API_VERSION; the function itself is exported for bindings, which
  * should compare uh_api_version() first. */
-UH_API uh_status uh_session_open(const char* scene_path, uh_session** out);
-UH_API uh_status uh_session_open_checked(int32_t api_version, const char* scene_path, uh_session** out);
+UH_API uh_status uh_session_open(const char* scene_path, uh_session_id* out);
+UH_API uh_status uh_session_open_checked(int32_t api_version, const char* scene_path, uh_session_id* out);
 #define uh_session_open(scene_path, out) uh_session_open_checked(UH_API_VERSION, (scene_path), (out))
 
 /* Opens a session of a scene built through calls; `def` may be NULL (defaults). Same version
  * check as uh_session_open. */
-UH_API uh_status uh_session_create(const uh_scene* scene, const uh_session_def* def, uh_session** out);
-UH_API uh_status uh_session_create_checked(int32_t api_version, const uh_scene* scene, const uh_session_def* def,
-                                           uh_session** out);
+UH_API uh_status uh_session_create(uh_scene_id scene, const uh_session_def* def, uh_session_id* out);
+UH_API uh_status uh_session_create_checked(int32_t api_version, uh_scene_id scene, const uh_session_def* def,
+                                           uh_session_id* out);
 #define uh_session_create(scene, def, out) uh_session_create_checked(UH_API_VERSION, (scene), (def), (out))
 
 /* Starts the haptic, collision and monitor threads and returns at once. */
-UH_API uh_status uh_session_start(uh_session* s);
+UH_API uh_status uh_session_start(uh_session_id s);
 
 /* Instead of start: runs `seconds` of the session on the calling thread in simulated time, one
  * collision step every `ticks_per_collision_step` haptic ticks (deterministic; for tests and
  * offline work). Returns when done; the session is then stopped. */
-UH_API uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_per_collision_step);
+UH_API uh_status uh_session_run_stepped(uh_session_id s, double seconds, int32_t ticks_per_collision_step);
 
 /* Copies the newest state of the (first) tool into `out` (out->struct_size set by the caller).
  * Any thread; never waits for the haptic thread. Before the first tick: zeros. After stop: the last state,
  * with the zero force the device got. */
-UH_API uh_status uh_session_poll(uh_session* s, uh_state* out);
+UH_API uh_status uh_session_poll(uh_session_id s, uh_state* out);
 
-/* Tools of the session's scene (a scene may hold several, each on its own device and haptic
- * thread): their count, names (valid until close) and each one's newest state, as
- * uh_session_poll gives the first tool's (`tool` from 0 to count - 1; any thread, never waits). */
-UH_API uh_status uh_session_tool_count(uh_session* s, int32_t* out);
-UH_API uh_status uh_session_tool_name(uh_session* s, int32_t tool, const char** out);
-UH_API uh_status uh_session_tool_state(uh_session* s, int32_t tool, uh_state* out);
+/* Tools of the session's scene (each on its own device and haptic thread): their count, names
+ * (valid until destroy) and each one's newest state, as uh_session_poll gives the first tool's
+ * (`tool` from 0 to count - 1; any thread, never waits). */
+UH_API uh_status uh_session_tool_count(uh_session_id s, int32_t* out);
+UH_API uh_status uh_session_tool_name(uh_session_id s, int32_t tool, const char** out);
+UH_API uh_status uh_session_tool_state(uh_session_id s, int32_t tool, uh_state* out);
 
 /* Takes the oldest contact event not yet taken: *has_event is 1 and `out` filled, or 0 when none
  * is waiting. Events queue up (1024; more are dropped) from start on. */
-UH_API uh_status uh_session_poll_event(uh_session* s, uh_contact_event* out, int32_t* has_event);
+UH_API uh_status uh_session_poll_event(uh_session_id s, uh_contact_event* out, int32_t* has_event);
 
 /* Moves object `object` (its scene index) while the session runs; the collision thread uses the
  * pose from its next step. Call it for one object from one thread only. */
-UH_API uh_status uh_session_set_object_pose(uh_session* s, int32_t object, const double position[3],
+UH_API uh_status uh_session_set_object_pose(uh_session_id s, int32_t object, const double position[3],
                                             const double orientation[4]);
 
-/* Sets (or with fn NULL removes) the haptic-thread tick callback. Only before start. */
-UH_API uh_status uh_session_set_tick_callback(uh_session* s, uh_tick_fn fn, void* user);
+/* Sets (or with fn NULL removes) the haptic-thread tick callback of the first tool. Only before
+ * start. */
+UH_API uh_status uh_session_set_tick_callback(uh_session_id s, uh_tick_fn fn, void* user);
 
 /* Sends zero force at once, stops and joins every thread, completes the report. Idempotent: later
- * calls return what the first returned. UH_ERROR_FAILED if a thread had ended on its own (the
- * report is still complete). Before start: UH_OK, nothing to do. */
-UH_API uh_status uh_session_stop(uh_session* s);
+ * calls return what the first returned. UH_ERROR_THREAD if a thread had ended on its own,
+ * UH_ERROR_DEVICE if a device faulted (the report is still complete). Before start: UH_OK,
+ * nothing to do. */
+UH_API uh_status uh_session_stop(uh_session_id s);
 
 /* The report of the run as the JSON object `uh run --json` prints. Only after stop (or a stepped
- * run); `*out` stays valid until the session is closed. */
-UH_API uh_status uh_session_report_json(uh_session* s, const char** out);
+ * run); `*out` stays valid until the session is destroyed. */
+UH_API uh_status uh_session_report_json(uh_session_id s, const char** out);
 
-/* Objects of the session's scene: their count and names (valid until close). */
-UH_API uh_status uh_session_object_count(uh_session* s, int32_t* out);
-UH_API uh_status uh_session_object_name(uh_session* s, int32_t object, const char** out);
+/* Objects of the session's scene: their count and names (valid until destroy). */
+UH_API uh_status uh_session_object_count(uh_session_id s, int32_t* out);
+UH_API uh_status uh_session_object_name(uh_session_id s, int32_t object, const char** out);
 
-/* Stops the session if it runs and frees it. NULL, a stale handle or a second close: nothing. */
-UH_API void uh_session_close(uh_session* s);
+/* Stops the session if it runs and destroys it. Zero, a stale id or a second destroy: nothing. */
+UH_API void uh_session_destroy(uh_session_id s);
 
 #ifdef __cplusplus
 }

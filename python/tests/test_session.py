@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 import unrealhaptics as uh
-from conftest import CUBE_TRIANGLES, CUBE_VERTICES, small_scene
+from conftest import ASSETS, CUBE_TRIANGLES, CUBE_VERTICES, small_scene
 
 
 def test_version_and_api():
     assert isinstance(uh.__version__, str) and uh.__version__.count(".") == 2
-    assert uh.api_version == 1
+    assert uh.api_version == 2
 
 
 def test_default_session_stepped_reads_contact_and_force():
@@ -120,8 +120,9 @@ def test_moving_an_object_moves_the_contact(scene):
 
 
 def test_bad_input_raises_with_a_message(scene):
-    with pytest.raises(uh.UhError, match="missing.json"):
+    with pytest.raises(uh.UhError, match="missing.json") as error:
         uh.Session.open("missing.json")
+    assert error.value.status == "UH_ERROR_FILE"  # each kind of failure has its status
     with pytest.raises(uh.UhError, match="exactly one"):
         scene.add_object("x", mesh="a.obj", ist="b.ist")
     with pytest.raises(uh.UhError, match="start"):
@@ -165,3 +166,21 @@ def test_two_tools_each_with_its_state(tmp_path):
     assert all(t["contact"]["ticks"] > 0 for t in report["tools"])
     assert right.haptic_ticks == 1000 and abs(right.tool_position[0] - 0.15) < 1e-9
     assert first.haptic_ticks == left.haptic_ticks and abs(left.tool_position[0]) < 1e-9
+
+
+def test_tools_added_through_calls_each_name_their_contacts():
+    scene = small_scene()
+    scene.add_object("ball", mesh=ASSETS / "ball.obj", spheres=200, meters_per_unit=0.03, position=(0.15, 0, 0.03))
+    with pytest.raises(uh.UhError, match="a tool named 'stylus' already"):
+        scene.add_tool(name="stylus", mesh=ASSETS / "stylus.obj", spheres=150, meters_per_unit=0.01)
+    index = scene.add_tool(name="right", mesh=ASSETS / "stylus.obj", spheres=150, meters_per_unit=0.01, mode="3dof",
+                           stiffness=1.6e4, max_force_n=4.0, config={"start": [0.15, 0, 0.1], "end": [0.15, 0, 0.048]})
+    assert index == 1 and scene.tool_count == 2
+    with uh.Session.open(scene) as s:
+        assert s.tool_names == ["stylus", "right"]
+        s.run_stepped(1.0, 4)
+        events = s.events()
+    begins = {(e.tool, e.object) for e in events if e.kind == "begin"}
+    assert begins == {(0, 0), (1, 1)}  # the left stylus meets the bunny, the right one the ball
+    scene.remove_tool("right")
+    assert scene.tool_count == 1

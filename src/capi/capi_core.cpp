@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <utility>
 
 #include "capi_support.hpp"
 
@@ -21,13 +23,38 @@ uh_status fail(uh_status status, std::string message) {
   return status;
 }
 
+// each kind of failure the modules tell apart, and its status
+constexpr std::pair<ErrorKind, uh_status> kKindStatus[] = {{ErrorKind::kInvalid, UH_ERROR_INVALID_ARGUMENT},
+                                                           {ErrorKind::kFile, UH_ERROR_FILE},
+                                                           {ErrorKind::kMesh, UH_ERROR_MESH},
+                                                           {ErrorKind::kDevice, UH_ERROR_DEVICE},
+                                                           {ErrorKind::kThread, UH_ERROR_THREAD},
+                                                           {ErrorKind::kBusy, UH_ERROR_BUSY}};
+
+uh_status fail(const Error& error, uh_status fallback) {
+  for (const auto& [kind, status] : kKindStatus)
+    if (kind == error.kind) return fail(status, error.message);
+  return fail(fallback, error.message);
+}
+
+ErrorKind error_kind(uh_status status) {
+  for (const auto& [kind, known] : kKindStatus)
+    if (known == status) return kind;
+  return ErrorKind::kUnspecified;
+}
+
+uh_status table_full(const char* kind) {
+  return fail(UH_ERROR_BUSY,
+              fmt::format("too many {} are open at once (about a million); destroy some", kind));
+}
+
 uh_status null_argument(const char* function, const char* argument) {
   return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {} is NULL", function, argument));
 }
 
 uh_status stale(const char* function, const char* kind) {
   return fail(UH_ERROR_STALE_HANDLE,
-              fmt::format("{}: the {} handle is not open (closed, freed, never opened, or another kind)",
+              fmt::format("{}: the {} id is not valid (destroyed, never made, or an id of another kind)",
                           function, kind));
 }
 
@@ -47,6 +74,20 @@ Result<Pose> pose_from_arrays(const double position[3], const double orientation
       std::sqrt(scaled.w * scaled.w + scaled.x * scaled.x + scaled.y * scaled.y + scaled.z * scaled.z);
   return Pose{Quat{scaled.w / n, scaled.x / n, scaled.y / n, scaled.z / n}, p};
 }
+
+// each kind's layout is a prefix of its newest: a struct grows only at its end, so that an older
+// program's smaller struct is read up to its size (an input struct's new field starts past the
+// older struct's end: its padding was never the caller's to set)
+static_assert(offsetof(uh_tool_def, tool_offset) >= sizeof(uh_v2_0_tool_def));
+static_assert(offsetof(uh_contact_event, tool) >= offsetof(uh_v2_0_contact_event, pairs) + sizeof(int32_t));
+static_assert(sizeof(uh_tree_build_def) == sizeof(uh_v2_0_tree_build_def) &&
+                  sizeof(uh_shape_def) == sizeof(uh_v2_0_shape_def) &&
+                  sizeof(uh_object_def) == sizeof(uh_v2_0_object_def) &&
+                  sizeof(uh_session_def) == sizeof(uh_v2_0_session_def) &&
+                  sizeof(uh_state) == sizeof(uh_v2_0_state) &&
+                  sizeof(uh_tree_info) == sizeof(uh_v2_0_tree_info) &&
+                  sizeof(uh_query_result) == sizeof(uh_v2_0_query_result),
+              "a struct grew: keep its older layout in uh_v2_0_structs.h and add the new fields at its end");
 
 HandleTable<TreeBox>& tree_table() {
   static HandleTable<TreeBox> table(1);
@@ -82,10 +123,18 @@ const char* uh_status_name(uh_status status) {
       return "UH_ERROR_WRONG_STATE";
     case UH_ERROR_VERSION:
       return "UH_ERROR_VERSION";
-    case UH_ERROR_FAILED:
-      return "UH_ERROR_FAILED";
     case UH_ERROR_INTERNAL:
       return "UH_ERROR_INTERNAL";
+    case UH_ERROR_FILE:
+      return "UH_ERROR_FILE";
+    case UH_ERROR_MESH:
+      return "UH_ERROR_MESH";
+    case UH_ERROR_DEVICE:
+      return "UH_ERROR_DEVICE";
+    case UH_ERROR_THREAD:
+      return "UH_ERROR_THREAD";
+    case UH_ERROR_BUSY:
+      return "UH_ERROR_BUSY";
     default:
       return "unknown uh_status";
   }

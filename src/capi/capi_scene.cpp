@@ -10,21 +10,62 @@
 namespace uh::capi {
 namespace {
 
-uh_status add_scene(controllers::Scene scene, uh_scene** out) {
+uh_status add_scene(controllers::Scene scene, uh_scene_id* out) {
   auto box = std::make_shared<SceneBox>();
   box->scene = std::move(scene);
-  const std::uintptr_t handle = scene_table().insert(std::move(box));
-  if (handle == 0) return fail(UH_ERROR_FAILED, "too many scenes are open at once (about a million)");
-  *out = as_handle<uh_scene>(handle);
+  const std::uint64_t id = scene_table().insert(std::move(box));
+  if (id == 0) return table_full("scenes");
+  out->bits = id;
   return UH_OK;
+}
+
+uh_shape_def default_shape_def() {
+  uh_shape_def def{};
+  def.struct_size = sizeof def;
+  def.spheres = 10000;
+  def.meters_per_unit = 1.0;
+  return def;
+}
+
+uh_object_def default_object_def() {
+  uh_object_def def{};
+  def.struct_size = sizeof def;
+  def.shape = default_shape_def();
+  def.orientation[0] = 1.0;
+  def.watch = 1;
+  return def;
+}
+
+uh_tool_def default_tool_def() {
+  const forcecomp::ForceParams f{};
+  uh_tool_def def{};
+  def.struct_size = sizeof def;
+  def.name = "tool";
+  def.shape = default_shape_def();
+  def.mode = UH_FORCE_6DOF;
+  def.law = UH_FORCE_LAW_GRADIENT;
+  def.stiffness = f.stiffness;
+  def.force_scale = f.force_scale;
+  def.damping = f.damping;
+  def.damping_full_volume = f.damping_full_volume;
+  def.mass_kg = f.mass_kg;
+  def.center_of_mass[0] = f.center_of_mass_body.x;
+  def.center_of_mass[1] = f.center_of_mass_body.y;
+  def.center_of_mass[2] = f.center_of_mass_body.z;
+  def.max_force_n = f.max_force_n;
+  def.max_torque_nm = f.max_torque_nm;
+  def.device_driver = "sim-line";
+  def.workspace_scale = 1.0;
+  def.workspace_rotation[0] = 1.0;
+  return def;
 }
 
 // The shape of a def: exactly one source; files must exist now; arrays are packed here.
 Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh_shape_def& def) {
-  if (def.struct_size < sizeof(uh_shape_def))
-    return Error{fmt::format("{}: shape.struct_size is {}, expected at least {}", what, def.struct_size,
-                             sizeof(uh_shape_def))};
-  const int sources = (def.mesh_path != nullptr) + (def.ist_path != nullptr) + (def.tree != nullptr) +
+  if (std::string why = size_problem<uh_shape_def>(fmt::format("{}: shape", what), def.struct_size);
+      !why.empty())
+    return Error{std::move(why), ErrorKind::kInvalid};
+  const int sources = (def.mesh_path != nullptr) + (def.ist_path != nullptr) + (def.tree.bits != 0) +
                       (def.vertices != nullptr || def.indices != nullptr);
   if (sources != 1)
     return Error{
@@ -51,21 +92,22 @@ Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh
     auto p = existing_file(def.ist_path, "ist_path");
     if (!p) return p.error();
     shape.ist = *p;
-  } else if (def.tree != nullptr) {
-    const auto box = tree_table().find(handle_value(def.tree));
-    if (!box) return Error{fmt::format("{}: shape.tree is not an open tree handle", what)};
+  } else if (def.tree.bits != 0) {
+    const auto box = tree_table().find(def.tree.bits);
+    if (!box) return Error{fmt::format("{}: shape.tree is not a valid tree id", what)};
     shape.tree = box->tree;
     // 0 when unknown: the gradient law is then uncalibrated
     if (box->meta.coverage > 0.0 && box->meta.coverage <= 1.0) shape.coverage = box->meta.coverage;
   } else {
-    uh_tree* tree = nullptr;
+    uh_tree_id tree{0};
     const uh_tree_build_def build{.struct_size = sizeof(uh_tree_build_def),
                                   .spheres = def.spheres,
                                   .meters_per_unit = def.meters_per_unit};
-    if (uh_tree_build_from_arrays(def.vertices, def.vertex_count, def.indices, def.triangle_count, &build,
-                                  &tree) != UH_OK)
-      return Error{fmt::format("{}: {}", what, uh_last_error())};
-    const std::shared_ptr<TreeBox> built = tree_table().remove(handle_value(tree));
+    if (const uh_status built = uh_tree_build_from_arrays(def.vertices, def.vertex_count, def.indices,
+                                                          def.triangle_count, &build, &tree);
+        built != UH_OK)
+      return Error{fmt::format("{}: {}", what, uh_last_error()), error_kind(built)};
+    const std::shared_ptr<TreeBox> built = tree_table().remove(tree.bits);
     if (!built) return Error{fmt::format("{}: the tree built from the arrays was lost", what)};
     shape.tree = built->tree;
     if (built->meta.coverage > 0.0 && built->meta.coverage <= 1.0) shape.coverage = built->meta.coverage;
@@ -85,13 +127,87 @@ struct NamedObject {
   std::vector<controllers::SceneObject>::iterator object;
 };
 
-uh_status find_named(const char* fn, const uh_scene* scene, const char* name, NamedObject& out) {
+uh_status find_named(const char* fn, uh_scene_id scene, const char* name, NamedObject& out) {
   if (name == nullptr) return null_argument(fn, "name");
-  out.box = scene_table().find(handle_value(scene));
+  out.box = scene_table().find(scene.bits);
   if (!out.box) return stale(fn, "scene");
   out.object = find_object(out.box->scene, name);
   if (out.object == out.box->scene.objects.end())
     return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: no object is named '{}'", fn, name));
+  return UH_OK;
+}
+
+std::vector<controllers::SceneTool>::iterator find_tool(controllers::Scene& scene, const std::string& name) {
+  return std::find_if(scene.tools.begin(), scene.tools.end(),
+                      [&](const controllers::SceneTool& t) { return t.name == name; });
+}
+
+// A tool def (this version's layout, defaults filled in) as the scene's tool, or what is wrong.
+Result<controllers::SceneTool> tool_from_def(const std::string& what, const uh_tool_def& def) {
+  const auto invalid = [](std::string message) { return Error{std::move(message), ErrorKind::kInvalid}; };
+  if (def.mode != UH_FORCE_6DOF && def.mode != UH_FORCE_3DOF)
+    return invalid(fmt::format("{}: mode {} is neither UH_FORCE_6DOF nor UH_FORCE_3DOF", what, def.mode));
+  if (def.law != UH_FORCE_LAW_GRADIENT && def.law != UH_FORCE_LAW_PAPER)
+    return invalid(
+        fmt::format("{}: law {} is neither UH_FORCE_LAW_GRADIENT nor UH_FORCE_LAW_PAPER", what, def.law));
+  const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  const auto non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
+  if (!non_negative(def.stiffness) || !non_negative(def.force_scale) || !non_negative(def.damping) ||
+      !non_negative(def.damping_full_volume) || !positive(def.mass_kg) || !positive(def.max_force_n) ||
+      !positive(def.max_torque_nm) || !positive(def.workspace_scale))
+    return invalid(fmt::format(
+        "{}: stiffness, force_scale, damping and damping_full_volume must be >= 0; mass_kg, max_force_n, "
+        "max_torque_nm and workspace_scale > 0 (all finite)",
+        what));
+  if (def.device_driver == nullptr || *def.device_driver == '\0')
+    return invalid(fmt::format("{}: device_driver is empty", what));
+  const Vec3 com{def.center_of_mass[0], def.center_of_mass[1], def.center_of_mass[2]};
+  if (!is_finite(com)) return invalid(fmt::format("{}: center_of_mass is not finite", what));
+  const Vec3 tool_offset{def.tool_offset[0], def.tool_offset[1], def.tool_offset[2]};
+  if (!is_finite(tool_offset)) return invalid(fmt::format("{}: tool_offset is not finite", what));
+  auto shape = shape_from_def(what, def.shape);
+  if (!shape) return shape.error();
+  auto workspace = pose_from_arrays(def.workspace_offset, def.workspace_rotation);
+  if (!workspace) return invalid(fmt::format("{}: workspace: {}", what, workspace.error().message));
+  auto config = controllers::parse_device_config(
+      def.device_config_json != nullptr ? def.device_config_json : "{}",
+      fmt::format("{} device_config_json", what), std::filesystem::current_path());
+  if (!config) return invalid(config.error().message);
+
+  controllers::SceneTool tool;
+  tool.name = def.name != nullptr ? def.name : "tool";
+  tool.shape = std::move(shape).value();
+  tool.mode = def.mode == UH_FORCE_3DOF ? forcecomp::ForceMode::k3Dof : forcecomp::ForceMode::k6Dof;
+  tool.force = {
+      .mass_kg = def.mass_kg,
+      .center_of_mass_body = com,
+      .law = def.law == UH_FORCE_LAW_PAPER ? forcecomp::ForceLaw::kPaper : forcecomp::ForceLaw::kGradient,
+      .stiffness = def.stiffness,
+      .force_scale = def.force_scale,
+      .damping = def.damping,
+      .damping_full_volume = def.damping_full_volume,
+      .max_force_n = def.max_force_n,
+      .max_torque_nm = def.max_torque_nm};
+  tool.device = {.driver = def.device_driver, .config = std::move(config).value()};
+  tool.workspace = {.world_from_device_base = *workspace,
+                    .scale = def.workspace_scale,
+                    .handle_from_tool = Pose{Quat{}, tool_offset}};
+  return tool;
+}
+
+// The tool of uh_scene_set_tool / uh_scene_add_tool: the caller's def read (an older layout with
+// this version's defaults for the rest) and converted; its name must not be another tool's.
+uh_status read_tool(const char* fn, const uh_tool_def* def, const controllers::Scene& scene,
+                    std::size_t replaced, controllers::SceneTool& out) {
+  uh_tool_def d = default_tool_def();
+  if (auto s = read_def(fn, "def", def, d); s != UH_OK) return s;
+  auto tool = tool_from_def(fmt::format("{}: tool", fn), d);
+  if (!tool) return fail(tool.error(), UH_ERROR_INVALID_ARGUMENT);
+  for (std::size_t i = 0; i < scene.tools.size(); ++i)
+    if (i != replaced && scene.tools[i].name == tool->name)
+      return fail(UH_ERROR_INVALID_ARGUMENT,
+                  fmt::format("{}: the scene has a tool named '{}' already", fn, tool->name));
+  out = std::move(tool).value();
   return UH_OK;
 }
 
@@ -103,123 +219,88 @@ using namespace uh::capi;
 
 extern "C" {
 
-uh_shape_def uh_default_shape_def(void) {
-  return uh_shape_def{.struct_size = sizeof(uh_shape_def),
-                      .mesh_path = nullptr,
-                      .ist_path = nullptr,
-                      .tree = nullptr,
-                      .vertices = nullptr,
-                      .vertex_count = 0,
-                      .indices = nullptr,
-                      .triangle_count = 0,
-                      .spheres = 10000,
-                      .meters_per_unit = 1.0};
-}
+uh_status uh_shape_def_init(uh_shape_def* def) { return init_def(__func__, def, default_shape_def); }
 
-uh_object_def uh_default_object_def(void) {
-  return uh_object_def{.struct_size = sizeof(uh_object_def),
-                       .name = nullptr,
-                       .shape = uh_default_shape_def(),
-                       .position = {0.0, 0.0, 0.0},
-                       .orientation = {1.0, 0.0, 0.0, 0.0},
-                       .watch = 1};
-}
+uh_status uh_object_def_init(uh_object_def* def) { return init_def(__func__, def, default_object_def); }
 
-uh_tool_def uh_default_tool_def(void) {
-  const forcecomp::ForceParams f{};
-  return uh_tool_def{
-      .struct_size = sizeof(uh_tool_def),
-      .name = "tool",
-      .shape = uh_default_shape_def(),
-      .mode = UH_FORCE_6DOF,
-      .law = UH_FORCE_LAW_GRADIENT,
-      .stiffness = f.stiffness,
-      .force_scale = f.force_scale,
-      .damping = f.damping,
-      .damping_full_volume = f.damping_full_volume,
-      .mass_kg = f.mass_kg,
-      .center_of_mass = {f.center_of_mass_body.x, f.center_of_mass_body.y, f.center_of_mass_body.z},
-      .max_force_n = f.max_force_n,
-      .max_torque_nm = f.max_torque_nm,
-      .device_driver = "sim-line",
-      .device_config_json = nullptr,
-      .workspace_scale = 1.0,
-      .workspace_offset = {0.0, 0.0, 0.0},
-      .workspace_rotation = {1.0, 0.0, 0.0, 0.0}};
-}
+uh_status uh_tool_def_init(uh_tool_def* def) { return init_def(__func__, def, default_tool_def); }
 
-uh_status uh_scene_create(const char* name, uh_scene** out) {
+int32_t uh_scene_is_valid(uh_scene_id scene) { return is_live(scene_table(), scene.bits); }
+
+uh_status uh_scene_create(const char* name, uh_scene_id* out) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
-    *out = nullptr;
+    *out = uh_scene_id{0};
     controllers::Scene scene;
     scene.name = name != nullptr ? name : "scene";
     scene.source = fmt::format("scene '{}'", scene.name);
+    scene.tools.clear();  // uh_scene_set_tool / uh_scene_add_tool add them
     return add_scene(std::move(scene), out);
   });
 }
 
-uh_status uh_scene_load(const char* scene_path, uh_scene** out) {
+uh_status uh_scene_load(const char* scene_path, uh_scene_id* out) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
-    *out = nullptr;
+    *out = uh_scene_id{0};
     auto scene = scene_path != nullptr ? controllers::load_scene(scene_path)
                                        : controllers::default_scene(controllers::default_cache_dir());
-    if (!scene) return fail(UH_ERROR_FAILED, scene.error().message);
+    if (!scene) return fail(scene.error(), UH_ERROR_FILE);
     return add_scene(std::move(scene).value(), out);
   });
 }
 
-uh_status uh_scene_parse(const char* json_text, const char* base_dir, uh_scene** out) {
+uh_status uh_scene_parse(const char* json_text, const char* base_dir, uh_scene_id* out) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
     if (json_text == nullptr) return null_argument(fn, "json_text");
     if (out == nullptr) return null_argument(fn, "out");
-    *out = nullptr;
+    *out = uh_scene_id{0};
     const std::filesystem::path base =
         base_dir != nullptr ? std::filesystem::path(base_dir) : std::filesystem::current_path();
     auto scene = controllers::parse_scene(json_text, "scene JSON", base);
-    if (!scene) return fail(UH_ERROR_FAILED, scene.error().message);
+    if (!scene) return fail(scene.error(), UH_ERROR_INVALID_ARGUMENT);
     return add_scene(std::move(scene).value(), out);
   });
 }
 
-void uh_scene_free(uh_scene* scene) {
+void uh_scene_destroy(uh_scene_id scene) {
   const char* const fn = __func__;
   const uh_status ignored = guarded(fn, [&]() -> uh_status {
-    scene_table().remove(handle_value(scene));
+    scene_table().remove(scene.bits);
     return UH_OK;
   });
   (void)ignored;
 }
 
-uh_status uh_scene_add_object(uh_scene* scene, const uh_object_def* def, int32_t* out_index) {
+uh_status uh_scene_add_object(uh_scene_id scene, const uh_object_def* def, int32_t* out_index) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
-    if (auto s = check_struct(fn, "def", def); s != UH_OK) return s;
-    const auto box = scene_table().find(handle_value(scene));
+    uh_object_def d = default_object_def();
+    if (auto s = read_def(fn, "def", def, d); s != UH_OK) return s;
+    const auto box = scene_table().find(scene.bits);
     if (!box) return stale(fn, "scene");
-    if (def->name == nullptr || *def->name == '\0')
+    if (d.name == nullptr || *d.name == '\0')
       return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: def->name is empty", fn));
     controllers::Scene& sc = box->scene;
-    if (find_object(sc, def->name) != sc.objects.end())
+    if (find_object(sc, d.name) != sc.objects.end())
       return fail(UH_ERROR_INVALID_ARGUMENT,
-                  fmt::format("{}: the scene has an object named '{}' already", fn, def->name));
-    const std::string what = fmt::format("{}: object '{}'", fn, def->name);
-    auto pose = pose_from_arrays(def->position, def->orientation);
+                  fmt::format("{}: the scene has an object named '{}' already", fn, d.name));
+    const std::string what = fmt::format("{}: object '{}'", fn, d.name);
+    auto pose = pose_from_arrays(d.position, d.orientation);
     if (!pose) return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", what, pose.error().message));
-    auto shape = shape_from_def(what, def->shape);
-    if (!shape) return fail(UH_ERROR_INVALID_ARGUMENT, shape.error().message);
-    sc.objects.push_back({.name = def->name, .shape = std::move(shape).value(), .pose = *pose});
-    if (def->watch != 0) sc.watch.push_back(def->name);
+    auto shape = shape_from_def(what, d.shape);
+    if (!shape) return fail(shape.error(), UH_ERROR_INVALID_ARGUMENT);
+    sc.objects.push_back({.name = d.name, .shape = std::move(shape).value(), .pose = *pose});
+    if (d.watch != 0) sc.watch.push_back(d.name);
     if (out_index != nullptr) *out_index = static_cast<int32_t>(sc.objects.size() - 1);
     return UH_OK;
   });
 }
 
-uh_status uh_scene_remove_object(uh_scene* scene, const char* name) {
+uh_status uh_scene_remove_object(uh_scene_id scene, const char* name) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
     NamedObject found;
@@ -230,7 +311,7 @@ uh_status uh_scene_remove_object(uh_scene* scene, const char* name) {
   });
 }
 
-uh_status uh_scene_set_object_pose(uh_scene* scene, const char* name, const double position[3],
+uh_status uh_scene_set_object_pose(uh_scene_id scene, const char* name, const double position[3],
                                    const double orientation[4]) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
@@ -243,7 +324,7 @@ uh_status uh_scene_set_object_pose(uh_scene* scene, const char* name, const doub
   });
 }
 
-uh_status uh_scene_watch(uh_scene* scene, const char* name, int32_t watch) {
+uh_status uh_scene_watch(uh_scene_id scene, const char* name, int32_t watch) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
     NamedObject found;
@@ -254,72 +335,65 @@ uh_status uh_scene_watch(uh_scene* scene, const char* name, int32_t watch) {
   });
 }
 
-uh_status uh_scene_set_tool(uh_scene* scene, const uh_tool_def* def) {
+uh_status uh_scene_set_tool(uh_scene_id scene, const uh_tool_def* def) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
-    if (auto s = check_struct(fn, "def", def); s != UH_OK) return s;
-    const auto box = scene_table().find(handle_value(scene));
+    const auto box = scene_table().find(scene.bits);
     if (!box) return stale(fn, "scene");
-    const std::string what = fmt::format("{}: tool", fn);
-    if (def->mode != UH_FORCE_6DOF && def->mode != UH_FORCE_3DOF)
-      return fail(UH_ERROR_INVALID_ARGUMENT,
-                  fmt::format("{}: mode {} is neither UH_FORCE_6DOF nor UH_FORCE_3DOF", what, def->mode));
-    if (def->law != UH_FORCE_LAW_GRADIENT && def->law != UH_FORCE_LAW_PAPER)
-      return fail(
-          UH_ERROR_INVALID_ARGUMENT,
-          fmt::format("{}: law {} is neither UH_FORCE_LAW_GRADIENT nor UH_FORCE_LAW_PAPER", what, def->law));
-    const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
-    const auto non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
-    if (!non_negative(def->stiffness) || !non_negative(def->force_scale) || !non_negative(def->damping) ||
-        !non_negative(def->damping_full_volume) || !positive(def->mass_kg) || !positive(def->max_force_n) ||
-        !positive(def->max_torque_nm) || !positive(def->workspace_scale))
-      return fail(UH_ERROR_INVALID_ARGUMENT,
-                  fmt::format("{}: stiffness, force_scale, damping and damping_full_volume must be >= 0; "
-                              "mass_kg, max_force_n, "
-                              "max_torque_nm and workspace_scale > 0 (all finite)",
-                              what));
-    if (def->device_driver == nullptr || *def->device_driver == '\0')
-      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: device_driver is empty", what));
-    const Vec3 com{def->center_of_mass[0], def->center_of_mass[1], def->center_of_mass[2]};
-    if (!is_finite(com))
-      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: center_of_mass is not finite", what));
-    auto shape = shape_from_def(what, def->shape);
-    if (!shape) return fail(UH_ERROR_INVALID_ARGUMENT, shape.error().message);
-    auto workspace = pose_from_arrays(def->workspace_offset, def->workspace_rotation);
-    if (!workspace)
-      return fail(UH_ERROR_INVALID_ARGUMENT,
-                  fmt::format("{}: workspace: {}", what, workspace.error().message));
-    auto config = controllers::parse_device_config(
-        def->device_config_json != nullptr ? def->device_config_json : "{}",
-        fmt::format("{} device_config_json", what), std::filesystem::current_path());
-    if (!config) return fail(UH_ERROR_INVALID_ARGUMENT, config.error().message);
-
+    controllers::Scene& sc = box->scene;
     controllers::SceneTool tool;
-    tool.name = def->name != nullptr ? def->name : "tool";
-    tool.shape = std::move(shape).value();
-    tool.mode = def->mode == UH_FORCE_3DOF ? forcecomp::ForceMode::k3Dof : forcecomp::ForceMode::k6Dof;
-    tool.force = {
-        .mass_kg = def->mass_kg,
-        .center_of_mass_body = com,
-        .law = def->law == UH_FORCE_LAW_PAPER ? forcecomp::ForceLaw::kPaper : forcecomp::ForceLaw::kGradient,
-        .stiffness = def->stiffness,
-        .force_scale = def->force_scale,
-        .damping = def->damping,
-        .damping_full_volume = def->damping_full_volume,
-        .max_force_n = def->max_force_n,
-        .max_torque_nm = def->max_torque_nm};
-    tool.device = {.driver = def->device_driver, .config = std::move(config).value()};
-    tool.workspace = {
-        .world_from_device_base = *workspace, .scale = def->workspace_scale, .handle_from_tool = {}};
-    box->scene.tool() = std::move(tool);
+    if (auto s = read_tool(fn, def, sc, 0, tool); s != UH_OK) return s;
+    if (sc.tools.empty())
+      sc.tools.push_back(std::move(tool));
+    else
+      sc.tool() = std::move(tool);
     return UH_OK;
   });
 }
 
-uh_status uh_scene_set_rates(uh_scene* scene, double haptic_hz, double collision_hz) {
+uh_status uh_scene_add_tool(uh_scene_id scene, const uh_tool_def* def, int32_t* out_index) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
-    const auto box = scene_table().find(handle_value(scene));
+    const auto box = scene_table().find(scene.bits);
+    if (!box) return stale(fn, "scene");
+    controllers::Scene& sc = box->scene;
+    controllers::SceneTool tool;
+    if (auto s = read_tool(fn, def, sc, sc.tools.size(), tool); s != UH_OK) return s;
+    sc.tools.push_back(std::move(tool));
+    if (out_index != nullptr) *out_index = static_cast<int32_t>(sc.tools.size() - 1);
+    return UH_OK;
+  });
+}
+
+uh_status uh_scene_remove_tool(uh_scene_id scene, const char* name) {
+  const char* const fn = __func__;
+  return guarded(fn, [&]() -> uh_status {
+    if (name == nullptr) return null_argument(fn, "name");
+    const auto box = scene_table().find(scene.bits);
+    if (!box) return stale(fn, "scene");
+    const auto tool = find_tool(box->scene, name);
+    if (tool == box->scene.tools.end())
+      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: no tool is named '{}'", fn, name));
+    box->scene.tools.erase(tool);
+    return UH_OK;
+  });
+}
+
+uh_status uh_scene_tool_count(uh_scene_id scene, int32_t* out) {
+  const char* const fn = __func__;
+  return guarded(fn, [&]() -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    const auto box = scene_table().find(scene.bits);
+    if (!box) return stale(fn, "scene");
+    *out = static_cast<int32_t>(box->scene.tools.size());
+    return UH_OK;
+  });
+}
+
+uh_status uh_scene_set_rates(uh_scene_id scene, double haptic_hz, double collision_hz) {
+  const char* const fn = __func__;
+  return guarded(fn, [&]() -> uh_status {
+    const auto box = scene_table().find(scene.bits);
     if (!box) return stale(fn, "scene");
     if (!(haptic_hz >= 1.0 && haptic_hz <= 10000.0) || !(collision_hz >= 0.0 && collision_hz <= 10000.0))
       return fail(
@@ -333,11 +407,11 @@ uh_status uh_scene_set_rates(uh_scene* scene, double haptic_hz, double collision
   });
 }
 
-uh_status uh_scene_object_count(const uh_scene* scene, int32_t* out) {
+uh_status uh_scene_object_count(uh_scene_id scene, int32_t* out) {
   const char* const fn = __func__;
   return guarded(fn, [&]() -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
-    const auto box = scene_table().find(handle_value(scene));
+    const auto box = scene_table().find(scene.bits);
     if (!box) return stale(fn, "scene");
     *out = static_cast<int32_t>(box->scene.objects.size());
     return UH_OK;

@@ -32,6 +32,7 @@ HandleTable<SessionBox>& session_table() {
 }
 
 void fill_state(const controllers::SessionState& s, uh_state& out) {
+  out.struct_size = sizeof(uh_state);
   out.time_s = s.time_s;
   out.tool_position[0] = s.tool_position_world.x;
   out.tool_position[1] = s.tool_position_world.y;
@@ -57,7 +58,6 @@ void fill_state(const controllers::SessionState& s, uh_state& out) {
 // haptic thread: hands each tick's state to the program's callback (real-time; no allocation)
 void call_tick_callback(SessionBox& box, const controllers::SessionState& s) {
   uh_state state{};
-  state.struct_size = sizeof(uh_state);
   fill_state(s, state);
   box.tick_fn(box.tick_user, &state);
 }
@@ -71,9 +71,16 @@ uh_status check_version(const char* function, int32_t api_version) {
   return UH_OK;
 }
 
+uh_session_def default_session_def() {
+  uh_session_def def{};
+  def.struct_size = sizeof def;
+  def.collision_hz = -1.0;
+  return def;
+}
+
 uh_status open_session(const char* function, const controllers::Scene& scene, const uh_session_def& def,
-                       uh_session** out) {
-  if (scene.tool().shape.mesh.empty() && scene.tool().shape.ist.empty() && !scene.tool().shape.tree)
+                       uh_session_id* out) {
+  if (scene.tools.empty())
     return fail(UH_ERROR_INVALID_ARGUMENT,
                 fmt::format("{}: {} has no tool (uh_scene_set_tool)", function, scene.source));
   controllers::SessionOptions options;
@@ -83,22 +90,22 @@ uh_status open_session(const char* function, const controllers::Scene& scene, co
   options.cache_dir =
       def.cache_dir != nullptr ? std::filesystem::path(def.cache_dir) : controllers::default_cache_dir();
   auto session = controllers::HapticSession::create(scene, options);
-  if (!session) return fail(UH_ERROR_FAILED, session.error().message);
+  if (!session) return fail(session.error(), UH_ERROR_INVALID_ARGUMENT);
   auto box = std::make_shared<SessionBox>();
   box->session = std::move(session).value();
   for (const auto& o : scene.objects) box->object_names.push_back(o.name);
   for (const auto& t : scene.tools) box->tool_names.push_back(t.name);
-  const std::uintptr_t handle = session_table().insert(std::move(box));
-  if (handle == 0) return fail(UH_ERROR_FAILED, "too many sessions are open at once");
-  *out = as_handle<uh_session>(handle);
+  const std::uint64_t id = session_table().insert(std::move(box));
+  if (id == 0) return table_full("sessions");
+  out->bits = id;
   return UH_OK;
 }
 
 // Runs `body(box)` with the session's owner lock held, or fails for a stale handle.
 template <typename Body>
-uh_status with_session(const char* function, uh_session* s, Body&& body) {
+uh_status with_session(const char* function, uh_session_id s, Body&& body) {
   return guarded(function, [&]() -> uh_status {
-    const auto box = session_table().find(handle_value(s));
+    const auto box = session_table().find(s.bits);
     if (!box) return stale(function, "session");
     const std::lock_guard lock(box->mutex);
     return body(*box);
@@ -107,21 +114,23 @@ uh_status with_session(const char* function, uh_session* s, Body&& body) {
 
 // uh_session_poll and uh_session_tool_state: without the owner lock (HapticSession::state() is
 // safe on its own, and the tools are fixed at open)
-uh_status poll_tool(const char* fn, uh_session* s, int32_t tool, uh_state* out) {
+uh_status poll_tool(const char* fn, uh_session_id s, int32_t tool, uh_state* out) {
   return guarded(fn, [&]() -> uh_status {
-    if (auto c = check_struct(fn, "out", out); c != UH_OK) return c;
-    const auto box = session_table().find(handle_value(s));
+    if (auto c = check_out(fn, "out", out); c != UH_OK) return c;
+    const auto box = session_table().find(s.bits);
     if (!box) return stale(fn, "session");
     if (tool < 0 || static_cast<std::size_t>(tool) >= box->tool_names.size())
       return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: there is no tool {} (the scene has {})", fn,
                                                          tool, box->tool_names.size()));
-    fill_state(box->session->state(static_cast<std::size_t>(tool)), *out);
+    uh_state state{};
+    fill_state(box->session->state(static_cast<std::size_t>(tool)), state);
+    write_out(state, out);
     return UH_OK;
   });
 }
 
 // uh_session_object_name and uh_session_tool_name: entry `index` of the box's `names`
-uh_status name_at(const char* fn, uh_session* s, std::vector<std::string> SessionBox::*names,
+uh_status name_at(const char* fn, uh_session_id s, std::vector<std::string> SessionBox::*names,
                   const char* kind, int32_t index, const char** out) {
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
@@ -137,7 +146,7 @@ uh_status name_at(const char* fn, uh_session* s, std::vector<std::string> Sessio
 uh_status finish(SessionBox& box, const Status& result) {
   box.stopped = true;
   box.report_json = controllers::session_report_json(box.session->report());
-  if (!result) return fail(UH_ERROR_FAILED, result.error().message);
+  if (!result) return fail(result.error(), UH_ERROR_THREAD);
   return UH_OK;
 }
 
@@ -149,62 +158,57 @@ using namespace uh::capi;
 
 extern "C" {
 
-uh_session_def uh_default_session_def(void) {
-  return uh_session_def{.struct_size = sizeof(uh_session_def),
-                        .haptic_hz = 0.0,
-                        .collision_hz = -1.0,
-                        .raise_priority = 0,
-                        .cache_dir = nullptr};
-}
+uh_status uh_session_def_init(uh_session_def* def) { return init_def(__func__, def, default_session_def); }
 
-uh_status(uh_session_open)(const char* scene_path, uh_session** out) {
+int32_t uh_session_is_valid(uh_session_id session) { return is_live(session_table(), session.bits); }
+
+uh_status(uh_session_open)(const char* scene_path, uh_session_id* out) {
   return uh_session_open_checked(UH_API_VERSION, scene_path, out);
 }
 
-uh_status uh_session_open_checked(int32_t api_version, const char* scene_path, uh_session** out) {
+uh_status uh_session_open_checked(int32_t api_version, const char* scene_path, uh_session_id* out) {
   return guarded("uh_session_open", [&]() -> uh_status {
     if (out == nullptr) return null_argument("uh_session_open", "out");
-    *out = nullptr;
+    *out = uh_session_id{0};
     if (auto v = check_version("uh_session_open", api_version); v != UH_OK) return v;
-    const uh_session_def def = uh_default_session_def();
     auto scene = scene_path != nullptr ? controllers::load_scene(scene_path)
                                        : controllers::default_scene(controllers::default_cache_dir());
-    if (!scene) return fail(UH_ERROR_FAILED, scene.error().message);
-    return open_session("uh_session_open", *scene, def, out);
+    if (!scene) return fail(scene.error(), UH_ERROR_FILE);
+    return open_session("uh_session_open", *scene, default_session_def(), out);
   });
 }
 
-uh_status(uh_session_create)(const uh_scene* scene, const uh_session_def* def, uh_session** out) {
+uh_status(uh_session_create)(uh_scene_id scene, const uh_session_def* def, uh_session_id* out) {
   return uh_session_create_checked(UH_API_VERSION, scene, def, out);
 }
 
-uh_status uh_session_create_checked(int32_t api_version, const uh_scene* scene, const uh_session_def* def,
-                                    uh_session** out) {
+uh_status uh_session_create_checked(int32_t api_version, uh_scene_id scene, const uh_session_def* def,
+                                    uh_session_id* out) {
   return guarded("uh_session_create", [&]() -> uh_status {
     if (out == nullptr) return null_argument("uh_session_create", "out");
-    *out = nullptr;
+    *out = uh_session_id{0};
     if (auto v = check_version("uh_session_create", api_version); v != UH_OK) return v;
+    uh_session_def d = default_session_def();
     if (def != nullptr)
-      if (auto s = check_struct("uh_session_create", "def", def); s != UH_OK) return s;
-    const auto box = scene_table().find(handle_value(scene));
+      if (auto s = read_def("uh_session_create", "def", def, d); s != UH_OK) return s;
+    const auto box = scene_table().find(scene.bits);
     if (!box) return stale("uh_session_create", "scene");
-    return open_session("uh_session_create", box->scene, def != nullptr ? *def : uh_default_session_def(),
-                        out);
+    return open_session("uh_session_create", box->scene, d, out);
   });
 }
 
-uh_status uh_session_start(uh_session* s) {
+uh_status uh_session_start(uh_session_id s) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (box.stopped || box.session->running())
       return fail(UH_ERROR_WRONG_STATE,
                   fmt::format("{}: the session has run already (a session runs once)", fn));
-    if (auto started = box.session->start(); !started) return fail(UH_ERROR_FAILED, started.error().message);
+    if (auto started = box.session->start(); !started) return fail(started.error(), UH_ERROR_THREAD);
     return UH_OK;
   });
 }
 
-uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_per_collision_step) {
+uh_status uh_session_run_stepped(uh_session_id s, double seconds, int32_t ticks_per_collision_step) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (!(seconds > 0.0 && seconds <= 86400.0) || ticks_per_collision_step < 1)
@@ -219,13 +223,13 @@ uh_status uh_session_run_stepped(uh_session* s, double seconds, int32_t ticks_pe
   });
 }
 
-uh_status uh_session_poll(uh_session* s, uh_state* out) { return poll_tool(__func__, s, 0, out); }
+uh_status uh_session_poll(uh_session_id s, uh_state* out) { return poll_tool(__func__, s, 0, out); }
 
-uh_status uh_session_tool_state(uh_session* s, int32_t tool, uh_state* out) {
+uh_status uh_session_tool_state(uh_session_id s, int32_t tool, uh_state* out) {
   return poll_tool(__func__, s, tool, out);
 }
 
-uh_status uh_session_tool_count(uh_session* s, int32_t* out) {
+uh_status uh_session_tool_count(uh_session_id s, int32_t* out) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
@@ -234,29 +238,33 @@ uh_status uh_session_tool_count(uh_session* s, int32_t* out) {
   });
 }
 
-uh_status uh_session_tool_name(uh_session* s, int32_t tool, const char** out) {
+uh_status uh_session_tool_name(uh_session_id s, int32_t tool, const char** out) {
   return name_at(__func__, s, &SessionBox::tool_names, "tool", tool, out);
 }
 
-uh_status uh_session_poll_event(uh_session* s, uh_contact_event* out, int32_t* has_event) {
+uh_status uh_session_poll_event(uh_session_id s, uh_contact_event* out, int32_t* has_event) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
-    if (auto c = check_struct(fn, "out", out); c != UH_OK) return c;
+    if (auto c = check_out(fn, "out", out); c != UH_OK) return c;
     if (has_event == nullptr) return null_argument(fn, "has_event");
     controllers::ContactEvent e;
     *has_event = box.session->poll_event(e) ? 1 : 0;
     if (*has_event != 0) {
-      out->kind = e.kind == controllers::ContactEventKind::kBegin ? UH_CONTACT_BEGIN : UH_CONTACT_END;
-      out->object = e.object;
-      out->time_s = e.time_s;
-      out->volume = e.volume;
-      out->pairs = e.pairs;
+      uh_contact_event event{};
+      event.struct_size = sizeof event;
+      event.kind = e.kind == controllers::ContactEventKind::kBegin ? UH_CONTACT_BEGIN : UH_CONTACT_END;
+      event.object = e.object;
+      event.time_s = e.time_s;
+      event.volume = e.volume;
+      event.pairs = e.pairs;
+      event.tool = e.tool;
+      write_out(event, out);
     }
     return UH_OK;
   });
 }
 
-uh_status uh_session_set_object_pose(uh_session* s, int32_t object, const double position[3],
+uh_status uh_session_set_object_pose(uh_session_id s, int32_t object, const double position[3],
                                      const double orientation[4]) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
@@ -268,7 +276,7 @@ uh_status uh_session_set_object_pose(uh_session* s, int32_t object, const double
   });
 }
 
-uh_status uh_session_set_tick_callback(uh_session* s, uh_tick_fn callback, void* user) {
+uh_status uh_session_set_tick_callback(uh_session_id s, uh_tick_fn callback, void* user) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (box.stopped || box.session->running())
@@ -282,7 +290,7 @@ uh_status uh_session_set_tick_callback(uh_session* s, uh_tick_fn callback, void*
   });
 }
 
-uh_status uh_session_stop(uh_session* s) {
+uh_status uh_session_stop(uh_session_id s) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (!box.session->running() && !box.stopped) return UH_OK;  // never started: nothing to stop
@@ -290,7 +298,7 @@ uh_status uh_session_stop(uh_session* s) {
   });
 }
 
-uh_status uh_session_report_json(uh_session* s, const char** out) {
+uh_status uh_session_report_json(uh_session_id s, const char** out) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
@@ -301,7 +309,7 @@ uh_status uh_session_report_json(uh_session* s, const char** out) {
   });
 }
 
-uh_status uh_session_object_count(uh_session* s, int32_t* out) {
+uh_status uh_session_object_count(uh_session_id s, int32_t* out) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {
     if (out == nullptr) return null_argument(fn, "out");
@@ -310,14 +318,14 @@ uh_status uh_session_object_count(uh_session* s, int32_t* out) {
   });
 }
 
-uh_status uh_session_object_name(uh_session* s, int32_t object, const char** out) {
+uh_status uh_session_object_name(uh_session_id s, int32_t object, const char** out) {
   return name_at(__func__, s, &SessionBox::object_names, "object", object, out);
 }
 
-void uh_session_close(uh_session* s) {
+void uh_session_destroy(uh_session_id s) {
   const char* const fn = __func__;
   const uh_status ignored = guarded(fn, [&]() -> uh_status {
-    const auto box = session_table().remove(handle_value(s));
+    const auto box = session_table().remove(s.bits);
     if (!box) return UH_OK;
     const std::lock_guard lock(box->mutex);
     const Status stopped = box->session->stop();

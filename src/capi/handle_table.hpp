@@ -1,12 +1,13 @@
 #pragma once
-// HandleTable<T>: the objects behind the C API's opaque handles (after Box2D v3's ids with a
-// generation). A handle is an integer in pointer clothing, never an address: kind tag, slot
-// index and the slot's generation. Freeing a slot raises its generation, so an old handle no
-// longer matches and is refused instead of reaching freed memory.
+// HandleTable<T>: the objects behind the C API's ids (after Box2D v3's ids with a generation). An
+// id is a 64-bit integer passed by value, never an address: kind tag, slot index and the slot's
+// generation. Destroying a slot raises its generation, so an old id no longer matches and is
+// refused instead of reaching freed memory. Ids need no 64-bit pointers: 32-bit builds use them as
+// they are.
 //
 // Threads: every member may be called from any thread (one mutex per table, held only for the
 // lookup). find() hands out a shared_ptr, so an object stays alive for a call in progress on
-// another thread even if its handle is closed meanwhile.
+// another thread even if its id is destroyed meanwhile.
 
 #include <cstddef>
 #include <cstdint>
@@ -19,18 +20,18 @@ namespace uh::capi {
 template <typename T>
 class HandleTable {
  public:
-  /// `kind` (1..15) is stored in every handle, so that a handle of another table never matches.
-  explicit HandleTable(std::uint32_t kind) : kind_(kind) {}
+  /// `kind` (1..255) is stored in every id, so that an id of another table never matches.
+  explicit HandleTable(std::uint8_t kind) : kind_(kind) {}
 
-  /// Stores `object` and returns its new handle value, or 0 when all 2^20 slots are in use.
-  std::uintptr_t insert(std::shared_ptr<T> object) {
+  /// Stores `object` and returns its new id, or 0 when all 2^20 slots are in use.
+  std::uint64_t insert(std::shared_ptr<T> object) {
     const std::lock_guard lock(mutex_);
     std::uint32_t index = 0;
     if (!free_.empty()) {
       index = free_.back();
       free_.pop_back();
     } else {
-      if (slots_.size() >= (std::size_t{1} << kIndexBits)) return 0;
+      if (slots_.size() >= kMaxSlots) return 0;
       index = static_cast<std::uint32_t>(slots_.size());
       slots_.push_back({});
     }
@@ -39,57 +40,50 @@ class HandleTable {
     return encode(index, slot.generation);
   }
 
-  /// The object of a live handle, or null for 0, a stale handle or one of another kind.
-  std::shared_ptr<T> find(std::uintptr_t handle) const {
+  /// The object of a live id, or null for 0, a stale id or one of another kind.
+  std::shared_ptr<T> find(std::uint64_t id) const {
     const std::lock_guard lock(mutex_);
-    const Slot* slot = lookup(handle);
+    const Slot* slot = lookup(id);
     return slot != nullptr ? slot->object : nullptr;
   }
 
-  /// Takes the object of a live handle out of the table (the handle goes stale); null otherwise.
-  std::shared_ptr<T> remove(std::uintptr_t handle) {
+  /// Takes the object of a live id out of the table (the id goes stale); null otherwise.
+  std::shared_ptr<T> remove(std::uint64_t id) {
     const std::lock_guard lock(mutex_);
-    Slot* slot = const_cast<Slot*>(lookup(handle));
+    Slot* slot = const_cast<Slot*>(lookup(id));
     if (slot == nullptr) return nullptr;
     std::shared_ptr<T> object = std::move(slot->object);
     slot->object.reset();
-    ++slot->generation;
-    free_.push_back(index_of(handle));
+    slot->generation = (slot->generation + 1) & kGenerationMask;
+    free_.push_back(index_of(id));
     return object;
   }
 
  private:
-  // handle layout (64 bits): generation (40) | index (20) | kind (4)
-  static constexpr int kKindBits = 4;
-  static constexpr int kIndexBits = 20;
-  static_assert(sizeof(std::uintptr_t) == 8, "the C API's handles need 64-bit pointers");
+  // id layout (64 bits): kind (8) | generation (24) | index (32); 0 is never an id (kind >= 1)
+  static constexpr std::size_t kMaxSlots = std::size_t{1} << 20;
+  static constexpr std::uint32_t kGenerationMask = (1u << 24) - 1;
 
   struct Slot {
     std::shared_ptr<T> object;
-    std::uint64_t generation = 1;
+    std::uint32_t generation = 1;
   };
 
-  static constexpr std::uint64_t kGenerationMask = (std::uint64_t{1} << (64 - kKindBits - kIndexBits)) - 1;
-
-  std::uintptr_t encode(std::uint32_t index, std::uint64_t generation) const {
-    return (static_cast<std::uintptr_t>(generation & kGenerationMask) << (kKindBits + kIndexBits)) |
-           (static_cast<std::uintptr_t>(index) << kKindBits) | kind_;
+  std::uint64_t encode(std::uint32_t index, std::uint32_t generation) const {
+    return (std::uint64_t{kind_} << 56) | (std::uint64_t{generation} << 32) | index;
   }
-  static std::uint32_t index_of(std::uintptr_t handle) {
-    return static_cast<std::uint32_t>((handle >> kKindBits) & ((1u << kIndexBits) - 1));
-  }
+  static std::uint32_t index_of(std::uint64_t id) { return static_cast<std::uint32_t>(id & 0xffffffffu); }
 
-  const Slot* lookup(std::uintptr_t handle) const {
-    if ((handle & ((1u << kKindBits) - 1)) != kind_) return nullptr;
-    const std::uint32_t index = index_of(handle);
+  const Slot* lookup(std::uint64_t id) const {
+    if ((id >> 56) != kind_) return nullptr;
+    const std::uint32_t index = index_of(id);
     if (index >= slots_.size()) return nullptr;
     const Slot& slot = slots_[index];
-    if (!slot.object || (slot.generation & kGenerationMask) != (handle >> (kKindBits + kIndexBits)))
-      return nullptr;
+    if (!slot.object || slot.generation != ((id >> 32) & kGenerationMask)) return nullptr;
     return &slot;
   }
 
-  std::uint32_t kind_;
+  std::uint8_t kind_;
   mutable std::mutex mutex_;
   std::vector<Slot> slots_;
   std::vector<std::uint32_t> free_;

@@ -353,7 +353,7 @@ bool CollisionWorld::read_contact(WatcherId watcher, ContactFrame& out) {
 Status CollisionWorld::start() {
   if (running()) return Error{"CollisionWorld::start: the collision thread runs already"};
   if (watchers_by_id_.count() == 0)
-    return Error{"CollisionWorld::start: nothing is watched (add a watcher first)"};
+    return Error{"CollisionWorld::start: nothing is watched (add a watcher first)", ErrorKind::kInvalid};
   apply_pending();
   free_retired();
   step_time_.reset();

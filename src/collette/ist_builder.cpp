@@ -58,10 +58,12 @@ Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t s
                                        const IstBuildOptions& options) {
   const std::string& name = mesh.source_name;
   if (options.sphere_count <= 0)
-    return Error{fmt::format("{}: the sphere count must be positive (got {})", name, options.sphere_count)};
+    return Error{fmt::format("{}: the sphere count must be positive (got {})", name, options.sphere_count),
+                 ErrorKind::kInvalid};
   if (!(options.meters_per_unit >= kIstMinMetersPerUnit && options.meters_per_unit <= kIstMaxMetersPerUnit))
     return Error{fmt::format("{}: meters per unit must be between {} and {} (got {})", name,
-                             kIstMinMetersPerUnit, kIstMaxMetersPerUnit, options.meters_per_unit)};
+                             kIstMinMetersPerUnit, kIstMaxMetersPerUnit, options.meters_per_unit),
+                 ErrorKind::kInvalid};
   const auto start = std::chrono::steady_clock::now();
 
   PackingOptions packing_options;
@@ -70,11 +72,11 @@ Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t s
   packing_options.max_radius = options.max_radius;
   packing_options.progress = options.progress;
   auto packing = pack_spheres(mesh, packing_options);
-  if (!packing) return Error{fmt::format("{}: {}", name, packing.error().message)};
+  if (!packing) return Error{fmt::format("{}: {}", name, packing.error().message), ErrorKind::kMesh};
 
   const auto tree_start = std::chrono::steady_clock::now();
   auto tree = build_sphere_tree(packing->spheres, options.tree);
-  if (!tree) return Error{fmt::format("{}: sphere tree: {}", name, tree.error().message)};
+  if (!tree) return Error{fmt::format("{}: sphere tree: {}", name, tree.error().message), ErrorKind::kMesh};
   const auto end = std::chrono::steady_clock::now();
 
   IstBuildResult result{

@@ -340,12 +340,16 @@ Result<IstAsset> load_ist(const std::filesystem::path& path) {
   // a regular file within the limit, read without blocking on a FIFO or a device
   auto bytes = read_regular_file(path, kMaxFileBytes);
   if (!bytes) return bytes.error();
-  return load_ist_from_memory(std::as_bytes(std::span<const char>(*bytes)), name);
+  // whatever is wrong with what it holds is wrong with the file
+  auto asset = load_ist_from_memory(std::as_bytes(std::span<const char>(*bytes)), name);
+  if (!asset) return asset.error().classified(ErrorKind::kFile);
+  return asset;
 }
 
 Status save_ist(const std::filesystem::path& path, const IstAsset& asset) {
   const std::string name = path.string();
-  if (const Status ok = validate(asset); !ok) return Error{name + ": not saved: " + ok.error().message};
+  if (const Status ok = validate(asset); !ok)
+    return Error{name + ": not saved: " + ok.error().message, ErrorKind::kInvalid};
   const std::vector<std::byte> bytes = encode_ist(asset);
   return write_file_atomically(
       path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));

@@ -321,18 +321,21 @@ Result<TriangleMesh> load_mesh(const std::filesystem::path& path, const MeshLoad
   const std::string name = path.filename().string();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
-    return Error{fmt::format("{}: file not found (looked for '{}')", name, path.string())};
+    return Error{fmt::format("{}: file not found (looked for '{}')", name, path.string()), ErrorKind::kFile};
   }
   // a directory, FIFO or device is refused before the mesh library opens it (one would block or
   // never end), and so is a file above the limit
   const auto size = check_regular_file(path, kMaxMeshFileBytes);
   if (!size) return size.error();
   if (*size == 0) {
-    return Error{fmt::format("{}: file is empty, no mesh to read", name)};
+    return Error{fmt::format("{}: file is empty, no mesh to read", name), ErrorKind::kFile};
   }
+  // what the reader refuses is the file (format, syntax); what the validation refuses, the mesh
   auto mesh = read_mesh_file(path);
-  if (!mesh) return mesh.error();
-  return validate_mesh(std::move(*mesh), options);
+  if (!mesh) return mesh.error().classified(ErrorKind::kFile);
+  auto valid = validate_mesh(std::move(*mesh), options);
+  if (!valid) return valid.error().classified(ErrorKind::kMesh);
+  return valid;
 }
 
 }  // namespace uh::collette

@@ -39,7 +39,8 @@ Result<ObjectSurfaces> load_watched_surfaces(const Scene& scene) {
     }
     auto surface = load_shape_surface(object.shape);
     if (!surface)
-      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, surface.error().message)};
+      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, surface.error().message),
+                   surface.error().kind};
     surfaces[i] = *surface;
     by_mesh.emplace(key, *surface);
   }
@@ -117,10 +118,12 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   session->haptic_hz_ = options.haptic_hz.value_or(scene.haptic_hz);
   session->collision_hz_ = options.collision_hz.value_or(scene.collision_hz);
   if (!(session->haptic_hz_ > 0.0) || session->haptic_hz_ > 10000.0)
-    return Error{fmt::format("{}: haptic rate {} Hz is outside (0, 10000]", scene.source, session->haptic_hz_)};
+    return Error{fmt::format("{}: haptic rate {} Hz is outside (0, 10000]", scene.source, session->haptic_hz_),
+                 ErrorKind::kInvalid};
   if (session->collision_hz_ < 0.0 || session->collision_hz_ > 10000.0)
-    return Error{fmt::format("{}: collision rate {} Hz is outside [0, 10000]", scene.source, session->collision_hz_)};
-  if (scene.tools.empty()) return Error{fmt::format("{}: the scene has no tool", scene.source)};
+    return Error{fmt::format("{}: collision rate {} Hz is outside [0, 10000]", scene.source, session->collision_hz_),
+                 ErrorKind::kInvalid};
+  if (scene.tools.empty()) return Error{fmt::format("{}: the scene has no tool", scene.source), ErrorKind::kInvalid};
   ForceControllerOptions force_options = scene.force;
   if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
   if (options.tick_force) force_options.tick_force = *options.tick_force;
@@ -143,7 +146,9 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   std::vector<ShapeTree> object_trees;
   for (const SceneObject& object : scene.objects) {
     auto tree = load_shared(object.shape);
-    if (!tree) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message)};
+    if (!tree)
+      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message),
+                   tree.error().kind};
     object_trees.push_back(*tree);
   }
   Result<ObjectSurfaces> surfaces =
@@ -186,7 +191,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
     rig->path = several ? fmt::format("tools[{}]", t) : std::string("tool");
     auto tool_tree = load_shared(tool.shape);
     if (!tool_tree)
-      return Error{fmt::format("{}: tool '{}': {}", scene.source, tool.name, tool_tree.error().message)};
+      return Error{fmt::format("{}: tool '{}': {}", scene.source, tool.name, tool_tree.error().message),
+                   tool_tree.error().kind};
     // the tool's pose comes from its device on its first haptic tick (BridgingController)
     auto tool_id = world.add_object({.tree = tool_tree->tree,
                                      .has_initial_pose = false,
@@ -202,7 +208,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       device_config.set("rate_hz", session->haptic_hz_);
     auto device = registry.create(tool.device.driver, device_config);
     if (!device)
-      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, device.error().message)};
+      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, device.error().message),
+                   device.error().kind};
     const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, session->haptic_hz_ * 0.5));
     rig->manager = std::make_unique<haptico::HapticManager>(
         std::move(device).value(),
@@ -215,7 +222,8 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
                                                  .rate = scene.rate_limit},
                                       .fault_group = &session->fault_group_});
     if (auto opened = rig->manager->open(); !opened)
-      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, opened.error().message)};
+      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, opened.error().message),
+                   opened.error().kind};
 
     const forcecomp::ForceComponent component(
         {.params = tool.force, .mode = tool.mode, .side = forcecomp::ContactSide::kB});
@@ -448,7 +456,8 @@ Status HapticSession::start(std::ostream* trace) {
       for (std::size_t u = 0; u < t; ++u) rigs_[u]->manager->stop();
       world_->stop();
       if (rigs_.size() == 1) return started;
-      return Error{fmt::format("{}: {}.device: {}", scene_.source, rigs_[t]->path, started.error().message)};
+      return Error{fmt::format("{}: {}.device: {}", scene_.source, rigs_[t]->path, started.error().message),
+                   started.error().kind};
     }
   }
   phase_ = Phase::kRunning;
@@ -475,7 +484,8 @@ Status HapticSession::thread_error() const {
   // the first haptic thread that ended by a throw (the others were zeroed with it)
   for (const auto& rig : rigs_)
     if (Status s = rig->manager->thread_status(); !s)
-      return Error{fmt::format("{}: {}{}", scene_.source, tool_label(rig->index), s.error().message)};
+      return Error{fmt::format("{}: {}{}", scene_.source, tool_label(rig->index), s.error().message),
+                   s.error().kind};
   return Ok{};
 }
 
@@ -485,7 +495,8 @@ Status HapticSession::device_error() const {
   for (const auto& rig : rigs_) {
     if (Status device = rig->manager->device_status(); !device)
       return Error{fmt::format("{}: {}{}{}", scene_.source, tool_label(rig->index), device.error().message,
-                               rigs_.size() > 1 ? "; every device was sent zero force" : "")};
+                               rigs_.size() > 1 ? "; every device was sent zero force" : ""),
+                   device.error().kind};
   }
   return Ok{};
 }
@@ -520,11 +531,11 @@ Status HapticSession::stop() {
   else if (Status device = device_error(); !device)
     stopped_ = device;
   else if (!haptic_alive)
-    stopped_ = Error{"the haptic thread ended before the session was stopped"};
+    stopped_ = Error{"the haptic thread ended before the session was stopped", ErrorKind::kThread};
   else if (!collision_alive)
-    stopped_ = Error{"the collision thread ended before the session was stopped"};
+    stopped_ = Error{"the collision thread ended before the session was stopped", ErrorKind::kThread};
   else if (trace_ != nullptr && !*trace_)
-    stopped_ = Error{"the trace could not be written"};
+    stopped_ = Error{"the trace could not be written", ErrorKind::kFile};
   return stopped_;
 }
 

@@ -689,7 +689,9 @@ Result<ShapeTree> load_shape_tree(
     if (!hash) return hash.error();
     std::error_code ec;
     std::filesystem::create_directories(cache_dir, ec);
-    if (ec) return Error{fmt::format("{}: cannot create the cache folder: {}", cache_dir.string(), ec.message())};
+    if (ec)
+      return Error{fmt::format("{}: cannot create the cache folder: {}", cache_dir.string(), ec.message()),
+                   ErrorKind::kFile};
     // keyed by everything the packing depends on (the radius bound in mesh units, shortest exact
     // form) and by the tree builder's version (a cache of an older builder's tree is rebuilt)
     const double max_radius = shape.max_sphere_radius / shape.meters_per_unit;

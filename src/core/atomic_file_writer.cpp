@@ -68,7 +68,8 @@ Result<AtomicFileWriter> AtomicFileWriter::create(const std::filesystem::path& t
   int fd = -1;
   if (const std::error_code error = detail::create_new_file(temp, fd)) {
     return Error{
-        fmt::format("{}: cannot create a file in {}: {}", target.string(), dir.string(), reason(error))};
+        fmt::format("{}: cannot create a file in {}: {}", target.string(), dir.string(), reason(error)),
+        ErrorKind::kFile};
   }
   return AtomicFileWriter(std::make_unique<State>(target, temp, fd));
 }
@@ -99,7 +100,7 @@ Status AtomicFileWriter::commit() {
   s.done = true;
   auto fail = [&](std::string_view what, std::error_code error) {
     detail::remove_file(s.temp);
-    return Error{fmt::format("{}: {}: {}", s.target.string(), what, reason(error))};
+    return Error{fmt::format("{}: {}: {}", s.target.string(), what, reason(error)), ErrorKind::kFile};
   };
   s.out.flush();
   if (!s.out || s.buf.error()) {
@@ -118,7 +119,8 @@ Status AtomicFileWriter::commit() {
       s.target.has_parent_path() ? s.target.parent_path() : std::filesystem::path(".");
   if (const std::error_code error = detail::sync_directory(dir)) {
     return Error{fmt::format("{}: written, but its directory could not be synced: {}", s.target.string(),
-                             reason(error))};
+                             reason(error)),
+                 ErrorKind::kFile};
   }
   return Ok{};
 }

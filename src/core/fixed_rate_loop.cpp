@@ -68,7 +68,7 @@ Status FixedRateLoop::start(Callback callback, ExitCallback on_exit) {
     });
   } catch (const std::exception& e) {
     running_.store(false, std::memory_order_release);
-    return Error{"loop '" + options_.name + "': cannot create its thread: " + e.what()};
+    return Error{"loop '" + options_.name + "': cannot create its thread: " + e.what(), ErrorKind::kThread};
   }
   return Ok{};
 }

@@ -47,11 +47,13 @@ Result<std::uint64_t> open_checked(const std::filesystem::path& path, std::uint6
   detail::FileKind kind = detail::FileKind::kOther;
   std::uint64_t size = 0;
   if (const std::error_code ec = detail::open_for_reading(path, file.fd, kind, size))
-    return Error{fmt::format("{}: cannot open the file: {}", path.string(), ec.message())};
-  if (const char* what = not_a_file(kind)) return Error{fmt::format("{}: {}", path.string(), what)};
+    return Error{fmt::format("{}: cannot open the file: {}", path.string(), ec.message()), ErrorKind::kFile};
+  if (const char* what = not_a_file(kind))
+    return Error{fmt::format("{}: {}", path.string(), what), ErrorKind::kFile};
   if (size > max_bytes)
     return Error{fmt::format("{}: {} bytes is larger than the limit of {} bytes for this file", path.string(),
-                             size, max_bytes)};
+                             size, max_bytes),
+                 ErrorKind::kFile};
   return size;
 }
 
@@ -73,13 +75,14 @@ Result<std::string> read_regular_file(const std::filesystem::path& path, std::ui
     std::size_t got = 0;
     if (const std::error_code ec =
             detail::read_some(file.fd, bytes.data() + total, bytes.size() - total, got))
-      return Error{fmt::format("{}: read error: {}", path.string(), ec.message())};
+      return Error{fmt::format("{}: read error: {}", path.string(), ec.message()), ErrorKind::kFile};
     if (got == 0) break;
     total += got;
   }
   if (total > max_bytes)
     return Error{fmt::format("{}: the file grew past the limit of {} bytes while it was read", path.string(),
-                             max_bytes)};
+                             max_bytes),
+                 ErrorKind::kFile};
   bytes.resize(total);
   return bytes;
 }

@@ -165,7 +165,8 @@ Status ForceDimensionDevice::open_selected() {
     if (held_devices().id_of(library_.path(), selection_.index) >= 0)
       return Error{
           fmt::format("forcedimension: device {} is open already (another tool of this program drives it)",
-                      selection_.index)};
+                      selection_.index),
+          ErrorKind::kBusy};
     const int id = api.dhdOpenID(static_cast<char>(selection_.index));
     if (id < 0)
       return Error{fmt::format("forcedimension: opening device {} failed: {}", selection_.index,
@@ -184,7 +185,8 @@ Status ForceDimensionDevice::open_selected() {
         return Error{
             fmt::format("forcedimension: the device with serial {} is open already (another tool of this "
                         "program drives it)",
-                        selection_.serial)};
+                        selection_.serial),
+            ErrorKind::kBusy};
       seen += fmt::format("{}serial {} (in use)", seen.empty() ? "" : ", ", sn);
       continue;
     }

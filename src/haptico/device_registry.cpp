@@ -32,9 +32,13 @@ Result<std::unique_ptr<HapticDevice>> DeviceRegistry::create(const std::string& 
   if (it == factories_.end()) {
     std::string known;
     for (const auto& [n, f] : factories_) known += fmt::format("{}{}", known.empty() ? "" : ", ", n);
-    return Error{fmt::format("unknown device driver '{}' (known drivers: {})", name, known.empty() ? "none" : known)};
+    return Error{fmt::format("unknown device driver '{}' (known drivers: {})", name, known.empty() ? "none" : known),
+                 ErrorKind::kDevice};
   }
-  return it->second(config);
+  // a driver's refusal is the device's, unless it told more (a file it reads, a device in use)
+  auto device = it->second(config);
+  if (!device) return device.error().classified(ErrorKind::kDevice);
+  return device;
 }
 
 std::vector<std::string> DeviceRegistry::names() const {

@@ -59,12 +59,12 @@ HapticManager::~HapticManager() {
 
 Status HapticManager::open() {
   if (open_) return Ok{};
-  if (Status s = device_->open(); !s) return s;
+  if (Status s = device_->open(); !s) return s.error().classified(ErrorKind::kDevice);
   info_ = device_->info();
   const auto refuse = [this](std::string why) -> Status {
     const Status closed = device_->close();
     (void)closed;
-    return Error{fmt::format("device '{}': {}", info_.name, why)};
+    return Error{fmt::format("device '{}': {}", info_.name, why), ErrorKind::kDevice};
   };
   if (info_.dof_actuated != 0 && info_.dof_actuated != 3 && info_.dof_actuated != 6) {
     return refuse(fmt::format("dof_actuated is {}, expected 0, 3 or 6", info_.dof_actuated));
@@ -179,7 +179,7 @@ void HapticManager::allow_binding() {
 
 Status HapticManager::thread_status() const {
   if (running() || failure_.empty()) return Ok{};
-  return Error{failure_};
+  return Error{failure_, ErrorKind::kThread};
 }
 
 Status HapticManager::device_status() {
@@ -189,7 +189,7 @@ Status HapticManager::device_status() {
     why = fault_was_freeze_.load(std::memory_order_relaxed)
               ? fmt::format("its state stopped advancing for {} ticks", options_.max_frozen_ticks)
               : std::string("it reported an error without a reason");
-  return Error{fmt::format("device '{}' faulted: {}; it was sent zero force", info_.name, why)};
+  return Error{fmt::format("device '{}' faulted: {}; it was sent zero force", info_.name, why), ErrorKind::kDevice};
 }
 
 TraceSample HapticManager::step(double now_s) {

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "uh/uh.h"
+#include "uh_v2_0_structs.h" /* an older caller's structs: API version 2's first layouts */
 
 static int failures = 0;
 
@@ -73,8 +74,8 @@ static uh_shape_def mesh_shape(const char* file, int64_t spheres) {
 
 /* The small scene of the C++ session tests, built through calls: a 10 cm bunny (600 spheres) and
  * a stylus (150) that goes down into it and back every second (sim-line). */
-static uh_scene* small_scene(void) {
-  uh_scene* scene = NULL;
+static uh_scene_id small_scene(void) {
+  uh_scene_id scene = {0};
   uh_object_def bunny = uh_default_object_def();
   uh_tool_def tool = uh_default_tool_def();
   REQUIRE_OK(uh_scene_create("small-c", &scene));
@@ -105,11 +106,11 @@ static uh_scene* small_scene(void) {
   return scene;
 }
 
-static uh_session* open_small_session(void) {
-  uh_scene* scene = small_scene();
-  uh_session* s = NULL;
+static uh_session_id open_small_session(void) {
+  uh_scene_id scene = small_scene();
+  uh_session_id s = {0};
   REQUIRE_OK(uh_session_create(scene, NULL, &s));
-  uh_scene_free(scene); /* the session copied it */
+  uh_scene_destroy(scene); /* the session copied it */
   return s;
 }
 
@@ -129,19 +130,19 @@ static void record_tick(void* user, const uh_state* state) {
 }
 
 static void test_version(void) {
-  uh_session* s = (uh_session*)1;
+  uh_session_id s = {1};
   /* the library reports the project's version, project(VERSION) in the top-level CMakeLists.txt */
   CHECK(strcmp(uh_version_string(), UH_TEST_PROJECT_VERSION) == 0);
   CHECK(uh_api_version() == UH_API_VERSION);
   CHECK_STATUS(uh_session_open_checked(UH_API_VERSION + 1, NULL, &s), UH_ERROR_VERSION);
-  CHECK(s == NULL);
+  CHECK(s.bits == 0);
   CHECK(strstr(uh_last_error(), "UH_API_VERSION") != NULL);
   CHECK(strcmp(uh_status_name(UH_ERROR_STALE_HANDLE), "UH_ERROR_STALE_HANDLE") == 0);
 }
 
 /* The default scene (the bunny sweep) run deterministically: contact and force read back. */
 static void test_default_session_stepped(void) {
-  uh_session* s = NULL;
+  uh_session_id s = {0};
   uh_state st;
   uh_contact_event e;
   tick_record rec = {0, 0.0, 0};
@@ -182,12 +183,12 @@ static void test_default_session_stepped(void) {
   CHECK(json_number(report, "\"haptic\"", "ticks") == 3000.0);
   CHECK(strstr(report, "\"mode\": \"stepped\"") != NULL);
   REQUIRE_OK(uh_session_stop(s)); /* stopped already: idempotent */
-  uh_session_close(s);
+  uh_session_destroy(s);
 }
 
 /* A short threaded run of a scene built through calls: poll state and events while it runs. */
 static void test_threaded_session(void) {
-  uh_session* s = open_small_session();
+  uh_session_id s = open_small_session();
   uh_state st;
   uh_contact_event e;
   int32_t has_event = 0, begins = 0, i;
@@ -221,13 +222,13 @@ static void test_threaded_session(void) {
   REQUIRE_OK(uh_session_report_json(s, &report));
   CHECK(strstr(report, "\"mode\": \"threaded\"") != NULL);
   CHECK(json_number(report, "\"force\"", "max_n") >= max_force - 1e-9);
-  uh_session_close(s);
+  uh_session_destroy(s);
 }
 
 /* Two sessions at once, each with its own threads and device. */
 static void test_several_sessions(void) {
-  uh_session* a = open_small_session();
-  uh_session* b = open_small_session();
+  uh_session_id a = open_small_session();
+  uh_session_id b = open_small_session();
   uh_state sa, sb;
   int i;
   double max_a = 0.0, max_b = 0.0;
@@ -244,8 +245,8 @@ static void test_several_sessions(void) {
   }
   REQUIRE_OK(uh_session_stop(a));
   CHECK(uh_session_poll(b, &sb) == UH_OK && sb.haptic_ticks > 0); /* b runs on after a stopped */
-  uh_session_close(b);                                             /* close stops b */
-  uh_session_close(a);
+  uh_session_destroy(b);                                             /* close stops b */
+  uh_session_destroy(a);
   CHECK(max_a > 0.1);
   CHECK(max_b > 0.1);
 
@@ -259,19 +260,20 @@ static void test_several_sessions(void) {
   CHECK(memcmp(sa.force, sb.force, sizeof sa.force) == 0);
   CHECK(memcmp(sa.tool_position, sb.tool_position, sizeof sa.tool_position) == 0);
   CHECK(norm3(sa.force) == 0.0); /* a run ends with zero force sent */
-  uh_session_close(a);
-  uh_session_close(b);
+  uh_session_destroy(a);
+  uh_session_destroy(b);
 }
 
 /* Misuse gives statuses, never crashes. */
 static void test_handle_misuse(void) {
-  uh_session* s = open_small_session();
-  uh_session* stale_handle = s;
+  uh_session_id s = open_small_session();
+  uh_session_id stale_handle = s;
+  const uh_session_id none = {0};
   uh_state st;
   uh_contact_event e;
   int32_t has_event = 0, count = 0;
   const char* text = NULL;
-  uh_tree* tree = NULL;
+  uh_tree_id tree = {0};
   st.struct_size = sizeof st;
   e.struct_size = sizeof e;
 
@@ -301,38 +303,45 @@ static void test_handle_misuse(void) {
   CHECK_STATUS(uh_session_start(s), UH_ERROR_WRONG_STATE);
   CHECK_STATUS(uh_session_run_stepped(s, 0.1, 4), UH_ERROR_WRONG_STATE);
   CHECK_STATUS(uh_session_report_json(s, &text), UH_OK);
-  uh_session_close(s);
-  uh_session_close(s); /* twice: nothing */
-  uh_session_close(NULL);
+  uh_session_destroy(s);
+  uh_session_destroy(s); /* twice: nothing */
+  uh_session_destroy(none);
 
   CHECK_STATUS(uh_session_poll(stale_handle, &st), UH_ERROR_STALE_HANDLE);
-  CHECK(strstr(uh_last_error(), "uh_session_poll: the session handle") != NULL);
+  CHECK(strstr(uh_last_error(), "uh_session_poll: the session id") != NULL);
   CHECK_STATUS(uh_session_start(stale_handle), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_stop(stale_handle), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_poll_event(stale_handle, &e, &has_event), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_object_count(stale_handle, &count), UH_ERROR_STALE_HANDLE);
-  CHECK_STATUS(uh_session_start(NULL), UH_ERROR_STALE_HANDLE);
-  CHECK_STATUS(uh_session_poll((uh_session*)(uintptr_t)0xdeadbeef0ull, &st), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_start(none), UH_ERROR_STALE_HANDLE);
+  {
+    const uh_session_id made_up = {0xdeadbeef0ull};
+    CHECK_STATUS(uh_session_poll(made_up, &st), UH_ERROR_STALE_HANDLE);
+    CHECK(!uh_session_is_valid(made_up) && !uh_session_is_valid(none));
+  }
+  CHECK(!uh_session_is_valid(stale_handle));
 
   /* a new session may reuse the slot: the old handle still refers to nothing */
   s = open_small_session();
-  CHECK(s != stale_handle);
+  CHECK(s.bits != stale_handle.bits && uh_session_is_valid(s));
   CHECK_STATUS(uh_session_poll(stale_handle, &st), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_poll(s, &st), UH_OK);
   /* a handle of another kind is refused */
-  CHECK_STATUS(uh_tree_load("/nonexistent.ist", &tree), UH_ERROR_FAILED);
-  CHECK(tree == NULL);
+  CHECK_STATUS(uh_tree_load("/nonexistent.ist", &tree), UH_ERROR_FILE);
+  CHECK(tree.bits == 0);
   CHECK(strstr(uh_last_error(), "/nonexistent.ist") != NULL);
-  CHECK_STATUS(uh_tree_get_info((const uh_tree*)s, NULL), UH_ERROR_INVALID_ARGUMENT);
   {
+    const uh_tree_id session_as_tree = {s.bits};
     uh_tree_info info;
+    CHECK_STATUS(uh_tree_get_info(session_as_tree, NULL), UH_ERROR_INVALID_ARGUMENT);
     info.struct_size = sizeof info;
-    CHECK_STATUS(uh_tree_get_info((const uh_tree*)s, &info), UH_ERROR_STALE_HANDLE);
+    CHECK_STATUS(uh_tree_get_info(session_as_tree, &info), UH_ERROR_STALE_HANDLE);
+    CHECK(!uh_tree_is_valid(session_as_tree));
   }
-  uh_session_close(s);
+  uh_session_destroy(s);
   CHECK_STATUS(uh_session_open(NULL, NULL), UH_ERROR_INVALID_ARGUMENT);
-  CHECK_STATUS(uh_session_open("/nonexistent/scene.json", &s), UH_ERROR_FAILED);
-  CHECK(s == NULL);
+  CHECK_STATUS(uh_session_open("/nonexistent/scene.json", &s), UH_ERROR_FILE);
+  CHECK(s.bits == 0);
   CHECK(strstr(uh_last_error(), "/nonexistent/scene.json") != NULL);
 }
 
@@ -346,7 +355,7 @@ static const int32_t cube_indices[12 * 3] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7,
  * (the packing does not overlap), so the volume is the packing's own, known from the build. */
 static void test_trees(void) {
   uh_tree_build_def def = uh_default_tree_build_def();
-  uh_tree *a = NULL, *b = NULL;
+  uh_tree_id a = {0}, b = {0}, loaded = {0};
   uh_tree_info info;
   uh_query_result r;
   const double origin[3] = {0, 0, 0}, identity[4] = {1, 0, 0, 0}, far[3] = {0.1, 0, 0};
@@ -381,30 +390,38 @@ static void test_trees(void) {
   CHECK(r.volume == 0.0 && r.pair_count == 0);
   CHECK(r.distance > 0.07 && r.distance < 0.1);
 
-  /* bad input */
-  CHECK_STATUS(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 10, &def, &b), UH_ERROR_FAILED);
+  /* bad input (a failed build leaves its out id zero) */
+  loaded = b;
+  CHECK_STATUS(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 10, &def, &b), UH_ERROR_MESH);
+  CHECK(b.bits == 0);
   CHECK(strstr(uh_last_error(), "not closed") != NULL);
   def.spheres = 0;
-  CHECK_STATUS(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 12, &def, &b), UH_ERROR_FAILED);
-  CHECK_STATUS(uh_tree_query(a, NULL, origin, identity, &r), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_tree_build_from_arrays(cube_vertices, 8, cube_indices, 12, &def, &b), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "sphere count must be positive") != NULL);
+  {
+    const uh_tree_id none = {0};
+    CHECK_STATUS(uh_tree_query(a, none, origin, identity, &r), UH_ERROR_STALE_HANDLE);
+  }
   {
     const double zero_q[4] = {0, 0, 0, 0};
     CHECK_STATUS(uh_tree_query(a, a, origin, zero_q, &r), UH_ERROR_INVALID_ARGUMENT);
   }
-  uh_tree_free(b);
-  CHECK_STATUS(uh_tree_query(a, b, origin, identity, &r), UH_ERROR_STALE_HANDLE);
-  uh_tree_free(b); /* twice: nothing */
-  uh_tree_free(a);
+  CHECK(uh_tree_is_valid(loaded));
+  uh_tree_destroy(loaded);
+  CHECK(!uh_tree_is_valid(loaded));
+  CHECK_STATUS(uh_tree_query(a, loaded, origin, identity, &r), UH_ERROR_STALE_HANDLE);
+  uh_tree_destroy(loaded); /* twice: nothing */
+  uh_tree_destroy(a);
 }
 
 /* Scenes through calls: objects from a tree, removal, watch, device config errors. */
 static void test_scene_building(void) {
-  uh_scene* scene = small_scene();
+  uh_scene_id scene = small_scene();
   uh_object_def cube = uh_default_object_def();
   uh_tool_def tool = uh_default_tool_def();
   uh_tree_build_def def = uh_default_tree_build_def();
-  uh_tree* tree = NULL;
-  uh_session* s = NULL;
+  uh_tree_id tree = {0};
+  uh_session_id s = {0};
   int32_t count = 0, index = -1;
   const char* name = NULL;
   def.spheres = 200;
@@ -415,7 +432,7 @@ static void test_scene_building(void) {
   cube.position[0] = 0.2; /* beside the bunny, never touched */
   REQUIRE_OK(uh_scene_add_object(scene, &cube, &index));
   CHECK(index == 1);
-  uh_tree_free(tree); /* the scene keeps its own reference */
+  uh_tree_destroy(tree); /* the scene keeps its own reference */
   CHECK_STATUS(uh_scene_add_object(scene, &cube, NULL), UH_ERROR_INVALID_ARGUMENT); /* duplicate name */
   cube.name = "two sources";
   cube.shape = mesh_shape("stylus.obj", 100);
@@ -434,7 +451,7 @@ static void test_scene_building(void) {
   REQUIRE_OK(uh_session_object_name(s, 1, &name));
   CHECK(strcmp(name, "cube") == 0);
   REQUIRE_OK(uh_session_run_stepped(s, 0.5, 4));
-  uh_session_close(s);
+  uh_session_destroy(s);
 
   CHECK_STATUS(uh_scene_remove_object(scene, "nothing"), UH_ERROR_INVALID_ARGUMENT);
   REQUIRE_OK(uh_scene_remove_object(scene, "cube"));
@@ -442,8 +459,9 @@ static void test_scene_building(void) {
   CHECK(count == 1);
   REQUIRE_OK(uh_scene_watch(scene, "bunny", 0));
   REQUIRE_OK(uh_session_create(scene, NULL, &s));
-  CHECK_STATUS(uh_session_start(s), UH_ERROR_FAILED); /* nothing watched */
-  uh_session_close(s);
+  CHECK_STATUS(uh_session_start(s), UH_ERROR_INVALID_ARGUMENT); /* nothing watched */
+  CHECK(strstr(uh_last_error(), "nothing is watched") != NULL);
+  uh_session_destroy(s);
   REQUIRE_OK(uh_scene_watch(scene, "bunny", 1));
 
   tool.shape = mesh_shape("stylus.obj", 150);
@@ -455,17 +473,18 @@ static void test_scene_building(void) {
   tool.device_config_json = NULL;
   tool.device_driver = "phantom-omni";
   REQUIRE_OK(uh_scene_set_tool(scene, &tool));
-  CHECK_STATUS(uh_session_create(scene, NULL, &s), UH_ERROR_FAILED);
+  CHECK_STATUS(uh_session_create(scene, NULL, &s), UH_ERROR_DEVICE);
   CHECK(strstr(uh_last_error(), "phantom-omni") != NULL);
   CHECK_STATUS(uh_scene_set_rates(scene, 0.5, 100), UH_ERROR_INVALID_ARGUMENT);
-  uh_scene_free(scene);
-  uh_scene_free(scene);
+  uh_scene_destroy(scene);
+  uh_scene_destroy(scene);
   CHECK_STATUS(uh_scene_object_count(scene, &count), UH_ERROR_STALE_HANDLE);
+  CHECK(!uh_scene_is_valid(scene));
 
   REQUIRE_OK(uh_scene_create("empty", &scene));
   CHECK_STATUS(uh_session_create(scene, NULL, &s), UH_ERROR_INVALID_ARGUMENT);
   CHECK(strstr(uh_last_error(), "no tool") != NULL);
-  uh_scene_free(scene);
+  uh_scene_destroy(scene);
 }
 
 /* The cube above written as OBJ (quads, corners with normals), binary STL, ASCII STL and OFF. */
@@ -543,14 +562,14 @@ static void test_mesh_formats(void) {
   def.meters_per_unit = 0.01;
   write_cube_files(UH_TEST_TMP_DIR);
   for (i = 0; i < sizeof files / sizeof files[0]; ++i) {
-    uh_tree* tree = NULL;
+    uh_tree_id tree = {0};
     uh_tree_info info;
     uh_status status;
     snprintf(path, sizeof path, "%s/%s", UH_TEST_TMP_DIR, files[i]);
     status = uh_tree_build(path, &def, &tree);
 #ifdef _WIN32
     if (strstr(files[i], ".off") != NULL) {
-      CHECK(status == UH_ERROR_FAILED && tree == NULL);
+      CHECK(status == UH_ERROR_FILE && tree.bits == 0);
       CHECK(strstr(uh_last_error(), "capi_cube.off") != NULL);
       CHECK(strstr(uh_last_error(), "OBJ (.obj) and STL (.stl) files only") != NULL);
       remove(path);
@@ -567,7 +586,7 @@ static void test_mesh_formats(void) {
     REQUIRE_OK(uh_tree_get_info(tree, &info));
     CHECK(fabs(info.mesh_volume - 8e-6) < 1e-12); /* (2 cm)^3, whatever the file format */
     CHECK(info.leaf_count > 50);
-    uh_tree_free(tree);
+    uh_tree_destroy(tree);
     remove(path);
   }
 }
@@ -578,7 +597,7 @@ static void test_mesh_formats(void) {
 static void test_two_tools(void) {
   char path[512];
   FILE* f;
-  uh_session* s = NULL;
+  uh_session_id s = {0};
   int32_t count = 0;
   const char* name = NULL;
   const char* report = NULL;
@@ -629,8 +648,213 @@ static void test_two_tools(void) {
   CHECK_STATUS(uh_session_tool_state(s, -1, &right), UH_ERROR_INVALID_ARGUMENT);
   REQUIRE_OK(uh_session_report_json(s, &report));
   CHECK(strstr(report, "\"tool\": \"right\"") != NULL);
-  uh_session_close(s);
+  uh_session_destroy(s);
   remove(path);
+}
+
+/* The small scene's stylus as the older caller (uh_v2_0_structs.h) sets it: its own smaller
+ * struct_size, the fields it knows, defaults from uh_tool_def_init written only as far as its end. */
+static void old_stylus(uh_v2_0_tool_def* tool) {
+  const uh_shape_def shape = mesh_shape("stylus.obj", 150);
+  memset(tool, 0, sizeof *tool);
+  tool->struct_size = (uint32_t)sizeof *tool;
+  REQUIRE_OK(uh_tool_def_init((uh_tool_def*)tool));
+  tool->name = "stylus";
+  memcpy(&tool->shape, &shape, sizeof tool->shape);
+  tool->stiffness = 1.6e4;
+  tool->damping = 1.0;
+  tool->center_of_mass[2] = 0.025;
+  tool->max_force_n = 6.0;
+  tool->max_torque_nm = 0.3;
+  tool->device_config_json =
+      "{\"start\": [0, 0, 0.10], \"end\": [0, 0, 0.045], \"duration_s\": 0.5, \"bounce\": true,"
+      " \"dof_actuated\": 6, \"max_force_n\": 6}";
+}
+
+/* The small scene (bunny, stylus) with the tool given as `tool` (any layout), run stepped for
+ * 0.5 s: the final state and the report's largest force. */
+static double run_with_tool(const void* tool, uh_state* final_state) {
+  uh_scene_id scene = {0};
+  uh_session_id s = {0};
+  uh_object_def bunny = uh_default_object_def();
+  const char* report = NULL;
+  double max_force;
+  REQUIRE_OK(uh_scene_create("tool-layouts", &scene));
+  bunny.name = "bunny";
+  bunny.shape = mesh_shape("bunny_npm_3674.obj", 600);
+  bunny.orientation[0] = 0.70710678;
+  bunny.orientation[1] = 0.70710678;
+  REQUIRE_OK(uh_scene_add_object(scene, &bunny, NULL));
+  REQUIRE_OK(uh_scene_set_tool(scene, (const uh_tool_def*)tool));
+  REQUIRE_OK(uh_session_create(scene, NULL, &s));
+  uh_scene_destroy(scene);
+  REQUIRE_OK(uh_session_run_stepped(s, 0.5, 4));
+  final_state->struct_size = sizeof *final_state;
+  REQUIRE_OK(uh_session_poll(s, final_state));
+  REQUIRE_OK(uh_session_report_json(s, &report));
+  max_force = json_number(report, "\"force\"", "max_n");
+  uh_session_destroy(s);
+  return max_force;
+}
+
+/* A program built against API version 2's first uh.h (its structs frozen in uh_v2_0_structs.h,
+ * smaller than today's where a struct grew) against this library: its structs are accepted, the
+ * fields they lack take their defaults, and nothing is read or written past their end. */
+static void test_older_caller(void) {
+  struct {
+    uh_v2_0_tool_def def;
+    unsigned char after[64]; /* where a newer layout's fields would be */
+  } old_tool;
+  struct {
+    uh_v2_0_state state;
+    unsigned char after[64];
+  } old_state;
+  uh_v2_0_object_def old_bunny;
+  uh_v2_0_session_def old_session;
+  uh_v2_0_contact_event old_event;
+  uh_tool_def new_tool = uh_default_tool_def();
+  uh_scene_id scene = {0};
+  uh_session_id s = {0};
+  uh_state old_run, new_run, offset_run;
+  double old_force, new_force, offset_force;
+  int32_t has_event = 0, events = 0;
+  size_t i;
+  const uh_shape_def bunny_shape = mesh_shape("bunny_npm_3674.obj", 600);
+
+  CHECK(sizeof old_tool.def < sizeof(uh_tool_def)); /* the tool def grew since */
+  /* defaults reach only as far as the caller's struct */
+  memset(&old_tool, 0xab, sizeof old_tool);
+  old_tool.def.struct_size = (uint32_t)sizeof old_tool.def;
+  REQUIRE_OK(uh_tool_def_init((uh_tool_def*)&old_tool.def));
+  for (i = 0; i < sizeof old_tool.after; ++i) CHECK(old_tool.after[i] == 0xab);
+  CHECK(old_tool.def.struct_size == sizeof old_tool.def);
+  CHECK(old_tool.def.stiffness == new_tool.stiffness && old_tool.def.max_force_n == new_tool.max_force_n);
+  CHECK(strcmp(old_tool.def.name, "tool") == 0 && old_tool.def.workspace_rotation[0] == 1.0);
+  CHECK(old_tool.def.shape.spheres == new_tool.shape.spheres);
+
+  /* the stylus set through the old layout, with bytes past its end that would be a NaN offset if
+   * they were read, runs as the same stylus through today's layout with tool_offset at its default */
+  old_stylus(&old_tool.def);
+  memset(old_tool.after, 0xff, sizeof old_tool.after);
+  old_force = run_with_tool(&old_tool.def, &old_run);
+  memcpy(&new_tool, &old_tool.def, sizeof old_tool.def);
+  new_tool.struct_size = sizeof new_tool;
+  CHECK(new_tool.tool_offset[0] == 0.0 && new_tool.tool_offset[1] == 0.0 && new_tool.tool_offset[2] == 0.0);
+  new_force = run_with_tool(&new_tool, &new_run);
+  CHECK(old_force > 0.5 && old_force == new_force);
+  CHECK(memcmp(old_run.tool_position, new_run.tool_position, sizeof old_run.tool_position) == 0);
+  CHECK(old_run.haptic_ticks == 500 && new_run.haptic_ticks == 500);
+  /* and the new field is read when the layout has it: the stylus sits 1 cm below the handle */
+  new_tool.tool_offset[2] = -0.01;
+  offset_force = run_with_tool(&new_tool, &offset_run);
+  CHECK(fabs(offset_run.tool_position[2] - (new_run.tool_position[2] - 0.01)) < 1e-9);
+  CHECK(offset_force != new_force);
+
+  /* a whole flow in old structs: object, tool, session settings, state and events */
+  REQUIRE_OK(uh_scene_create("older-caller", &scene));
+  memset(&old_bunny, 0, sizeof old_bunny);
+  old_bunny.struct_size = (uint32_t)sizeof old_bunny;
+  REQUIRE_OK(uh_object_def_init((uh_object_def*)&old_bunny));
+  CHECK(old_bunny.watch == 1 && old_bunny.orientation[0] == 1.0);
+  old_bunny.name = "bunny";
+  memcpy(&old_bunny.shape, &bunny_shape, sizeof old_bunny.shape);
+  old_bunny.orientation[0] = 0.70710678;
+  old_bunny.orientation[1] = 0.70710678;
+  REQUIRE_OK(uh_scene_add_object(scene, (const uh_object_def*)&old_bunny, NULL));
+  REQUIRE_OK(uh_scene_set_tool(scene, (const uh_tool_def*)&old_tool.def));
+  memset(&old_session, 0, sizeof old_session);
+  old_session.struct_size = (uint32_t)sizeof old_session;
+  REQUIRE_OK(uh_session_def_init((uh_session_def*)&old_session));
+  CHECK(old_session.collision_hz == -1.0);
+  REQUIRE_OK(uh_session_create(scene, (const uh_session_def*)&old_session, &s));
+  uh_scene_destroy(scene);
+  REQUIRE_OK(uh_session_run_stepped(s, 0.5, 4));
+  memset(&old_state, 0xab, sizeof old_state);
+  old_state.state.struct_size = (uint32_t)sizeof old_state.state;
+  REQUIRE_OK(uh_session_poll(s, (uh_state*)&old_state.state));
+  for (i = 0; i < sizeof old_state.after; ++i) CHECK(old_state.after[i] == 0xab);
+  CHECK(old_state.state.haptic_ticks == 500);
+  CHECK(memcmp(old_state.state.tool_position, old_run.tool_position, sizeof old_run.tool_position) == 0);
+  old_event.struct_size = (uint32_t)sizeof old_event;
+  while (uh_session_poll_event(s, (uh_contact_event*)&old_event, &has_event) == UH_OK && has_event) {
+    CHECK(old_event.object == 0 && old_event.struct_size == sizeof old_event);
+    ++events;
+  }
+  CHECK(events >= 1);
+
+  /* a newer program's struct than this library knows is refused, saying so */
+  new_tool.struct_size = (uint32_t)sizeof new_tool + 8;
+  REQUIRE_OK(uh_scene_create("newer-caller", &scene));
+  CHECK_STATUS(uh_scene_set_tool(scene, &new_tool), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "newer uh.h") != NULL);
+  new_tool.struct_size = (uint32_t)sizeof old_tool.def - 8; /* no layout at all */
+  CHECK_STATUS(uh_scene_set_tool(scene, &new_tool), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "no layout of uh_tool_def") != NULL);
+  uh_scene_destroy(scene);
+  uh_session_destroy(s);
+}
+
+/* Two tools added through calls, each on its own device: the left stylus presses into the bunny,
+ * the right one into a ball; each contact event names its tool. */
+static void test_several_tools(void) {
+  uh_scene_id scene = small_scene();
+  uh_object_def ball = uh_default_object_def();
+  uh_tool_def right = uh_default_tool_def();
+  uh_session_id s = {0};
+  uh_contact_event e;
+  uh_state left_state, right_state;
+  int32_t count = 0, index = -1, has_event = 0, begins[2] = {0, 0};
+  const char* name = NULL;
+  ball.name = "ball";
+  ball.shape = mesh_shape("ball.obj", 200);
+  ball.shape.meters_per_unit = 0.03;
+  ball.position[0] = 0.15;
+  ball.position[2] = 0.03;
+  REQUIRE_OK(uh_scene_add_object(scene, &ball, NULL));
+  right.name = "stylus"; /* the first tool's name */
+  right.shape = mesh_shape("stylus.obj", 150);
+  right.mode = UH_FORCE_3DOF;
+  right.stiffness = 1.6e4;
+  right.max_force_n = 4.0;
+  right.device_config_json = "{\"start\": [0.15, 0, 0.1], \"end\": [0.15, 0, 0.048]}";
+  CHECK_STATUS(uh_scene_add_tool(scene, &right, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "a tool named 'stylus' already") != NULL);
+  right.name = "right";
+  REQUIRE_OK(uh_scene_add_tool(scene, &right, &index));
+  CHECK(index == 1);
+  REQUIRE_OK(uh_scene_tool_count(scene, &count));
+  CHECK(count == 2);
+  REQUIRE_OK(uh_session_create(scene, NULL, &s));
+  REQUIRE_OK(uh_session_tool_count(s, &count));
+  CHECK(count == 2);
+  REQUIRE_OK(uh_session_tool_name(s, 1, &name));
+  CHECK(strcmp(name, "right") == 0);
+  REQUIRE_OK(uh_session_run_stepped(s, 1.0, 4));
+  left_state.struct_size = right_state.struct_size = sizeof(uh_state);
+  REQUIRE_OK(uh_session_tool_state(s, 0, &left_state));
+  REQUIRE_OK(uh_session_tool_state(s, 1, &right_state));
+  CHECK(fabs(right_state.tool_position[0] - 0.15) < 1e-9 && fabs(left_state.tool_position[0]) < 1e-9);
+  e.struct_size = sizeof e;
+  while (uh_session_poll_event(s, &e, &has_event) == UH_OK && has_event) {
+    CHECK(e.tool == 0 || e.tool == 1);
+    CHECK(e.object == e.tool); /* the left stylus meets the bunny only, the right one the ball */
+    if (e.kind == UH_CONTACT_BEGIN && e.tool >= 0 && e.tool < 2) ++begins[e.tool];
+  }
+  CHECK(begins[0] >= 1 && begins[1] >= 1);
+  uh_session_destroy(s);
+
+  /* tools removed by name; a scene without one cannot open */
+  CHECK_STATUS(uh_scene_remove_tool(scene, "nobody"), UH_ERROR_INVALID_ARGUMENT);
+  REQUIRE_OK(uh_scene_remove_tool(scene, "stylus"));
+  REQUIRE_OK(uh_scene_remove_tool(scene, "right"));
+  REQUIRE_OK(uh_scene_tool_count(scene, &count));
+  CHECK(count == 0);
+  CHECK_STATUS(uh_session_create(scene, NULL, &s), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "no tool") != NULL);
+  REQUIRE_OK(uh_scene_set_tool(scene, &right)); /* set_tool on a scene without tools adds the first */
+  REQUIRE_OK(uh_scene_tool_count(scene, &count));
+  CHECK(count == 1);
+  uh_scene_destroy(scene);
 }
 
 int main(int argc, char** argv) {
@@ -645,7 +869,9 @@ int main(int argc, char** argv) {
                {"trees", test_trees},
                {"scene_building", test_scene_building},
                {"mesh_formats", test_mesh_formats},
-               {"two_tools", test_two_tools}};
+               {"two_tools", test_two_tools},
+               {"older_caller", test_older_caller},
+               {"several_tools", test_several_tools}};
   size_t i;
   if (argc != 2) {
     fprintf(stderr, "usage: %s TEST\n", argv[0]);

@@ -20,6 +20,7 @@ TEST(MeshImport, MissingFileIsAClearError) {
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("nothing_here.obj"), std::string::npos);
   EXPECT_NE(r.error().message.find("not found"), std::string::npos);
+  EXPECT_EQ(r.error().kind, uh::ErrorKind::kFile);  // the file's failure, not the mesh's
 }
 
 TEST(MeshImport, EmptyAndGarbageFilesAreClearErrors) {
@@ -97,6 +98,7 @@ TEST(MeshImport, CubeMissingAFaceIsNotClosed) {
                 "2-manifold mesh is required)"),
             std::string::npos)
       << r.error().message;
+  EXPECT_EQ(r.error().kind, uh::ErrorKind::kMesh);  // the file was read; the mesh is unusable
   // programs show the message as it is: it names no C++ type or option
   for (const char* cpp : {"MeshLoadOptions", "allow_open", "{.", "::", "repair ="})
     EXPECT_EQ(r.error().message.find(cpp), std::string::npos) << cpp << " in " << r.error().message;

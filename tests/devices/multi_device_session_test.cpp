@@ -123,6 +123,7 @@ TEST_F(MultiDeviceSessionTest, OneDeviceCannotServeTwoTools) {
     EXPECT_NE(session.error().message.find("hands.json: tools[1].device: forcedimension: " + message),
               std::string::npos)
         << session.error().message;
+    EXPECT_EQ(session.error().kind, uh::ErrorKind::kBusy) << "the device is in use, kept through the session";
   }
   EXPECT_EQ(standin.get("open", 0), 0.0) << "everything opened was closed again";
   EXPECT_EQ(standin.get("open", 1), 0.0);

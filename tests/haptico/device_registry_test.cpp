@@ -18,6 +18,7 @@ TEST(DeviceRegistry, UnknownNameListsKnownDrivers) {
   EXPECT_EQ(r.error().message,
             "unknown device driver 'phantom-omni' (known drivers: sim-circle, sim-hand, sim-line, sim-raster, sim-replay)");
   EXPECT_EQ(DeviceRegistry{}.create("x").error().message, "unknown device driver 'x' (known drivers: none)");
+  EXPECT_EQ(r.error().kind, uh::ErrorKind::kDevice);
 }
 
 TEST(DeviceRegistry, CreatesEverySimulatedDriver) {

@@ -352,6 +352,7 @@ TEST(HapticManager, FrozenDeviceCountsAsDeviceError) {
   ASSERT_FALSE(f.manager->device_status());
   EXPECT_EQ(f.manager->device_status().error().message,
             "device 'fake' faulted: its state stopped advancing for 3 ticks; it was sent zero force");
+  EXPECT_EQ(f.manager->device_status().error().kind, uh::ErrorKind::kDevice);
   // a live device again, and the fault cleared: forces come back
   f.device->frozen = false;
   f.manager->clear_fault();
@@ -488,6 +489,7 @@ TEST(HapticManager, ThrowingDelegateZeroesTheDeviceFromTheHapticThread) {
   EXPECT_EQ(status.error().message,
             "the haptic thread stopped: a ForceOnHapticTick delegate (computing the force) threw: contact solver "
             "diverged; the device was sent zero force");
+  EXPECT_EQ(status.error().kind, uh::ErrorKind::kThread);
   std::vector<TraceSample> trace;
   f.manager->drain_trace(trace);
   ASSERT_EQ(trace.size(), 51u);

@@ -10,7 +10,7 @@ namespace UnrealHaptics
     /// <summary>The force law (docs/forcecomp.md): minus the gradient of the overlap volume, or the paper's eq. 1.</summary>
     public enum ForceLaw { Gradient = 0, Paper = 1 }
 
-    /// <summary>The tool of a scene: its shape, force law (ForceComp) and device (Haptico).</summary>
+    /// <summary>A tool of a scene: its shape, force law (ForceComp) and device (Haptico).</summary>
     public sealed class ToolSettings
     {
         public string Name = "tool";
@@ -31,24 +31,24 @@ namespace UnrealHaptics
 
     public sealed class Scene : IDisposable
     {
-        IntPtr raw_;
+        Native.uh_scene_id id_;
 
-        Scene(IntPtr raw) { raw_ = raw; }
+        Scene(Native.uh_scene_id id) { id_ = id; }
 
         /// <summary>A scene file; null: the embedded default scene.</summary>
         public static Scene Load(string scenePath = null)
         {
-            IntPtr raw;
-            Native.Check(Native.uh_scene_load(Native.Utf8In(scenePath), out raw), "uh_scene_load");
-            return new Scene(raw);
+            Native.uh_scene_id id;
+            Native.Check(Native.uh_scene_load(Native.Utf8In(scenePath), out id), "uh_scene_load");
+            return new Scene(id);
         }
 
-        internal IntPtr Raw
+        internal Native.uh_scene_id Id
         {
             get
             {
-                if (raw_ == IntPtr.Zero) throw new ObjectDisposedException("Scene");
-                return raw_;
+                if (id_.bits == 0) throw new ObjectDisposedException("Scene");
+                return id_;
             }
         }
 
@@ -102,7 +102,7 @@ namespace UnrealHaptics
 
         static Native.uh_shape_def Shape(long spheres, double metersPerUnit)
         {
-            var shape = Native.uh_default_shape_def();
+            var shape = Native.DefaultShapeDef();
             shape.spheres = spheres;
             shape.meters_per_unit = metersPerUnit;
             return shape;
@@ -122,7 +122,7 @@ namespace UnrealHaptics
                 def.orientation = orientation ?? new double[] { 1, 0, 0, 0 };
                 def.watch = watch ? 1 : 0;
                 int index;
-                Native.Check(Native.uh_scene_add_object(Raw, ref def, out index), "uh_scene_add_object");
+                Native.Check(Native.uh_scene_add_object(Id, ref def, out index), "uh_scene_add_object");
                 return index;
             }
             finally
@@ -131,8 +131,34 @@ namespace UnrealHaptics
             }
         }
 
-        /// <summary>Sets the tool (its mesh or .ist, force law, limits and device); see ToolSettings.</summary>
+        /// <summary>Sets the first tool (its mesh or .ist, force law, limits and device); see ToolSettings.</summary>
         public void SetTool(ToolSettings t)
+        {
+            WithToolDef(t, (ref Native.uh_tool_def def) => Native.Check(Native.uh_scene_set_tool(Id, ref def), "uh_scene_set_tool"));
+        }
+
+        /// <summary>Adds a tool after the scene's tools, on its own device; returns its index.</summary>
+        public int AddTool(ToolSettings t)
+        {
+            int index = -1;
+            WithToolDef(t, (ref Native.uh_tool_def def) => Native.Check(Native.uh_scene_add_tool(Id, ref def, out index), "uh_scene_add_tool"));
+            return index;
+        }
+
+        public int ToolCount
+        {
+            get
+            {
+                int n;
+                Native.Check(Native.uh_scene_tool_count(Id, out n), "uh_scene_tool_count");
+                return n;
+            }
+        }
+
+        delegate void ToolDefUse(ref Native.uh_tool_def def);
+
+        // the tool def of `t`, handed to `use` while the strings it points to are pinned
+        static void WithToolDef(ToolSettings t, ToolDefUse use)
         {
             if (t == null || string.IsNullOrEmpty(t.MeshPath)) throw new ArgumentException("the tool needs a mesh or .ist file");
             var pins = new System.Collections.Generic.List<GCHandle>();
@@ -145,7 +171,7 @@ namespace UnrealHaptics
             };
             try
             {
-                var def = Native.uh_default_tool_def();
+                var def = Native.DefaultToolDef();
                 def.name = pin(t.Name);
                 def.shape = Shape(t.Spheres, t.MetersPerUnit);
                 if (t.MeshPath.EndsWith(".ist", StringComparison.OrdinalIgnoreCase))
@@ -162,7 +188,7 @@ namespace UnrealHaptics
                 def.max_torque_nm = t.MaxTorqueNm;
                 def.device_driver = pin(t.DeviceDriver);
                 def.device_config_json = pin(t.DeviceConfigJson);
-                Native.Check(Native.uh_scene_set_tool(Raw, ref def), "uh_scene_set_tool");
+                use(ref def);
             }
             finally
             {
@@ -172,24 +198,24 @@ namespace UnrealHaptics
 
         public void RemoveObject(string name)
         {
-            Native.Check(Native.uh_scene_remove_object(Raw, Native.Utf8In(name)), "uh_scene_remove_object");
+            Native.Check(Native.uh_scene_remove_object(Id, Native.Utf8In(name)), "uh_scene_remove_object");
         }
 
         public void SetPose(string name, double[] position, double[] orientation)
         {
-            Native.Check(Native.uh_scene_set_object_pose(Raw, Native.Utf8In(name), position, orientation),
+            Native.Check(Native.uh_scene_set_object_pose(Id, Native.Utf8In(name), position, orientation),
                 "uh_scene_set_object_pose");
         }
 
         public void Watch(string name, bool watch)
         {
-            Native.Check(Native.uh_scene_watch(Raw, Native.Utf8In(name), watch ? 1 : 0), "uh_scene_watch");
+            Native.Check(Native.uh_scene_watch(Id, Native.Utf8In(name), watch ? 1 : 0), "uh_scene_watch");
         }
 
         /// <summary>Haptic rate in [1, 10000] Hz; collision rate in [0, 10000] Hz (0 = free-running).</summary>
         public void SetRates(double hapticHz, double collisionHz)
         {
-            Native.Check(Native.uh_scene_set_rates(Raw, hapticHz, collisionHz), "uh_scene_set_rates");
+            Native.Check(Native.uh_scene_set_rates(Id, hapticHz, collisionHz), "uh_scene_set_rates");
         }
 
         public int ObjectCount
@@ -197,18 +223,18 @@ namespace UnrealHaptics
             get
             {
                 int n;
-                Native.Check(Native.uh_scene_object_count(Raw, out n), "uh_scene_object_count");
+                Native.Check(Native.uh_scene_object_count(Id, out n), "uh_scene_object_count");
                 return n;
             }
         }
 
         public void Dispose()
         {
-            if (raw_ != IntPtr.Zero) Native.uh_scene_free(raw_);
-            raw_ = IntPtr.Zero;
+            Native.uh_scene_destroy(id_);  // a zero id: nothing
+            id_ = new Native.uh_scene_id();
             GC.SuppressFinalize(this);
         }
 
-        ~Scene() { if (raw_ != IntPtr.Zero) Native.uh_scene_free(raw_); }
+        ~Scene() { Native.uh_scene_destroy(id_); }
     }
 }

@@ -27,40 +27,29 @@ namespace UnrealHaptics
 
     public enum ContactKind { Begin = Native.UH_CONTACT_BEGIN, End = Native.UH_CONTACT_END }
 
-    /// <summary>A contact between the tool and a watched object began or ended.</summary>
+    /// <summary>A contact between a tool and a watched object began or ended.</summary>
     public struct ContactEvent
     {
         public ContactKind Kind;
         public int Object;        // the object's index in the scene
+        public int Tool;          // the tool's index in the scene
         public double TimeS;      // of the collision step that saw it [s]
         public double Volume;     // overlap volume then [m^3] (0 for End)
         public int Pairs;         // overlapping sphere pairs then
     }
 
-    /// <summary>Closes the native session when the last reference goes (uh_session_close stops
-    /// the session first), even when Dispose() was never called.</summary>
-    sealed class SessionHandle : SafeHandle
-    {
-        public SessionHandle() : base(IntPtr.Zero, true) { }
-        public override bool IsInvalid { get { return handle == IntPtr.Zero; } }
-        public void Adopt(IntPtr raw) { SetHandle(raw); }
-        protected override bool ReleaseHandle()
-        {
-            Native.uh_session_close(handle);
-            return true;
-        }
-    }
-
     public sealed class Session : IDisposable
     {
-        readonly SessionHandle handle_;
+        // the native session's id; zero once destroyed (uh_session_destroy stops it first), by
+        // Dispose() or, when that was never called, by the finaliser
+        long id_;
         // the tick counter the haptic-thread callback writes (through a GCHandle as its user pointer)
         sealed class TickCounter { public long Ticks; }
         readonly TickCounter counter_ = new TickCounter();
         GCHandle counterHandle_;
         static readonly Native.uh_tick_fn TickCallback = OnTick;  // kept alive for the process
 
-        Session(SessionHandle handle) { handle_ = handle; }
+        Session(Native.uh_session_id id) { id_ = unchecked((long)id.bits); }
 
         /// <summary>Opens a session of a scene file (docs/scenes.md); null: the embedded default
         /// scene (the bunny explored by a simulated stylus). Loads or builds the trees and opens the
@@ -68,24 +57,24 @@ namespace UnrealHaptics
         public static Session Open(string scenePath = null)
         {
             CheckVersion();
-            IntPtr raw;
-            var status = Native.uh_session_open_checked(Native.ApiVersion, Native.Utf8In(scenePath), out raw);
-            return Adopt(status, raw, "uh_session_open");
+            Native.uh_session_id id;
+            var status = Native.uh_session_open_checked(Native.ApiVersion, Native.Utf8In(scenePath), out id);
+            return Adopt(status, id, "uh_session_open");
         }
 
         /// <summary>Opens a session of a scene built through calls (see Scene).</summary>
         public static Session Create(Scene scene, string cacheDir = null)
         {
             CheckVersion();
-            var def = Native.uh_default_session_def();
+            var def = Native.DefaultSessionDef();
             var cache = Native.Utf8In(cacheDir);
             var pin = cache != null ? GCHandle.Alloc(cache, GCHandleType.Pinned) : default(GCHandle);
             try
             {
                 def.cache_dir = cache != null ? pin.AddrOfPinnedObject() : IntPtr.Zero;
-                IntPtr raw;
-                var status = Native.uh_session_create_checked(Native.ApiVersion, scene.Raw, ref def, out raw);
-                return Adopt(status, raw, "uh_session_create");
+                Native.uh_session_id id;
+                var status = Native.uh_session_create_checked(Native.ApiVersion, scene.Id, ref def, out id);
+                return Adopt(status, id, "uh_session_create");
             }
             finally
             {
@@ -93,17 +82,10 @@ namespace UnrealHaptics
             }
         }
 
-        static Session Adopt(int status, IntPtr raw, string call)
+        static Session Adopt(int status, Native.uh_session_id id, string call)
         {
-            var handle = new SessionHandle();
-            handle.Adopt(raw);
-            if (status != Native.UH_OK)
-            {
-                var e = new UhException(status, call, Native.LastError());
-                handle.Dispose();
-                throw e;
-            }
-            return new Session(handle);
+            if (status != Native.UH_OK) throw new UhException(status, call, Native.LastError());
+            return new Session(id);
         }
 
         static void CheckVersion()
@@ -114,13 +96,21 @@ namespace UnrealHaptics
                     "libuh speaks API version " + library + ", this binding version " + Native.ApiVersion);
         }
 
-        IntPtr Raw
+        Native.uh_session_id Raw
         {
             get
             {
-                if (handle_.IsClosed) throw new ObjectDisposedException("Session");
-                return handle_.DangerousGetHandle();
+                var id = Interlocked.Read(ref id_);
+                if (id == 0) throw new ObjectDisposedException("Session");
+                return new Native.uh_session_id { bits = unchecked((ulong)id) };
             }
+        }
+
+        // destroys the native session once, whoever calls first (Dispose or the finaliser)
+        void Destroy()
+        {
+            var id = Interlocked.Exchange(ref id_, 0);
+            if (id != 0) Native.uh_session_destroy(new Native.uh_session_id { bits = unchecked((ulong)id) });
         }
 
         /// <summary>Counts the haptic thread's ticks (TickCallbacks) through a native callback on
@@ -182,7 +172,7 @@ namespace UnrealHaptics
             n.struct_size = (uint)Marshal.SizeOf(typeof(Native.uh_contact_event));
             int has;
             Native.Check(Native.uh_session_poll_event(Raw, ref n, out has), "uh_session_poll_event");
-            e = new ContactEvent { Kind = (ContactKind)n.kind, Object = n.@object, TimeS = n.time_s, Volume = n.volume, Pairs = n.pairs };
+            e = new ContactEvent { Kind = (ContactKind)n.kind, Object = n.@object, Tool = n.tool, TimeS = n.time_s, Volume = n.volume, Pairs = n.pairs };
             return has != 0;
         }
 
@@ -226,7 +216,7 @@ namespace UnrealHaptics
         /// <summary>Stops (zero force, threads joined) and frees the session. Safe twice.</summary>
         public void Dispose()
         {
-            handle_.Dispose();
+            Destroy();
             // the haptic thread is joined: the callback's user pointer is no longer used
             if (counterHandle_.IsAllocated) counterHandle_.Free();
             GC.SuppressFinalize(this);
@@ -234,9 +224,8 @@ namespace UnrealHaptics
 
         ~Session()
         {
-            // a SafeHandle may be released from another finaliser; the counter handle is freed
-            // only once no haptic thread can call back (after the close)
-            handle_.Dispose();
+            // the counter handle is freed only once no haptic thread can call back (after the destroy)
+            Destroy();
             if (counterHandle_.IsAllocated) counterHandle_.Free();
         }
     }

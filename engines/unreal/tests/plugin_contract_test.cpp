@@ -134,7 +134,7 @@ TEST(UnrealPluginContract, BuildsStartsPollsAndStopsTheLevelsSession) {
   const FUhApi& uh = api();
   const std::filesystem::path cache = cache_dir();
   FUhSessionBuild build = UhBuildSession(uh, level_request(cache));
-  ASSERT_NE(build.Session, nullptr) << *build.Error;
+  ASSERT_NE(build.Session.bits, 0u) << *build.Error;
   // the missing scene object and the tool without a mesh are warnings, never a failed start
   ASSERT_EQ(build.Warnings.Num(), 2);
   EXPECT_TRUE(build.Warnings[0].Contains("no-such-object")) << *build.Warnings[0];
@@ -183,7 +183,7 @@ TEST(UnrealPluginContract, BuildsStartsPollsAndStopsTheLevelsSession) {
   EXPECT_EQ(state.force[0], 0.0);
   EXPECT_EQ(state.force[1], 0.0);
   EXPECT_EQ(state.force[2], 0.0);
-  uh.uh_session_close(build.Session);
+  uh.uh_session_destroy(build.Session);
 }
 
 TEST(UnrealPluginContract, CachesAStaticMeshsPackingAndRepacksADamagedOne) {
@@ -191,15 +191,15 @@ TEST(UnrealPluginContract, CachesAStaticMeshsPackingAndRepacksADamagedOne) {
   const std::filesystem::path cache = cache_dir();
   for (const std::filesystem::path& old : cached_cubes(cache)) std::filesystem::remove(old);
   FUhSessionBuild first = UhBuildSession(uh, level_request(cache));
-  ASSERT_NE(first.Session, nullptr) << *first.Error;
-  uh.uh_session_close(first.Session);
+  ASSERT_NE(first.Session.bits, 0u) << *first.Error;
+  uh.uh_session_destroy(first.Session);
   const std::vector<std::filesystem::path> cached = cached_cubes(cache);
   ASSERT_EQ(cached.size(), 1u);
 
   std::ofstream(cached[0], std::ios::binary | std::ios::trunc) << "not a tree";
   FUhSessionBuild second = UhBuildSession(uh, level_request(cache));
-  ASSERT_NE(second.Session, nullptr) << *second.Error;
-  uh.uh_session_close(second.Session);
+  ASSERT_NE(second.Session.bits, 0u) << *second.Error;
+  uh.uh_session_destroy(second.Session);
   EXPECT_GT(std::filesystem::file_size(cached[0]), 100u);  // packed again and saved over the damaged file
 }
 
@@ -209,7 +209,7 @@ TEST(UnrealPluginContract, RemovesTheScenesObjectsTheLevelReplacesAndOverridesTh
   request.SceneObjectsToRemove = TArray<FString>{"bunny"};
   request.HapticHz = 2000.0;  // the manager's override (0: the scene's 1000 Hz)
   FUhSessionBuild build = UhBuildSession(uh, request);
-  ASSERT_NE(build.Session, nullptr) << *build.Error;
+  ASSERT_NE(build.Session.bits, 0u) << *build.Error;
   EXPECT_EQ(build.Warnings.Num(), 1);  // the tool without a mesh only
   ASSERT_EQ(build.ObjectNames.Num(), 1);
   EXPECT_TRUE(build.ObjectNames[0] == FString("cube"));
@@ -225,14 +225,14 @@ TEST(UnrealPluginContract, RemovesTheScenesObjectsTheLevelReplacesAndOverridesTh
     if (*c != ' ' && *c != '\n') text += *c;
   // the haptic target rate (the collision one stays the scene's 1000 Hz)
   EXPECT_NE(text.find("\"target_hz\":2000"), std::string::npos) << text;
-  uh.uh_session_close(build.Session);
+  uh.uh_session_destroy(build.Session);
 }
 
 TEST(UnrealPluginContract, AFailedBuildNamesTheCallAndTheFile) {
   FUhSessionRequest request;
   request.ScenePath = "/nonexistent/level-scene.json";
   const FUhSessionBuild build = UhBuildSession(api(), request);
-  EXPECT_EQ(build.Session, nullptr);
+  EXPECT_EQ(build.Session.bits, 0u);
   EXPECT_TRUE(build.Error.StartsWith("uh_scene_load")) << *build.Error;
   EXPECT_TRUE(build.Error.Contains("level-scene.json")) << *build.Error;
 }
@@ -261,9 +261,11 @@ TEST(UnrealPluginContract, ConvertsTheTickStateAndContactEvents) {
   uh_contact_event event{};
   event.kind = UH_CONTACT_END;
   event.object = 1;
+  event.tool = 1;
   const TArray<FString> names{"bunny", "cube"};
   const FUhContact contact = UhToContact(event, names);
   EXPECT_TRUE(contact.ObjectName == FString("cube"));
+  EXPECT_EQ(contact.Tool, 1);
   EXPECT_FALSE(contact.bBegin);
   event.object = 5;  // an index the session does not have
   EXPECT_TRUE(UhToContact(event, names).ObjectName.IsEmpty());

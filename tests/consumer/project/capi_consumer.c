@@ -10,7 +10,7 @@ int main(void) {
                                     1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
   const double origin[3] = {0, 0, 0}, identity[4] = {1, 0, 0, 0};
   uh_tree_build_def def = uh_default_tree_build_def();
-  uh_tree* cube = NULL;
+  uh_tree_id cube = {0};
   uh_query_result r;
   def.spheres = 100;
   if (uh_api_version() != UH_API_VERSION) return 1;
@@ -20,7 +20,7 @@ int main(void) {
   }
   r.struct_size = sizeof r;
   if (uh_tree_query(cube, cube, origin, identity, &r) != UH_OK || !(r.volume > 0.0)) return 1;
-  uh_tree_free(cube);
+  uh_tree_destroy(cube);
   printf("capi consumer ok (libuh %s)\n", uh_version_string());
   return 0;
 }

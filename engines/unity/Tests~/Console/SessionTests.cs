@@ -67,6 +67,39 @@ static class SessionTests
         Expect(Marshal.SizeOf(typeof(Native.uh_state)) == 168,
                "uh_state as in C (168 bytes): " + Marshal.SizeOf(typeof(Native.uh_state)));
         Expect(Marshal.SizeOf(typeof(Native.uh_contact_event)) == 40, "uh_contact_event as in C (40 bytes)");
+        Expect(Marshal.SizeOf(typeof(Native.uh_session_id)) == 8, "ids are 64-bit values");
+        var defaults = Native.DefaultToolDef();
+        Expect(defaults.workspace_scale == 1.0 && defaults.workspace_rotation_w == 1.0 && defaults.tool_offset_z == 0.0,
+               "the library's tool defaults fill this binding's layout");
+    }
+
+    // A second tool on its own device, far from the bunny: every contact event names the first.
+    static void TestASecondToolIsAddedAndEventsNameTheirTool()
+    {
+        var source = Environment.GetEnvironmentVariable("UH_SOURCE_DIR");
+        Expect(!string.IsNullOrEmpty(source), "UH_SOURCE_DIR names the repository (scripts/test.sh sets it)");
+        using (var scene = Scene.Load())
+        {
+            var index = scene.AddTool(new ToolSettings
+            {
+                Name = "far", MeshPath = Path.Combine(source, "assets/meshes/stylus.obj"), MetersPerUnit = 0.01,
+                Spheres = 150, DeviceDriver = "sim-line",
+                DeviceConfigJson = "{\"start\": [1, 0, 0.1], \"end\": [1, 0, 0.2]}",
+            });
+            Expect(index == 1 && scene.ToolCount == 2, "the second tool's index: " + index);
+            using (var s = Session.Create(scene, Environment.GetEnvironmentVariable("UH_CACHE_DIR")))
+            {
+                s.RunStepped(3.0, 4);
+                ContactEvent e;
+                int begins = 0;
+                while (s.PollEvent(out e))
+                {
+                    Expect(e.Tool == 0, "only the first tool touches: " + e.Tool);
+                    if (e.Kind == ContactKind.Begin) ++begins;
+                }
+                Expect(begins >= 1, "the first tool touched the bunny");
+            }
+        }
     }
 
     static void TestTheDefaultSessionRunsPollsAndStopsWithTheReportAndZeroForce()
@@ -138,7 +171,7 @@ static class SessionTests
         }
         catch (UhException e)
         {
-            Expect(e.Status == Native.UH_ERROR_FAILED, "UH_ERROR_FAILED: " + e.Status);
+            Expect(e.Status == Native.UH_ERROR_FILE, "UH_ERROR_FILE: " + e.Status);
             Expect(e.Message.Contains("/nonexistent/scene.json"), "names the file: " + e.Message);
         }
         using (var s = Session.Open())

@@ -11,6 +11,15 @@
 #include "UhSessionBuilder.h"
 #include "UnrealHapticsLog.h"
 
+namespace
+{
+	// the session's id as libuh takes it (the header keeps its bits: uh.h is private to this module)
+	uh_session_id AsId(uint64 Bits)
+	{
+		return uh_session_id{Bits};
+	}
+}
+
 FSimpleMulticastDelegate AHapticManager::OnPackingStarted;
 FSimpleMulticastDelegate AHapticManager::OnPackingFinished;
 
@@ -124,7 +133,7 @@ void AHapticManager::SetObjectPose(const FString& Name, const FTransform& Transf
 	double P[3], Q[4];
 	UhConvert::Position(Transform.GetLocation(), P);
 	UhConvert::Orientation(Transform.GetRotation(), Q);
-	Api->uh_session_set_object_pose(Session, Index, P, Q);
+	Api->uh_session_set_object_pose(AsId(SessionId), Index, P, Q);
 }
 
 // Registrations close here; the scene is built and its meshes packed on a worker thread (seconds
@@ -164,15 +173,15 @@ void AHapticManager::FinishBuild(FUhSessionBuild& Build)
 	{
 		UE_LOG(LogUnrealHaptics, Warning, TEXT("%s: %s"), *GetName(), *Warning);
 	}
-	if (Build.Session == nullptr)
+	if (Build.Session.bits == 0)
 	{
 		Fail(Build.Error);
 		return;
 	}
-	Session = Build.Session;
+	SessionId = Build.Session.bits;
 	SessionObjectNames = Build.ObjectNames;
 	FString Error;
-	if (!UhStartSession(*FUhApi::Get(), Session, &UhDispatchTick, &HookTable, Error))
+	if (!UhStartSession(*FUhApi::Get(), AsId(SessionId), &UhDispatchTick, &HookTable, Error))
 	{
 		CloseSession();
 		Fail(Error);
@@ -217,7 +226,7 @@ void AHapticManager::PollState()
 {
 	uh_state S{};
 	S.struct_size = sizeof S;
-	if (FUhApi::Get()->uh_session_poll(Session, &S) != UH_OK)
+	if (FUhApi::Get()->uh_session_poll(AsId(SessionId), &S) != UH_OK)
 	{
 		return;
 	}
@@ -239,7 +248,7 @@ void AHapticManager::PollEvents()
 	uh_contact_event E{};
 	E.struct_size = sizeof E;
 	int32 Has = 0;
-	while (IsRunning() && FUhApi::Get()->uh_session_poll_event(Session, &E, &Has) == UH_OK && Has != 0)
+	while (IsRunning() && FUhApi::Get()->uh_session_poll_event(AsId(SessionId), &E, &Has) == UH_OK && Has != 0)
 	{
 		const FUhContact Contact = UhToContact(E, SessionObjectNames);
 		OnNativeContact.Broadcast(Contact);
@@ -283,9 +292,9 @@ void AHapticManager::DiscardPendingBuild()
 	const TSharedPtr<FUhSessionBuild> Build = PendingBuild.Get();
 	PendingBuild = TFuture<TSharedPtr<FUhSessionBuild>>();
 	OnPackingFinished.Broadcast();
-	if (const FUhApi* Api = FUhApi::Get(); Api != nullptr && Build->Session != nullptr)
+	if (const FUhApi* Api = FUhApi::Get(); Api != nullptr && Build->Session.bits != 0)
 	{
-		Api->uh_session_close(Build->Session);
+		Api->uh_session_destroy(Build->Session);
 	}
 }
 
@@ -295,9 +304,9 @@ FString AHapticManager::StopHaptics()
 	if (State == EUhSessionState::Running)
 	{
 		const FUhApi* Api = FUhApi::Get();
-		Api->uh_session_stop(Session);  // zero force, every thread joined
+		Api->uh_session_stop(AsId(SessionId));  // zero force, every thread joined
 		const char* Json = nullptr;
-		if (Api->uh_session_report_json(Session, &Json) == UH_OK)
+		if (Api->uh_session_report_json(AsId(SessionId), &Json) == UH_OK)
 		{
 			Report = UTF8_TO_TCHAR(Json);
 		}
@@ -315,11 +324,11 @@ FString AHapticManager::StopHaptics()
 
 void AHapticManager::CloseSession()
 {
-	if (const FUhApi* Api = FUhApi::Get(); Api != nullptr && Session != nullptr)
+	if (const FUhApi* Api = FUhApi::Get(); Api != nullptr && SessionId != 0)
 	{
-		Api->uh_session_close(Session);  // stops first if it runs
+		Api->uh_session_destroy(AsId(SessionId));  // stops first if it runs
 	}
-	Session = nullptr;
+	SessionId = 0;
 }
 
 void AHapticManager::EndPlay(const EEndPlayReason::Type Reason)
@@ -332,7 +341,7 @@ void AHapticManager::EndPlay(const EEndPlayReason::Type Reason)
 // Should EndPlay never come (an actor destroyed without it), the session still stops and closes.
 void AHapticManager::BeginDestroy()
 {
-	if (PendingBuild.IsValid() || Session != nullptr)
+	if (PendingBuild.IsValid() || SessionId != 0)
 	{
 		DiscardPendingBuild();
 		CloseSession();

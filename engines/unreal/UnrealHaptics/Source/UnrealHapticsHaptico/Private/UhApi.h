@@ -14,16 +14,16 @@
 	X(uh_version_string) \
 	X(uh_api_version) \
 	X(uh_last_error) \
-	X(uh_default_tree_build_def) \
-	X(uh_default_object_def) \
-	X(uh_default_tool_def) \
-	X(uh_default_session_def) \
+	X(uh_tree_build_def_init) \
+	X(uh_object_def_init) \
+	X(uh_tool_def_init) \
+	X(uh_session_def_init) \
 	X(uh_tree_load) \
 	X(uh_tree_build_from_arrays) \
 	X(uh_tree_save) \
-	X(uh_tree_free) \
+	X(uh_tree_destroy) \
 	X(uh_scene_load) \
-	X(uh_scene_free) \
+	X(uh_scene_destroy) \
 	X(uh_scene_add_object) \
 	X(uh_scene_remove_object) \
 	X(uh_scene_watch) \
@@ -38,7 +38,7 @@
 	X(uh_session_object_name) \
 	X(uh_session_stop) \
 	X(uh_session_report_json) \
-	X(uh_session_close)
+	X(uh_session_destroy)
 
 struct FUhApi
 {
@@ -48,6 +48,17 @@ struct FUhApi
 
 	/** The loaded API, or nullptr (logged once) when the library is missing or of another version. */
 	static const FUhApi* Get();
+
+	/** A descriptor with libuh's defaults, as uh.h's inline uh_default_*() makes it, through the
+	 *  resolved uh_*_init (e.g. Defaults(Api.uh_tool_def_init)). */
+	template <typename TDef>
+	static TDef Defaults(uh_status (*Init)(TDef*))
+	{
+		TDef Def{};
+		Def.struct_size = sizeof(TDef);
+		Init(&Def);
+		return Def;
+	}
 
 	/** The calling thread's last libuh error as an FString (libuh keeps it per thread). */
 	FString LastError() const { return UTF8_TO_TCHAR(uh_last_error()); }

@@ -38,23 +38,23 @@ namespace
 	}
 
 	// A static mesh's triangles as a tree: loaded from the cache when packed before, else packed
-	// (seconds) and saved there. nullptr on failure (Out.Error set).
-	uh_tree* CachedTree(const FUhApi& Api, const FUhObjectSpec& O, const FString& CacheDir, FUhSessionBuild& Out)
+	// (seconds) and saved there. A zero id on failure (Out.Error set).
+	uh_tree_id CachedTree(const FUhApi& Api, const FUhObjectSpec& O, const FString& CacheDir, FUhSessionBuild& Out)
 	{
 		const FString Path = CacheDir.IsEmpty() ? FString() : CachePath(Api, O, CacheDir);
 		const FTCHARToUTF8 Utf8Path(*Path);
-		uh_tree* Tree = nullptr;
+		uh_tree_id Tree{};
 		if (!Path.IsEmpty() && Api.uh_tree_load(Utf8Path.Get(), &Tree) == UH_OK)
 		{
 			return Tree;
 		}
-		uh_tree_build_def Def = Api.uh_default_tree_build_def();
+		uh_tree_build_def Def = FUhApi::Defaults(Api.uh_tree_build_def_init);
 		Def.spheres = O.Spheres;
 		if (Api.uh_tree_build_from_arrays(O.Vertices.GetData(), O.Vertices.Num() / 3, O.Indices.GetData(), O.Indices.Num() / 3,
 				&Def, &Tree) != UH_OK)
 		{
 			Out.Error = Failure(Api, TEXT("uh_tree_build_from_arrays '") + O.Name + TEXT("'"));
-			return nullptr;
+			return uh_tree_id{};
 		}
 		if (!Path.IsEmpty() && Api.uh_tree_save(Tree, Utf8Path.Get()) != UH_OK)
 		{
@@ -63,14 +63,14 @@ namespace
 		return Tree;
 	}
 
-	bool AddObject(const FUhApi& Api, uh_scene* Scene, const FUhSessionRequest& Request, const FUhObjectSpec& O,
+	bool AddObject(const FUhApi& Api, uh_scene_id Scene, const FUhSessionRequest& Request, const FUhObjectSpec& O,
 		FUhSessionBuild& Out)
 	{
-		uh_object_def Def = Api.uh_default_object_def();
+		uh_object_def Def = FUhApi::Defaults(Api.uh_object_def_init);
 		const FTCHARToUTF8 Name(*O.Name);
 		const FTCHARToUTF8 Ist(*O.IstPath);
 		const FTCHARToUTF8 Mesh(*O.MeshPath);
-		uh_tree* Tree = nullptr;
+		uh_tree_id Tree{};
 		Def.name = Name.Get();
 		Def.shape.spheres = O.Spheres;
 		if (!O.IstPath.IsEmpty())
@@ -82,7 +82,7 @@ namespace
 			Def.shape.mesh_path = Mesh.Get();  // packed by libuh, cached in the session's cache_dir
 			Def.shape.meters_per_unit = O.MeshMetersPerUnit;
 		}
-		else if ((Tree = CachedTree(Api, O, Request.CacheDir, Out)) == nullptr)
+		else if ((Tree = CachedTree(Api, O, Request.CacheDir, Out)).bits == 0)
 		{
 			return false;
 		}
@@ -102,13 +102,13 @@ namespace
 		{
 			Out.Error = Failure(Api, TEXT("uh_scene_add_object '") + O.Name + TEXT("'"));
 		}
-		Api.uh_tree_free(Tree);  // the scene holds its own reference
+		Api.uh_tree_destroy(Tree);  // the scene holds its own reference
 		return bAdded;
 	}
 
-	bool SetTool(const FUhApi& Api, uh_scene* Scene, const FUhToolSpec& Tool, FUhSessionBuild& Out)
+	bool SetTool(const FUhApi& Api, uh_scene_id Scene, const FUhToolSpec& Tool, FUhSessionBuild& Out)
 	{
-		uh_tool_def Def = Api.uh_default_tool_def();
+		uh_tool_def Def = FUhApi::Defaults(Api.uh_tool_def_init);
 		const FTCHARToUTF8 Mesh(*Tool.MeshPath);
 		const FTCHARToUTF8 Driver(*Tool.DeviceDriver);
 		const FTCHARToUTF8 Config(*Tool.DeviceConfigJson);
@@ -142,7 +142,7 @@ namespace
 
 	// The scene: the file (or the default), the level's objects, then the file's objects the level
 	// replaces (after, so the scene never runs empty), the volumes' watched names and the tool.
-	bool BuildScene(const FUhApi& Api, uh_scene* Scene, const FUhSessionRequest& Request, FUhSessionBuild& Out)
+	bool BuildScene(const FUhApi& Api, uh_scene_id Scene, const FUhSessionRequest& Request, FUhSessionBuild& Out)
 	{
 		for (const FUhObjectSpec& O : Request.Objects)
 		{
@@ -177,7 +177,7 @@ namespace
 FUhSessionBuild UhBuildSession(const FUhApi& Api, const FUhSessionRequest& Request)
 {
 	FUhSessionBuild Out;
-	uh_scene* Scene = nullptr;
+	uh_scene_id Scene{};
 	const FTCHARToUTF8 ScenePath(*Request.ScenePath);
 	if (Api.uh_scene_load(Request.ScenePath.IsEmpty() ? nullptr : ScenePath.Get(), &Scene) != UH_OK)
 	{
@@ -186,7 +186,7 @@ FUhSessionBuild UhBuildSession(const FUhApi& Api, const FUhSessionRequest& Reque
 	}
 	if (BuildScene(Api, Scene, Request, Out))
 	{
-		uh_session_def Def = Api.uh_default_session_def();
+		uh_session_def Def = FUhApi::Defaults(Api.uh_session_def_init);
 		const FTCHARToUTF8 CacheDir(*Request.CacheDir);
 		Def.haptic_hz = Request.HapticHz > 0.0 ? Request.HapticHz : 0.0;
 		Def.collision_hz = Request.CollisionHz;
@@ -194,13 +194,13 @@ FUhSessionBuild UhBuildSession(const FUhApi& Api, const FUhSessionRequest& Reque
 		Def.cache_dir = Request.CacheDir.IsEmpty() ? nullptr : CacheDir.Get();
 		if (Api.uh_session_create_checked(UH_API_VERSION, Scene, &Def, &Out.Session) != UH_OK)
 		{
-			Out.Session = nullptr;
+			Out.Session = uh_session_id{};
 			Out.Error = Failure(Api, TEXT("uh_session_create"));
 		}
 	}
-	Api.uh_scene_free(Scene);  // the session holds a copy
+	Api.uh_scene_destroy(Scene);  // the session holds a copy
 	int32 Count = 0;
-	if (Out.Session != nullptr && Api.uh_session_object_count(Out.Session, &Count) == UH_OK)
+	if (Out.Session.bits != 0 && Api.uh_session_object_count(Out.Session, &Count) == UH_OK)
 	{
 		for (int32 I = 0; I < Count; ++I)
 		{
@@ -212,7 +212,7 @@ FUhSessionBuild UhBuildSession(const FUhApi& Api, const FUhSessionRequest& Reque
 	return Out;
 }
 
-bool UhStartSession(const FUhApi& Api, uh_session* Session, uh_tick_fn Fn, void* User, FString& OutError)
+bool UhStartSession(const FUhApi& Api, uh_session_id Session, uh_tick_fn Fn, void* User, FString& OutError)
 {
 	if (Api.uh_session_set_tick_callback(Session, Fn, User) != UH_OK)
 	{
@@ -264,6 +264,7 @@ FUhContact UhToContact(const uh_contact_event& In, const TArray<FString>& Object
 {
 	FUhContact Out;
 	Out.ObjectName = In.object >= 0 && In.object < ObjectNames.Num() ? ObjectNames[In.object] : FString();
+	Out.Tool = In.tool;
 	Out.bBegin = In.kind == UH_CONTACT_BEGIN;
 	Out.TimeSeconds = In.time_s;
 	Out.Volume = In.volume;

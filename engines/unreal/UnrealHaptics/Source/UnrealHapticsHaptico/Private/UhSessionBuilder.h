@@ -30,7 +30,7 @@ struct FUhSessionRequest
 /** What the build made. */
 struct FUhSessionBuild
 {
-	uh_session* Session = nullptr;  // opened, not started; nullptr on failure
+	uh_session_id Session{};       // opened, not started; zero on failure
 	FString Error;                  // the failing call and libuh's message
 	TArray<FString> Warnings;       // worth a log line, not a failure
 	TArray<FString> ObjectNames;    // the session's objects by index
@@ -40,7 +40,7 @@ struct FUhSessionBuild
 FUhSessionBuild UhBuildSession(const FUhApi& Api, const FUhSessionRequest& Request);
 
 /** Binds the tick function and starts the threads; on failure returns libuh's message. */
-bool UhStartSession(const FUhApi& Api, uh_session* Session, uh_tick_fn Fn, void* User, FString& OutError);
+bool UhStartSession(const FUhApi& Api, uh_session_id Session, uh_tick_fn Fn, void* User, FString& OutError);
 
 /** libuh's state as the hooks see it (haptic thread: copies only). */
 void UhToTickState(const uh_state& In, FUhTickState& Out);

@@ -23,7 +23,6 @@
 #include "HapticManager.generated.h"
 
 struct FUhSessionBuild;
-struct uh_session;
 
 /** The newest haptic state in Unreal's frame (centimetres; force in newtons). */
 USTRUCT(BlueprintType)
@@ -172,7 +171,7 @@ private:
 	FUhHapticHookTable HookTable;
 	TArray<FString> SessionObjectNames;
 	TFuture<TSharedPtr<FUhSessionBuild>> PendingBuild;  // shared: FUhSessionBuild is private to this module
-	uh_session* Session = nullptr;
+	uint64 SessionId = 0;  // libuh's uh_session_id (its bits); 0: none
 	EUhSessionState State = EUhSessionState::Idle;
 	FUhHapticState Newest;
 	FString Report;

@@ -66,6 +66,7 @@ struct FUhHapticHookTable
 struct FUhContact
 {
 	FString ObjectName;
+	int32 Tool = 0;  // the tool's index in the scene
 	bool bBegin = true;
 	double TimeSeconds = 0.0;
 	double Volume = 0.0;  // overlap volume [m^3] (0 at the end)
