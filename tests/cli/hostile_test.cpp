@@ -466,7 +466,8 @@ void expect_served_through(ChildProcess& server, std::uint16_t port, const Clien
   late.request(hello, "welcome");
   ASSERT_TRUE(server.signal(SIGTERM));
   EXPECT_TRUE(server.wait(60s).exited);
-  std::printf("under load: peak %ld MiB; %s\n", peak, describe(r).c_str());
+  std::printf("%s under load: peak %ld MiB; %s\n", server.out().substr(0, server.out().find(':')).c_str(), peak,
+              describe(r).c_str());
 }
 
 // `uh serve` under load: 300 clients that subscribe to the state stream and never read, 8 that flood
