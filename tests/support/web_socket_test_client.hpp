@@ -67,6 +67,17 @@ class Client {
     return std::nullopt;
   }
 
+  /// The next message if one comes within `limit`; nullopt when none did or the connection ended
+  /// (then ended() is true). For a test that does other work between reads.
+  std::optional<json> poll(std::chrono::milliseconds limit) {
+    std::string text;
+    const auto got = client_->receive(text, limit);
+    ended_ = ended_ || got == net::WebSocketClient::Received::ended;
+    if (got == net::WebSocketClient::Received::message) return json::parse(text);
+    return std::nullopt;
+  }
+  bool ended() const { return ended_; }
+
   /// Reads until a message of `type` (others, e.g. state and session events, are skipped).
   json expect(const std::string& type) {
     for (;;) {
@@ -104,6 +115,7 @@ class Client {
   }
 
   std::unique_ptr<net::WebSocketClient> client_;
+  bool ended_ = false;
 };
 
 // A plain HTTP GET on loopback: status and body.
