@@ -23,8 +23,9 @@ thread_local bool t_in_frame = false;
 // how long stop() waits for the servo thread to end the run before giving up on it
 constexpr auto kStopWait = std::chrono::seconds(2);
 // a run whose scheduler runs no frame for this long has stalled: the watchdog ends it, forces off
-// (250 servo periods at 1 kHz: far beyond any scheduling hiccup, short for a hand on the stylus)
-constexpr auto kStallLimit = std::chrono::milliseconds(250);
+// (250 servo periods at 1 kHz: far beyond any scheduling hiccup, short for a hand on the stylus);
+// config `stall_limit_ms` sets another, in [10, 10000]
+constexpr double kDefaultStallLimitMs = 250.0;
 
 // HD's frame (x right, y up, z toward the user) -> the field's (x toward the operator, y right, z up)
 constexpr int kFromHd[3] = {2, 0, 1};  // field axis i is HD axis kFromHd[i]
@@ -55,13 +56,19 @@ LibrarySearch open_haptics_library_search() {
 Result<std::unique_ptr<haptico::HapticDevice>> OpenHapticsDevice::create(
     const haptico::DeviceConfig& config) {
   constexpr std::string_view kName = "openhaptics";
-  if (Status s = config.check_keys({"library", "name", "max_force_n"}, kName); !s) return s.error();
+  if (Status s = config.check_keys({"library", "name", "max_force_n", "stall_limit_ms"}, kName); !s)
+    return s.error();
   auto force = config.number("max_force_n", 0.0);
   if (!force) return Error{fmt::format("{}: {}", kName, force.error().message)};
   if (config.has("max_force_n") && !(*force > 0.0)) return Error{"openhaptics: max_force_n must be positive"};
   if (config.has("name") && config.text("name", "").empty())
     return Error{"openhaptics: name is empty (leave it out for HD's default device)"};
-  Selection sel{.name = config.text("name", ""), .max_force_n = *force};
+  auto stall = config.number("stall_limit_ms", kDefaultStallLimitMs);
+  if (!stall) return Error{fmt::format("{}: {}", kName, stall.error().message)};
+  if (!(*stall >= 10.0 && *stall <= 10000.0)) return Error{"openhaptics: stall_limit_ms must be in [10, 10000]"};
+  Selection sel{.name = config.text("name", ""),
+                .max_force_n = *force,
+                .stall_limit = std::chrono::milliseconds(std::lround(*stall))};
   return std::unique_ptr<haptico::HapticDevice>(new OpenHapticsDevice(config, std::move(sel)));
 }
 
@@ -348,7 +355,7 @@ void OpenHapticsDevice::watch() {
   while (!watchdog_stop_.load(std::memory_order_acquire) && running()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const Clock::time_point last{Clock::duration(last_frame_ns_.load(std::memory_order_relaxed))};
-    if (Clock::now() - last < kStallLimit || !running()) continue;
+    if (Clock::now() - last < selection_.stall_limit || !running()) continue;
     // the scheduler no longer runs frames: forces off without it, no more frames asked of it, and
     // the run over, so that the session ends now (the HapticManager latches it as a device fault)
     const hd::Api& api = *api_;
@@ -357,7 +364,7 @@ void OpenHapticsDevice::watch() {
     servo_dead_.store(true);
     if (!faulted_.exchange(true))
       fault_.note("the HD scheduler stopped running servo frames",
-                  "no frame for 250 ms; forces were disabled");
+                  fmt::format("no frame for {} ms; forces were disabled", selection_.stall_limit.count()).c_str());
     running_.store(false, std::memory_order_release);
     return;
   }

@@ -39,6 +39,9 @@ TEST(OpenHapticsDevice, IsRegisteredAndRejectsBadSettings) {
   EXPECT_NE(typo.error().message.find("nmae"), std::string::npos) << typo.error().message;
   EXPECT_FALSE(registry.create("openhaptics", {{"max_force_n", "0"}}));
   EXPECT_FALSE(registry.create("openhaptics", {{"name", ""}}));
+  auto stall = registry.create("openhaptics", {{"stall_limit_ms", "5"}});
+  ASSERT_FALSE(stall);
+  EXPECT_EQ(stall.error().message, "openhaptics: stall_limit_ms must be in [10, 10000]");
 }
 
 TEST(OpenHapticsDevice, AMissingLibraryListsEveryPlaceTried) {
@@ -288,6 +291,30 @@ TEST(OpenHapticsDevice, AStallMidRunEndsTheRunAtOnceWithForcesOff) {
       status.error().message,
       "device 'openhaptics Touch' faulted: the HD scheduler stopped running servo frames: no frame for 250 "
       "ms; forces were disabled; it was sent zero force");
+}
+
+// The stall limit is the device's setting: a longer one rides out a longer stall, then ends the run
+TEST(OpenHapticsDevice, TheStallLimitIsASetting) {
+  testing::HdStandin standin;
+  DeviceConfig config = standin_config();
+  config.set("stall_limit_ms", 600.0);
+  HapticManager manager(make(config), {.rate_hz = 1000.0});
+  manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& c) {
+    c.force = {0.0, 0.0, 1.0};
+  });
+  ASSERT_TRUE(manager.start());
+  wait_for([&] { return standin.get("force_output") == 1.0; });
+  ASSERT_EQ(standin.get("force_output"), 1.0);
+  standin.set("freeze", 1);
+  const auto frozen = std::chrono::steady_clock::now();
+  wait_for([&] { return !manager.running(); });
+  ASSERT_FALSE(manager.running());
+  EXPECT_GE(std::chrono::steady_clock::now() - frozen, std::chrono::milliseconds(600));
+  EXPECT_EQ(standin.get("force_output"), 0.0);
+  manager.stop();
+  const Status status = manager.device_status();
+  ASSERT_FALSE(status);
+  EXPECT_NE(status.error().message.find("no frame for 600 ms"), std::string::npos) << status.error().message;
 }
 
 }  // namespace

@@ -75,6 +75,7 @@ class OpenHapticsDevice final : public haptico::ClockedDevice, private haptico::
   struct Selection {
     std::string name;          // "" = HD's default device
     double max_force_n = 0.0;  // 0: the device's
+    std::chrono::milliseconds stall_limit{250};  // no servo frame for this long ends the run, forces off
   };
   explicit OpenHapticsDevice(haptico::DeviceConfig config, Selection selection);
 
