@@ -246,17 +246,23 @@ TEST(OpenHapticsDevice, AnErrorMidRunStopsTheForcesAndReopeningWorks) {
   EXPECT_EQ(standin.get("init_count"), 2.0);
 }
 
-// a scheduler that stops running frames: stopping does not hang, turns the forces off without it
-// and reports the device as faulted
-TEST(OpenHapticsDevice, ASchedulerThatStopsAnsweringEndsWithForcesOffAndAFault) {
-  testing::HdStandin standin;
-  HapticManager manager(make(standin_config()), {.rate_hz = 1000.0});
+// Starts `manager` pushing 1 N and waits until the stand-in's forces are on.
+void start_pushing(HapticManager& manager, testing::HdStandin& standin) {
   manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& c) {
     c.force = {0.0, 0.0, 1.0};
   });
   ASSERT_TRUE(manager.start());
   wait_for([&] { return standin.get("force_output") == 1.0; });
   ASSERT_EQ(standin.get("force_output"), 1.0);
+}
+
+// a scheduler that stops running frames: stopping does not hang, turns the forces off without it
+// and reports the device as faulted
+TEST(OpenHapticsDevice, ASchedulerThatStopsAnsweringEndsWithForcesOffAndAFault) {
+  testing::HdStandin standin;
+  HapticManager manager(make(standin_config()), {.rate_hz = 1000.0});
+  start_pushing(manager, standin);
+  if (::testing::Test::HasFatalFailure()) return;
   standin.set("freeze", 1);
   manager.stop();  // gives up on the frozen scheduler after a bounded wait
   EXPECT_FALSE(manager.running());
@@ -274,12 +280,8 @@ TEST(OpenHapticsDevice, ASchedulerThatStopsAnsweringEndsWithForcesOffAndAFault) 
 TEST(OpenHapticsDevice, AStallMidRunEndsTheRunAtOnceWithForcesOff) {
   testing::HdStandin standin;
   HapticManager manager(make(standin_config()), {.rate_hz = 1000.0});
-  manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& c) {
-    c.force = {0.0, 0.0, 1.0};
-  });
-  ASSERT_TRUE(manager.start());
-  wait_for([&] { return standin.get("force_output") == 1.0; });
-  ASSERT_EQ(standin.get("force_output"), 1.0);
+  start_pushing(manager, standin);
+  if (::testing::Test::HasFatalFailure()) return;
   standin.set("freeze", 1);
   wait_for([&] { return !manager.running(); });
   ASSERT_FALSE(manager.running()) << "the run ended by itself";
@@ -299,12 +301,8 @@ TEST(OpenHapticsDevice, TheStallLimitIsASetting) {
   DeviceConfig config = standin_config();
   config.set("stall_limit_ms", 600.0);
   HapticManager manager(make(config), {.rate_hz = 1000.0});
-  manager.force_on_haptic_tick().add_delegate([](const DeviceState&, DeviceCommand& c) {
-    c.force = {0.0, 0.0, 1.0};
-  });
-  ASSERT_TRUE(manager.start());
-  wait_for([&] { return standin.get("force_output") == 1.0; });
-  ASSERT_EQ(standin.get("force_output"), 1.0);
+  start_pushing(manager, standin);
+  if (::testing::Test::HasFatalFailure()) return;
   standin.set("freeze", 1);
   const auto frozen = std::chrono::steady_clock::now();
   wait_for([&] { return !manager.running(); });
