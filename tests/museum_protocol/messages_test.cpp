@@ -294,7 +294,8 @@ TEST(ServerMessages, InHandsCarriesTheFormAndNeverWhichPieceItIs) {
     for (auto& [k, v] : keys.items())
       if (!v.is_object()) v = nullptr;
     keys["form"] = json::array();
-    for (const auto& [k, v] : json::parse(text)["form"].items()) keys["form"].push_back(k);
+    const json parsed = json::parse(text);  // named: a range over a temporary's member would dangle
+    for (const auto& [k, v] : parsed["form"].items()) keys["form"].push_back(k);
     seen.push_back(keys.dump());
   }
   for (const std::string& k : seen) EXPECT_EQ(k, seen.front());
