@@ -6,6 +6,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <map>
+#include <numbers>
 #include <thread>
 #include <tuple>
 
@@ -20,6 +21,17 @@ namespace {
 
 double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The spring the proxy renders on a contact of `material` [N/m]: the gradient law's spring of a
+// round tip, 2 pi r k (docs/scenes.md, `stiffness`), r the tool's largest inner sphere (the tip of a
+// ball tool, the shaft of a stylus). 0 under the paper law, whose eps_c is no spring: the coupling's.
+double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::ContactMaterial& material,
+                        const collette::SphereTree& tool_tree) {
+  if (force.law != forcecomp::ForceLaw::kGradient) return 0.0;
+  double radius = 0.0;
+  for (const auto& leaf : tool_tree.leaves()) radius = std::max(radius, static_cast<double>(leaf.radius));
+  return 2.0 * std::numbers::pi * radius * material.stiffness;
 }
 
 // Per object of the scene: its mesh surface in metres when a tool watches it and it has a mesh
@@ -128,7 +140,10 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
   if (options.tick_force) force_options.tick_force = *options.tick_force;
   force_options.check_model = options.check_model;
-  if (options.proxy) force_options.proxy.enabled = *options.proxy;
+  if (options.proxy)
+    force_options.proxy.enabled = *options.proxy;
+  else if (force_options.use_coupling)
+    force_options.proxy.enabled = false;  // the proxy is the default, the coupling a choice: it wins
   if (force_options.proxy.enabled) force_options.use_coupling = false;  // the proxy is the simulated tool
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
@@ -253,6 +268,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       if (rig->proxy)
         rig->proxy->watch(object_ids[i], {.friction_static = material.friction_static,
                                           .friction_dynamic = material.friction_dynamic,
+                                          .stiffness_n_m = proxy_spring_n_m(tool.force, material, *tool_tree->tree),
                                           .object_texture = material.object_texture,
                                           .tool_texture = material.tool_texture,
                                           .surface = surfaces->at(i)});

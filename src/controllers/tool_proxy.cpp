@@ -283,6 +283,7 @@ ToolProxy::HoldingFriction ToolProxy::holding_friction(std::span<const forcecomp
       const ProxyContact& contact = watched_[static_cast<std::size_t>(c.tag)].contact;
       h.friction_static = std::max(h.friction_static, contact.friction_static);
       h.friction_dynamic = std::max(h.friction_dynamic, contact.friction_dynamic);
+      h.stiffness_n_m = std::max(h.stiffness_n_m, contact.stiffness_n_m);
     }
   }
   h.normal = norm(sum) > 0.0 ? normalized(sum) : Vec3{};
@@ -341,6 +342,7 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   HoldingFriction held = holding_friction(rows, step.active_index, rows.empty() ? 0 : step.active);
   out.friction_static = held.friction_static;
   out.friction_dynamic = held.friction_dynamic;
+  out.stiffness_n_m = held.stiffness_n_m;
   if (held.friction_static > 0.0) held.normal = contact_normal(rows, held.normal);
   out.contact_normal = held.normal;
   if (step.active > 0 && held.friction_static > 0.0 && norm(held.normal) > 0.0)
