@@ -287,6 +287,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   }
   HapticSession& self = *session;
   self.collision_connection_ = world.on_collision().connect<&HapticSession::on_collision>(self);
+  self.step_connection_ = world.on_step().connect<&HapticSession::on_step>(self);  // after the proxies'
   self.object_ids_ = object_ids;
   self.report_.scene = scene.name;
   return session;
@@ -334,7 +335,7 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   ToolRig* rig = nullptr;
   for (auto& r : rigs_)
     if (r->tool_id == b) rig = r.get();
-  if (rig == nullptr) return;
+  if (rig == nullptr || rig->proxy) return;  // a proxy's contacts are its constraints' (on_step)
   auto& touching = rig->touching;
   if (a != ContactFrame::kEveryObject) {
     if (a < 0 || static_cast<std::size_t>(a) >= touching.size()) return;
@@ -354,6 +355,19 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   }
   for (std::size_t i = 0; i < touching.size(); ++i)
     if (now[i] == 0) contact_edge(*rig, static_cast<collette::ObjectId>(i), false, frame.time_s, 0.0, 0);
+}
+
+void HapticSession::on_step(double time_s) {
+  // collision thread, after every proxy's own step: through a proxy the tool rests on the surface
+  // (on the mesh, above the spheres), so its contact is its constraint rows in contact, not overlap
+  for (auto& rig : rigs_) {
+    if (!rig->proxy) continue;
+    const ToolProxy& proxy = *rig->proxy;
+    for (std::size_t k = 0; k < proxy.watched_count(); ++k) {
+      const std::int32_t rows = proxy.contact_rows(k);
+      contact_edge(*rig, proxy.watched_object(k), rows > 0, time_s, 0.0, rows);
+    }
+  }
 }
 
 void HapticSession::contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s,

@@ -154,6 +154,13 @@ class ToolProxy {
   /// follows the handle at the haptic rate (zero in free space). Haptic thread; real-time safe.
   Pose slide(const ProxyState& state, const Pose& world_from_handle_tool);
 
+  /// The objects watched, in watch() order, and how many of the last step's constraint rows with
+  /// each are in contact at the proxy's new pose (0: apart). Collision thread, after on_step (an
+  /// OnStep handler bound after bind()): the session's contact events come from here.
+  std::size_t watched_count() const { return watched_.size(); }
+  collette::ObjectId watched_object(std::size_t k) const { return watched_[k].id; }
+  std::int32_t contact_rows(std::size_t k) const { return contact_rows_[k]; }
+
   ToolProxyStats stats() const;
   /// The proxy's pose. Only while the collision thread does not run (before start, after stop).
   const Pose& pose() const { return proxy_; }
@@ -170,6 +177,7 @@ class ToolProxy {
     double stiffness_n_m = 0.0;
   };
   Vec3 contact_normal(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& holding) const;
+  void count_contacts(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w);
   HoldingFriction holding_friction(std::span<const forcecomp::ProxyConstraint> rows, const std::int32_t* active,
                                    std::int32_t count) const;
   void add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal, double gap,
@@ -231,6 +239,7 @@ class ToolProxy {
     Vec3 on_tool{};    // world frame
   };
   std::vector<TextureContact> texture_contact_;
+  std::vector<std::int32_t> contact_rows_;  // per watched object: rows in contact after the step
   std::int32_t constraint_count_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
