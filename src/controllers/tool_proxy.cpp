@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "uh/core/atomic_max.hpp"
 #include "uh/forcecomp/virtual_coupling.hpp"
 
 namespace uh::controllers {
@@ -77,9 +78,6 @@ Vec3 friction_step(const Vec3& from, const Vec3& free, const Vec3& handle, const
   return t + std::min(back, 1.0) * (free - t);
 }
 
-void raise_max(std::atomic<double>& max, double value) {
-  if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
-}
 
 }  // namespace
 
@@ -455,8 +453,7 @@ void ToolProxy::on_step(double time_s) {
   // the sums start again next step (whether or not this one used them)
   for (const std::int32_t leaf : touched_) smooth_[static_cast<std::size_t>(leaf)] = {};
   touched_.clear();
-  max_constraints_.store(std::max(max_constraints_.load(std::memory_order_relaxed), constraint_count_),
-                         std::memory_order_relaxed);
+  raise_max(max_constraints_, constraint_count_);
   out.world_from_proxy = proxy_;
   out.time_s = time_s;
   out.constraints = constraint_count_;
