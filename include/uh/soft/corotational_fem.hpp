@@ -1,0 +1,104 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "uh/core/result.hpp"
+#include "uh/soft/tet_mesh.hpp"
+
+namespace uh::soft {
+
+/// Linear isotropic elasticity with mass and Rayleigh damping, C = alpha M + beta K.
+struct ElasticMaterial {
+  double young_modulus_pa = 1.0e5;  ///< E [Pa], > 0
+  double poisson_ratio = 0.3;       ///< nu, in [0, 0.5)
+  double density_kg_m3 = 1000.0;    ///< rho [kg/m^3], > 0
+  double mass_damping_per_s = 0.0;  ///< alpha [1/s], >= 0; also slows rigid motion (drag)
+  double stiffness_damping_s = 0.0; ///< beta [s], >= 0; damps deformation only
+};
+
+/// The nodes of `mesh` inside the box [min, max] (bounds included) [m], object frame.
+std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3d& min, const Eigen::Vector3d& max);
+
+/// Corotational linear FEM on linear tetrahedra (Mueller and Gross 2004): each element's rotation is
+/// the polar decomposition of its deformation gradient, its forces are the linear ones in that
+/// rotated frame. Lumped mass from the density. Steps are implicit (backward Euler), linearised
+/// with the rotations of the step's start, and solved by a sparse LDL^T factorisation whose pattern
+/// is analysed once and whose values are refactored each step. Fixed nodes are eliminated: they
+/// stay at their held position (the rest position unless moved with `hold`).
+/// Not thread-safe: one simulation thread owns it. Steps allocate nothing in the assembly; the
+/// factorisation may.
+class CorotationalFem {
+ public:
+  /// A model of `mesh` (positively oriented tetrahedra of nonzero volume) with `fixed` nodes held.
+  /// Fails (kInvalid) on a bad material or node index, (kMesh) on an empty or degenerate mesh.
+  static Result<CorotationalFem> create(TetMesh mesh, const ElasticMaterial& material,
+                                        const std::vector<std::int32_t>& fixed);
+
+  /// One backward-Euler step of `dt_s` [s] under `external_forces` [N] (one per node, object frame;
+  /// those on fixed nodes are ignored). Fails when dt_s is not positive and finite, the forces are
+  /// not one finite vector per node, or the factorisation fails; the state is then unchanged.
+  Status step(double dt_s, const std::vector<Eigen::Vector3d>& external_forces);
+
+  /// The static equilibrium under `external_forces` (no inertia, no damping), by at most
+  /// `max_iterations` linear solves, each with the rotations of the last iterate, until no node
+  /// moves more than `tolerance_m`. Needs fixed nodes (a free body has no equilibrium); velocities
+  /// are set to zero. Returns the solves it took.
+  Result<int> solve_static(const std::vector<Eigen::Vector3d>& external_forces, int max_iterations = 50,
+                           double tolerance_m = 1e-12);
+
+  /// Holds fixed node `node` at `position` [m] from the next step or solve on (a prescribed motion).
+  Status hold(std::int32_t node, const Eigen::Vector3d& position);
+
+  const TetMesh& mesh() const { return mesh_; }
+  const std::vector<Eigen::Vector3d>& positions() const { return positions_; }    ///< [m]
+  const std::vector<Eigen::Vector3d>& velocities() const { return velocities_; }  ///< [m/s]
+  std::vector<Eigen::Vector3d>& velocities() { return velocities_; }              ///< set initial motion
+  std::vector<Eigen::Vector3d>& positions() { return positions_; }                ///< set an initial shape
+  const std::vector<double>& node_masses() const { return masses_; }              ///< lumped [kg]
+  bool is_fixed(std::int32_t node) const { return free_index_[static_cast<std::size_t>(node)] < 0; }
+  int free_dofs() const { return static_cast<int>(rhs_.size()); }
+
+ private:
+  using Block = Eigen::Matrix3d;
+  struct Element {
+    std::array<std::int32_t, 4> nodes{};
+    Eigen::Matrix3d rest_inverse;     // inverse of the rest edge matrix [X1-X0, X2-X0, X3-X0]
+    std::array<Block, 16> stiffness;  // rest stiffness K_ab [N/m], a * 4 + b
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  };
+
+  CorotationalFem() = default;
+  void build_pattern();
+  void update_rotations();
+  void elastic_forces(std::vector<Eigen::Vector3d>& forces) const;
+  Status solve_increment(double mass_coefficient, double stiffness_coefficient,
+                         const std::vector<Eigen::Vector3d>& loads);
+  Status check_loads(const std::vector<Eigen::Vector3d>& external_forces) const;
+  double apply_increment(double dt_s);
+
+  TetMesh mesh_;
+  ElasticMaterial material_;
+  std::vector<Element> elements_;
+  std::vector<Eigen::Vector3d> positions_;
+  std::vector<Eigen::Vector3d> velocities_;
+  std::vector<Eigen::Vector3d> held_;      // target positions of fixed nodes
+  std::vector<double> masses_;
+  std::vector<std::int32_t> free_index_;   // node -> its index among free nodes, -1 when fixed
+  Eigen::SparseMatrix<double> system_;     // over free DOFs, fixed pattern
+  std::vector<std::int32_t> block_slots_;  // per element block (a, b) and column c: value index of row 3 b'
+  std::vector<std::int32_t> diagonal_slots_;
+  // owned through a pointer: Eigen's solvers cannot be moved
+  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> solver_;
+  Eigen::VectorXd rhs_;
+  Eigen::VectorXd increment_;
+  std::vector<Eigen::Vector3d> forces_;    // scratch: elastic + external loads
+};
+
+}  // namespace uh::soft
