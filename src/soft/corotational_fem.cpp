@@ -1,7 +1,6 @@
 #include "uh/soft/corotational_fem.hpp"
 
 #include <Eigen/LU>
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +8,26 @@
 
 namespace uh::soft {
 namespace {
+
+// the rotation of F = R S for det F > 0, by Newton's iteration X <- (g X + X^-T / g) / 2 with
+// Higham's scaling g: quadratic, a handful of iterations, orthogonal to rounding
+bool polar_newton(const Eigen::Matrix3d& deformation, Eigen::Matrix3d& rotation) {
+  constexpr int kMaxIterations = 20;
+  constexpr double kConverged = 1e-13;
+  Eigen::Matrix3d x = deformation;
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    const Eigen::Matrix3d inverse_transpose = x.inverse().transpose();
+    const double scale = std::sqrt(inverse_transpose.norm() / x.norm());
+    const Eigen::Matrix3d next = 0.5 * (scale * x + inverse_transpose / scale);
+    const double change = (next - x).norm();
+    x = next;
+    if (change < kConverged) {
+      rotation = x;
+      return true;
+    }
+  }
+  return false;
+}
 
 constexpr std::size_t at(std::int32_t index) { return static_cast<std::size_t>(index); }
 
@@ -34,14 +53,29 @@ Eigen::Matrix3d edge_matrix(const std::vector<Eigen::Vector3d>& x, const std::ar
   return edges;
 }
 
-// the rotation of F = R S, S symmetric; a reflection (an inverted element) is turned into the
-// nearest rotation by flipping the axis of the smallest singular value
-Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& deformation) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(deformation, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d u = svd.matrixU();
-  const Eigen::Matrix3d& v = svd.matrixV();
-  if ((u * v.transpose()).determinant() < 0.0) u.col(2) = -u.col(2);
-  return u * v.transpose();
+// the rotation of F = R S, S symmetric positive: the iteration of Mueller et al. (2016, "A robust
+// method to extract the rotational part of deformations"), turning `rotation` about the axis that
+// makes R^T F more symmetric until it is symmetric. Warm-started from the last step's rotation it
+// takes one or two turns; it never yields a reflection, even for an inverted element.
+int extract_rotation(const Eigen::Matrix3d& deformation, Eigen::Quaterniond& rotation) {
+  // a strongly stretched element converges slowly (about a dozen turns); a cap that leaves the
+  // rest to the next step makes a rigid body creep, so the rotation is converged each time
+  constexpr int kMaxTurns = 40;
+  constexpr double kConverged = 1e-10;  // [rad]
+  for (int turn = 0; turn < kMaxTurns; ++turn) {
+    const Eigen::Matrix3d r = rotation.toRotationMatrix();
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+    double alignment = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      axis += r.col(i).cross(deformation.col(i));
+      alignment += r.col(i).dot(deformation.col(i));
+    }
+    axis /= std::abs(alignment) + 1e-9;
+    const double angle = axis.norm();
+    if (angle < kConverged) return turn;
+    rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis / angle)) * rotation).normalized();
+  }
+  return kMaxTurns;
 }
 
 bool all_finite(const std::vector<Eigen::Vector3d>& vectors) {
@@ -162,9 +196,18 @@ void CorotationalFem::build_pattern() {
   solver_->analyzePattern(system_);
 }
 
+// Newton's polar iteration where the element is not inverted (fast, exact); the warm-started turns
+// where it is (they never yield a reflection)
 void CorotationalFem::update_rotations() {
+  constexpr double kLeastVolumeRatio = 1e-3;
   for (auto& element : elements_) {
-    element.rotation = polar_rotation(edge_matrix(positions_, element.nodes) * element.rest_inverse);
+    const Eigen::Matrix3d deformation = edge_matrix(positions_, element.nodes) * element.rest_inverse;
+    if (deformation.determinant() > kLeastVolumeRatio && polar_newton(deformation, element.rotation)) {
+      element.quaternion = Eigen::Quaterniond(element.rotation);
+      continue;
+    }
+    rotation_turns_ += extract_rotation(deformation, element.quaternion);
+    element.rotation = element.quaternion.toRotationMatrix();
   }
 }
 
@@ -221,14 +264,51 @@ Status CorotationalFem::solve_increment(double mass_coefficient, double stiffnes
       }
     }
   }
+  return solve_system();
+}
+
+// Preconditioned conjugate gradients on the current system, preconditioned by the factorisation of
+// an earlier one: rotations change little from step to step, so a few iterations reach the exact
+// solution. When they do not, the current system is factorised and solved directly, and that
+// factorisation preconditions the next steps.
+Status CorotationalFem::solve_system() {
+  iterations_ = 0;
+  if (factorised_ && conjugate_gradients()) return Ok{};
   solver_->factorize(system_);
-  if (solver_->info() != Eigen::Success) {
+  factorised_ = solver_->info() == Eigen::Success;
+  if (!factorised_) {
     return Error{"soft::CorotationalFem: the system's factorisation failed (is every part of the body connected?)",
                  ErrorKind::kInvalid};
   }
+  ++factorisations_;
   increment_ = solver_->solve(rhs_);
   if (!increment_.allFinite()) return Error{"soft::CorotationalFem: the solve gave a non-finite step", ErrorKind::kInvalid};
   return Ok{};
+}
+
+bool CorotationalFem::conjugate_gradients() {
+  constexpr int kMaxIterations = 12;
+  constexpr double kRelativeResidual = 1e-8;
+  const double target = kRelativeResidual * rhs_.norm();
+  // the last solve's increment is the first guess: the motion is smooth from step to step
+  residual_ = rhs_ - system_ * increment_;
+  preconditioned_ = solver_->solve(residual_);
+  direction_ = preconditioned_;
+  double rz = residual_.dot(preconditioned_);
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    iterations_ = iteration;
+    if (!(residual_.norm() > target)) return increment_.allFinite();
+    product_.noalias() = system_ * direction_;
+    const double alpha = rz / direction_.dot(product_);
+    increment_ += alpha * direction_;
+    residual_ -= alpha * product_;
+    preconditioned_ = solver_->solve(residual_);
+    const double rz_next = residual_.dot(preconditioned_);
+    direction_ = preconditioned_ + (rz_next / rz) * direction_;
+    rz = rz_next;
+  }
+  iterations_ = kMaxIterations;
+  return !(residual_.norm() > target) && increment_.allFinite();
 }
 
 Status CorotationalFem::hold(std::int32_t node, const Eigen::Vector3d& position) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -29,8 +30,9 @@ std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3
 /// Corotational linear FEM on linear tetrahedra (Mueller and Gross 2004): each element's rotation is
 /// the polar decomposition of its deformation gradient, its forces are the linear ones in that
 /// rotated frame. Lumped mass from the density. Steps are implicit (backward Euler), linearised
-/// with the rotations of the step's start, and solved by a sparse LDL^T factorisation whose pattern
-/// is analysed once and whose values are refactored each step. Fixed nodes are eliminated: they
+/// with the rotations of the step's start, and solved by conjugate gradients preconditioned with a
+/// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once), which is
+/// refactored only when the iterations do not converge quickly. Fixed nodes are eliminated: they
 /// stay at their held position (the rest position unless moved with `hold`).
 /// Not thread-safe: one simulation thread owns it. Steps allocate nothing in the assembly; the
 /// factorisation may.
@@ -64,6 +66,13 @@ class CorotationalFem {
   const std::vector<double>& node_masses() const { return masses_; }              ///< lumped [kg]
   bool is_fixed(std::int32_t node) const { return free_index_[static_cast<std::size_t>(node)] < 0; }
   int free_dofs() const { return static_cast<int>(rhs_.size()); }
+  /// How many times the system was factorised (the others were solved by iterations on an older
+  /// factorisation).
+  int factorisations() const { return factorisations_; }
+  /// Conjugate-gradient iterations of the last solve (0 when it was factorised and solved directly).
+  int last_iterations() const { return iterations_; }
+  /// Turns of the rotation extraction over all elements and steps so far.
+  std::int64_t rotation_turns() const { return rotation_turns_; }
 
  private:
   using Block = Eigen::Matrix3d;
@@ -72,6 +81,7 @@ class CorotationalFem {
     Eigen::Matrix3d rest_inverse;     // inverse of the rest edge matrix [X1-X0, X2-X0, X3-X0]
     std::array<Block, 16> stiffness;  // rest stiffness K_ab [N/m], a * 4 + b
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    Eigen::Quaterniond quaternion = Eigen::Quaterniond::Identity();  // the same, warm start of the next
   };
 
   CorotationalFem() = default;
@@ -80,6 +90,8 @@ class CorotationalFem {
   void elastic_forces(std::vector<Eigen::Vector3d>& forces) const;
   Status solve_increment(double mass_coefficient, double stiffness_coefficient,
                          const std::vector<Eigen::Vector3d>& loads);
+  Status solve_system();
+  bool conjugate_gradients();
   Status check_loads(const std::vector<Eigen::Vector3d>& external_forces) const;
   double apply_increment(double dt_s);
 
@@ -96,8 +108,13 @@ class CorotationalFem {
   std::vector<std::int32_t> diagonal_slots_;
   // owned through a pointer: Eigen's solvers cannot be moved
   std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> solver_;
+  bool factorised_ = false;
+  int factorisations_ = 0;
+  int iterations_ = 0;
+  std::int64_t rotation_turns_ = 0;
   Eigen::VectorXd rhs_;
   Eigen::VectorXd increment_;
+  Eigen::VectorXd residual_, preconditioned_, direction_, product_;  // scratch of the iterations
   std::vector<Eigen::Vector3d> forces_;    // scratch: elastic + external loads
 };
 
