@@ -321,6 +321,18 @@ Status CorotationalFem::hold(std::int32_t node, const Eigen::Vector3d& position)
   return Ok{};
 }
 
+Status CorotationalFem::set_state(std::vector<Eigen::Vector3d> positions, std::vector<Eigen::Vector3d> velocities) {
+  const auto fits = [&](const std::vector<Eigen::Vector3d>& v) { return v.size() == positions_.size() && all_finite(v); };
+  if (!fits(positions) || !fits(velocities)) {
+    return Error{"soft::CorotationalFem::set_state: expected one finite position and velocity per node (" +
+                     std::to_string(positions_.size()) + ")",
+                 ErrorKind::kInvalid};
+  }
+  positions_ = std::move(positions);
+  velocities_ = std::move(velocities);
+  return Ok{};
+}
+
 Status CorotationalFem::check_loads(const std::vector<Eigen::Vector3d>& external_forces) const {
   if (external_forces.size() != positions_.size() || !all_finite(external_forces)) {
     return Error{"soft::CorotationalFem: expected one finite external force per node (" +

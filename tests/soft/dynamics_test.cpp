@@ -43,8 +43,9 @@ TEST(SoftDynamics, FreeBodyKeepsMomentumAndRecoversVolume) {
   EXPECT_NEAR(rest_volume, kSide * kSide * kSide, 1e-15);
   // stretched by 10 % along x, and thrown
   const Eigen::Vector3d throw_velocity(0.1, 0.0, -0.05);
-  for (auto& p : fem.positions()) p.x() *= 1.1;
-  for (auto& v : fem.velocities()) v = throw_velocity;
+  std::vector<Eigen::Vector3d> stretched = fem.positions();
+  for (auto& p : stretched) p.x() *= 1.1;
+  ASSERT_TRUE(fem.set_state(stretched, std::vector<Eigen::Vector3d>(stretched.size(), throw_velocity)));
   const Eigen::Vector3d start = centre_of_mass(fem);
   double total_mass = 0.0;
   for (const double m : fem.node_masses()) total_mass += m;
@@ -64,7 +65,9 @@ TEST(SoftDynamics, RigidRotationStressesNothing) {
   auto fem = free_cube({.young_modulus_pa = 1.0e5});
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.8, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   const Eigen::Vector3d shift(0.3, -0.1, 0.2);
-  for (auto& p : fem.positions()) p = rotation * p + shift;
+  std::vector<Eigen::Vector3d> turned = fem.positions();
+  for (auto& p : turned) p = rotation * p + shift;
+  ASSERT_TRUE(fem.set_state(turned, fem.velocities()));
   const std::vector<Eigen::Vector3d> start = fem.positions();
   const std::vector<Eigen::Vector3d> no_load(start.size(), Eigen::Vector3d::Zero());
   for (int step = 0; step < 100; ++step) ASSERT_TRUE(fem.step(1e-3, no_load));
@@ -72,11 +75,13 @@ TEST(SoftDynamics, RigidRotationStressesNothing) {
 }
 
 TEST(SoftDynamics, InvertedCubeTurnsBackOut) {
-  // the far corner pushed through the opposite one inverts all six tetrahedra; the rotations stay
-  // proper (no reflection), so the elastic forces push the cube back out to its rest volume
+  // the cube turned inside out through its centre (x -> c - x / 2): every tetrahedron inverted; the
+  // rotations stay proper (no reflection), and the elastic forces bring back the rest volume
   auto fem = free_cube({.young_modulus_pa = 1.0e4, .mass_damping_per_s = 5.0});
   const double rest_volume = mesh_volume(fem.mesh(), fem.positions());
-  for (auto& p : fem.positions()) p = Eigen::Vector3d::Constant(kSide) - 0.5 * p;
+  std::vector<Eigen::Vector3d> inverted = fem.positions();
+  for (auto& p : inverted) p = Eigen::Vector3d::Constant(kSide) - 0.5 * p;
+  ASSERT_TRUE(fem.set_state(inverted, fem.velocities()));
   EXPECT_LT(mesh_volume(fem.mesh(), fem.positions()), 0.0);
   const std::vector<Eigen::Vector3d> no_load(fem.positions().size(), Eigen::Vector3d::Zero());
   for (int step = 0; step < 3000; ++step) ASSERT_TRUE(fem.step(1e-3, no_load)) << step;

@@ -83,6 +83,7 @@ TEST(CorotationalFem, RejectsBadMaterialNodesAndLoads) {
   EXPECT_FALSE(fem->step(1e-3, {}));
   EXPECT_FALSE(fem->step(0.0, no_load));
   EXPECT_FALSE(fem->hold(0, Eigen::Vector3d::Zero()));  // not a fixed node
+  EXPECT_FALSE(fem->set_state({}, fem->velocities()));
 }
 
 }  // namespace

@@ -55,14 +55,16 @@ class CorotationalFem {
   Result<int> solve_static(const std::vector<Eigen::Vector3d>& external_forces, int max_iterations = 50,
                            double tolerance_m = 1e-12);
 
+  /// Sets every node's position [m] and velocity [m/s] (one finite vector per node each): an
+  /// initial shape and motion. Fixed nodes stay held where `hold` put them (their rest position).
+  Status set_state(std::vector<Eigen::Vector3d> positions, std::vector<Eigen::Vector3d> velocities);
+
   /// Holds fixed node `node` at `position` [m] from the next step or solve on (a prescribed motion).
   Status hold(std::int32_t node, const Eigen::Vector3d& position);
 
   const TetMesh& mesh() const { return mesh_; }
   const std::vector<Eigen::Vector3d>& positions() const { return positions_; }    ///< [m]
   const std::vector<Eigen::Vector3d>& velocities() const { return velocities_; }  ///< [m/s]
-  std::vector<Eigen::Vector3d>& velocities() { return velocities_; }              ///< set initial motion
-  std::vector<Eigen::Vector3d>& positions() { return positions_; }                ///< set an initial shape
   const std::vector<double>& node_masses() const { return masses_; }              ///< lumped [kg]
   bool is_fixed(std::int32_t node) const { return free_index_[static_cast<std::size_t>(node)] < 0; }
   int free_dofs() const { return static_cast<int>(rhs_.size()); }
