@@ -34,8 +34,8 @@ std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3
 /// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once), which is
 /// refactored only when the iterations do not converge quickly. Fixed nodes are eliminated: they
 /// stay at their held position (the rest position unless moved with `hold`).
-/// Not thread-safe: one simulation thread owns it. Steps allocate nothing in the assembly; the
-/// factorisation may.
+/// Not thread-safe: one simulation thread owns it. Not real-time: the assembly writes into fixed
+/// slots, but Eigen's products, solves and factorisations may allocate.
 class CorotationalFem {
  public:
   /// A model of `mesh` (positively oriented tetrahedra of nonzero volume) with `fixed` nodes held.
