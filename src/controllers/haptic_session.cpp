@@ -47,6 +47,23 @@ Result<ObjectSurfaces> load_watched_surfaces(const Scene& scene) {
   return surfaces;
 }
 
+// The scene as the session runs it (the options' rates, margins and force options over the
+// scene's), checked as every scene is (uh::scene::validate): the session checks no field itself.
+Result<Scene> effective_scene(const Scene& scene, const SessionOptions& options) {
+  Scene s = scene;
+  s.haptic_hz = options.haptic_hz.value_or(scene.haptic_hz);
+  s.collision_hz = options.collision_hz.value_or(scene.collision_hz);
+  s.contact_margin = options.contact_margin.value_or(scene.contact_margin);
+  s.coherence_skin = options.coherence_skin.value_or(scene.coherence_skin);
+  if (options.multi_rate) s.force.multi_rate = *options.multi_rate;
+  if (options.tick_force) s.force.tick_force = *options.tick_force;
+  if (options.proxy) s.force.proxy.enabled = *options.proxy;
+  if (s.force.proxy.enabled) s.force.use_coupling = false;  // the proxy is the simulated tool
+  if (Status valid = uh::scene::validate(s); !valid)
+    return Error{fmt::format("{}: {}", scene.source, valid.error().message), ErrorKind::kInvalid};
+  return s;
+}
+
 }  // namespace
 
 // One tool: its device's manager (its own haptic loop and limit chain), its controllers, what
@@ -113,23 +130,14 @@ HapticSession::~HapticSession() {
 
 Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene, const SessionOptions& options,
                                                              const haptico::DeviceRegistry& registry) {
+  auto effective = effective_scene(scene, options);
+  if (!effective) return effective.error();
   std::unique_ptr<HapticSession> session(new HapticSession());
   session->scene_ = scene;
-  session->haptic_hz_ = options.haptic_hz.value_or(scene.haptic_hz);
-  session->collision_hz_ = options.collision_hz.value_or(scene.collision_hz);
-  if (!(session->haptic_hz_ > 0.0) || session->haptic_hz_ > 10000.0)
-    return Error{fmt::format("{}: haptic rate {} Hz is outside (0, 10000]", scene.source, session->haptic_hz_),
-                 ErrorKind::kInvalid};
-  if (session->collision_hz_ < 0.0 || session->collision_hz_ > 10000.0)
-    return Error{fmt::format("{}: collision rate {} Hz is outside [0, 10000]", scene.source, session->collision_hz_),
-                 ErrorKind::kInvalid};
-  if (scene.tools.empty()) return Error{fmt::format("{}: the scene has no tool", scene.source), ErrorKind::kInvalid};
-  ForceControllerOptions force_options = scene.force;
-  if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
-  if (options.tick_force) force_options.tick_force = *options.tick_force;
+  session->haptic_hz_ = effective->haptic_hz;
+  session->collision_hz_ = effective->collision_hz;
+  ForceControllerOptions force_options = effective->force;
   force_options.check_model = options.check_model;
-  if (options.proxy) force_options.proxy.enabled = *options.proxy;
-  if (force_options.proxy.enabled) force_options.use_coupling = false;  // the proxy is the simulated tool
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
 
@@ -159,9 +167,9 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       .raise_priority = options.raise_priority,
       // the proxy's constraints are the pairs within the margin: it may step no farther than that
       // (its mesh rows come with the pairs: docs/forcecomp.md, "Resting on the mesh")
-      .contact_margin = std::max(options.contact_margin.value_or(scene.contact_margin),
+      .contact_margin = std::max(effective->contact_margin,
                                  force_options.proxy.enabled ? force_options.proxy.step_m : 0.0),
-      .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
+      .coherence_skin = effective->coherence_skin});
   auto& world = *session->world_;
   std::vector<collette::ObjectId> object_ids;
   std::vector<double> object_coverages;
@@ -181,7 +189,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   // A tool against everything also meets the other tools: the force controller renders only its
   // watched objects, so tools pass through each other.
   const bool watch_all = scene.watch.size() == scene.objects.size() && !scene.objects.empty() &&
-                         !(options.coherence_skin.value_or(scene.coherence_skin) > 0.0);
+                         !(effective->coherence_skin > 0.0);
   const bool several = scene.tools.size() > 1;
   for (std::size_t t = 0; t < scene.tools.size(); ++t) {
     const SceneTool& tool = scene.tools[t];
