@@ -139,18 +139,9 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   ForceControllerOptions force_options = effective->force;
   force_options.check_model = options.check_model;
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
-  const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
-
-  // objects of one shape share its tree (a room repeats a few meshes): loaded once
-  std::map<std::tuple<std::string, std::string, std::int64_t, double, double>, ShapeTree> loaded;
-  const auto load_shared = [&](const SceneShape& shape) -> Result<ShapeTree> {
-    const auto key = std::make_tuple(shape.mesh.string(), shape.ist.string(), shape.spheres,
-                                     shape.meters_per_unit, shape.max_sphere_radius);
-    if (const auto it = loaded.find(key); it != loaded.end() && !shape.tree) return it->second;
-    auto tree = load_shape_tree(shape, cache, options.build_progress);
-    if (tree && !shape.tree) loaded.emplace(key, *tree);
-    return tree;
-  };
+  // objects of one shape share its tree (a room repeats a few meshes): the cache loads it once
+  collette::IstCache cache(options.cache_dir);
+  const auto load_shared = [&](const SceneShape& shape) { return tree_of(shape, cache, options.build_progress); };
   std::vector<ShapeTree> object_trees;
   for (const SceneObject& object : scene.objects) {
     auto tree = load_shared(object.shape);

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "uh/collette/ist_cache.hpp"
 #include "uh/collette/mesh_inside.hpp"
 #include "uh/collette/sphere_tree.hpp"
 #include "uh/controllers/force_controller.hpp"
@@ -31,21 +32,19 @@ using uh::scene::SceneShape;
 using uh::scene::SceneTool;
 using uh::scene::write_default_scene;
 
-/// Where built .ist files are cached: $UH_CACHE_DIR, else $XDG_CACHE_HOME/unrealhaptics, else
-/// (Windows) %LOCALAPPDATA%\unrealhaptics\cache, else ~/.cache/unrealhaptics, else a folder in the
-/// system temp directory.
+/// Where built .ist files are cached: collette::IstCache::default_dir().
 std::filesystem::path default_cache_dir();
 
 /// A shape's tree in metres with its packing's coverage (sphere volume / mesh volume, (0, 1]).
-struct ShapeTree {
-  std::shared_ptr<const collette::SphereTree> tree;
-  double coverage = 1.0;
-};
+using ShapeTree = collette::CachedTree;
 
-/// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the
-/// mesh file's hash and the sphere count), building and caching it on first use; the coverage
-/// comes from the .ist metadata (SceneShape::coverage for a tree in memory). `progress` gets
-/// the packing progress when a build is needed. Setup only.
+/// The shape's tree in metres: the tree in memory as it is (with SceneShape::coverage), else the
+/// .ist file's or the mesh's packing through `cache` (collette::IstCache: built and cached on
+/// first use; a cache shares one tree between the shapes that ask for the same). Setup only.
+Result<ShapeTree> tree_of(const SceneShape& shape, collette::IstCache& cache,
+                          const collette::IstCache::Progress& progress = {});
+
+/// tree_of() through a cache of `cache_dir` made for this call, for callers that load one tree.
 Result<ShapeTree> load_shape_tree(
     const SceneShape& shape, const std::filesystem::path& cache_dir,
     const std::function<void(const std::string& what, double fraction)>& progress = {});
