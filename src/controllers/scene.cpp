@@ -25,7 +25,7 @@ Result<ShapeTree> load_shape_tree(
 }
 
 Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape) {
-  if (shape.mesh.empty() || shape.tree) return std::shared_ptr<const collette::MeshInside>{};
+  if (shape.mesh.empty()) return std::shared_ptr<const collette::MeshInside>{};
   auto mesh = collette::load_mesh(shape.mesh);
   if (!mesh) return mesh.error();
   for (Vec3& v : mesh->vertices) v = v * shape.meters_per_unit;

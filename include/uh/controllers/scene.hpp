@@ -50,8 +50,8 @@ Result<ShapeTree> load_shape_tree(
     const std::function<void(const std::string& what, double fraction)>& progress = {});
 
 /// The shape's mesh surface in metres, for exact nearest-point queries (the proxy rests on it rather
-/// than on the packing's grain); null when the shape has no mesh file or comes as a tree (a .ist, a
-/// tree in memory, or one preloaded by `uh explore`: see docs/forcecomp.md, "Not yet").
+/// than on the packing's grain); null when the shape has no mesh file (a .ist file; a tree in memory
+/// without the mesh it was packed from).
 /// The mesh is read and validated as for packing. Setup only.
 Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape);
 
