@@ -11,8 +11,8 @@
 #include "commands.hpp"
 #include "progress_bar.hpp"
 #include "session_plot.hpp"
-#include "uh/controllers/exploration.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/exploration/exploration.hpp"
 
 namespace uh::cli {
 namespace {
@@ -39,7 +39,7 @@ std::string shown(const std::optional<double>& v, const char* format_unit) {
 int explore(const ExploreArgs& args) {
   auto scene = controllers::load_scene(args.scene);
   if (!scene) return fail(scene.error().message);
-  controllers::ExploreOptions options;
+  exploration::ExploreOptions options;
   options.seed = args.seed;
   if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
   options.ticks_per_collision_step = args.ticks_per_collision;
@@ -55,7 +55,7 @@ int explore(const ExploreArgs& args) {
     }
     bar->update(fraction);
   };
-  auto explored = controllers::explore_scene(*scene, args.object, options, session);
+  auto explored = exploration::explore_scene(*scene, args.object, options, session);
   bar.reset();
   if (!explored) return fail(explored.error().message);
   if (!args.plot.empty())

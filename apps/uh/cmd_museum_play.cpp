@@ -100,6 +100,78 @@ json verdict_json(const BlindVerdict& v) {
           {"evidence", evidence}};
 }
 
+// What the watcher saw of a round: its summary (as parsed and as the server wrote it) and how
+// many events of each kind there were. With `print`, each event's caption as it comes.
+struct WatchedRound {
+  std::optional<Summary> summary;
+  std::string summary_text;
+  json event_counts = json::object();
+};
+
+WatchedRound watch_round(museum_client::GameLink& watcher, const museum::Level& level, bool print) {
+  WatchedRound round;
+  const Welcome& welcome = watcher.welcome();
+  double time_left = level.rules.round_s;
+  museum_players::ViveView seen(level);  // the round as the watcher sees it: names the pieces in the lines
+  for (;;) {
+    auto note = museum_players::next_message(watcher);
+    if (!note) break;
+    if (const auto* s = std::get_if<Snapshot>(&note->message)) {
+      time_left = s->time_left_s;
+      seen.update(*s, welcome.targets);
+    }
+    if (const auto* e = std::get_if<GameEvent>(&note->message)) {
+      const std::string name = museum::to_string(e->event.type);
+      round.event_counts[name] = round.event_counts.value(name, 0) + 1;
+      if (e->event.type == museum::EventType::guard_heard) seen.heard(e->event);
+      if (print)
+        std::printf("[%s left] %s\n", clock_of(time_left).c_str(),
+                    museum::describe(e->event, level, seen.state()).caption.c_str());
+    }
+    if (const auto* s = std::get_if<Summary>(&note->message)) {
+      round.summary = *s;
+      round.summary_text = std::move(note->text);
+      break;
+    }
+    std::fflush(stdout);
+  }
+  return round;
+}
+
+void print_round_json(const MuseumPlayArgs& args, const WatchedRound& round, const std::vector<BlindVerdict>& verdicts,
+                      double wall_s) {
+  json out{{"level", args.level},
+           {"seed", args.seed},
+           {"speed", args.speed},
+           {"wall_s", wall_s},
+           {"summary", json::parse(round.summary_text, nullptr, false)},  // the link parsed it already
+           {"events", round.event_counts},
+           {"verdicts", json::array()}};
+  for (const BlindVerdict& v : verdicts) out["verdicts"].push_back(verdict_json(v));
+  std::printf("%s\n", out.dump(2).c_str());
+}
+
+void print_round(const Summary& summary, const std::vector<BlindVerdict>& verdicts, double wall_s) {
+  std::printf("uh museum play: the round ended%s after %.0f s of game time (%.0f s on the clock)\n",
+              summary.ended_early ? " early, every target settled," : "", summary.seconds_played, wall_s);
+  for (const museum_protocol::TargetView& t : summary.targets)
+    std::printf("  %-8s genuine: %-8s forgery: %s\n", t.kind.c_str(), t.genuine.c_str(), t.forgery.c_str());
+  for (const BlindVerdict& v : verdicts) {
+    const auto& e = v.judgement.evidence;
+    std::printf("  Phantom on the %s (item %d): %s, from %.0f s of touch%s\n", v.kind.c_str(), v.item,
+                museum_players::to_string(v.judgement.verdict), v.simulated_s,
+                e.empty() ? ""
+                          : fmt::format(" (most telling: {} {:.2f} {} against {:.2f})", e.front().feature,
+                                        e.front().difference, e.front().unit, e.front().threshold)
+                                .c_str());
+  }
+  std::printf(
+      "score %d: %d genuine kept, %d forgeries kept, %d genuine put aside, %d forgeries put aside, "
+      "time bonus %d; caught %d times\n",
+      summary.points, summary.genuine_kept, summary.forgeries_kept, summary.genuine_rejected,
+      summary.forgeries_rejected, summary.time_bonus, summary.times_caught);
+}
+
 int museum_play_bots(const MuseumPlayArgs& args) {
   museum::Level level =
       museum::make_level(args.level == "hard" ? museum::Difficulty::hard : museum::Difficulty::easy);
@@ -123,7 +195,6 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   const std::string url = fmt::format("ws://127.0.0.1:{}/ws", port);
   auto watcher = museum_players::join_as_bot(url, "watcher");
   if (!watcher) return fail(watcher.error().message);
-  const Welcome& welcome = (*watcher)->welcome();
 
   std::vector<BlindVerdict> verdicts;
   std::mutex verdicts_mutex;
@@ -142,71 +213,19 @@ int museum_play_bots(const MuseumPlayArgs& args) {
   std::thread vive([&] { run_bot("vive"); });
   std::thread phantom([&] { run_bot("phantom"); });
 
-  std::optional<Summary> summary;
-  std::string summary_text;  // the summary as the server wrote it, for --json
-  json event_counts = json::object();
-  double time_left = level.rules.round_s;
-  museum_players::ViveView seen(level);  // the round as the watcher sees it: names the pieces in the lines
-  for (;;) {
-    auto note = museum_players::next_message(**watcher);
-    if (!note) break;
-    if (const auto* s = std::get_if<Snapshot>(&note->message)) {
-      time_left = s->time_left_s;
-      seen.update(*s, welcome.targets);
-    }
-    if (const auto* e = std::get_if<GameEvent>(&note->message)) {
-      const std::string name = museum::to_string(e->event.type);
-      event_counts[name] = event_counts.value(name, 0) + 1;
-      if (e->event.type == museum::EventType::guard_heard) seen.heard(e->event);
-      if (!args.json)
-        std::printf("[%s left] %s\n", clock_of(time_left).c_str(),
-                    museum::describe(e->event, level, seen.state()).caption.c_str());
-    }
-    if (const auto* s = std::get_if<Summary>(&note->message)) {
-      summary = *s;
-      summary_text = std::move(note->text);
-      break;
-    }
-    std::fflush(stdout);
-  }
+  const WatchedRound round = watch_round(**watcher, level, !args.json);
   vive.join();
   phantom.join();
   (*watcher)->stop();
   (*server)->stop();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!failure.empty()) return fail(failure);
-  if (!summary) return fail("the round did not end: the server closed the connection first");
+  if (!round.summary) return fail("the round did not end: the server closed the connection first");
 
-  if (args.json) {
-    json out{{"level", args.level},
-             {"seed", args.seed},
-             {"speed", args.speed},
-             {"wall_s", wall_s},
-             {"summary", json::parse(summary_text, nullptr, false)},  // the link parsed it already
-             {"events", event_counts},
-             {"verdicts", json::array()}};
-    for (const BlindVerdict& v : verdicts) out["verdicts"].push_back(verdict_json(v));
-    std::printf("%s\n", out.dump(2).c_str());
-    return 0;
-  }
-  std::printf("uh museum play: the round ended%s after %.0f s of game time (%.0f s on the clock)\n",
-              summary->ended_early ? " early, every target settled," : "", summary->seconds_played, wall_s);
-  for (const museum_protocol::TargetView& t : summary->targets)
-    std::printf("  %-8s genuine: %-8s forgery: %s\n", t.kind.c_str(), t.genuine.c_str(), t.forgery.c_str());
-  for (const BlindVerdict& v : verdicts) {
-    const auto& e = v.judgement.evidence;
-    std::printf("  Phantom on the %s (item %d): %s, from %.0f s of touch%s\n", v.kind.c_str(), v.item,
-                museum_players::to_string(v.judgement.verdict), v.simulated_s,
-                e.empty() ? ""
-                          : fmt::format(" (most telling: {} {:.2f} {} against {:.2f})", e.front().feature,
-                                        e.front().difference, e.front().unit, e.front().threshold)
-                                .c_str());
-  }
-  std::printf(
-      "score %d: %d genuine kept, %d forgeries kept, %d genuine put aside, %d forgeries put aside, "
-      "time bonus %d; caught %d times\n",
-      summary->points, summary->genuine_kept, summary->forgeries_kept, summary->genuine_rejected,
-      summary->forgeries_rejected, summary->time_bonus, summary->times_caught);
+  if (args.json)
+    print_round_json(args, round, verdicts, wall_s);
+  else
+    print_round(*round.summary, verdicts, wall_s);
   return 0;
 }
 

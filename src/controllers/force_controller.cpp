@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "uh/core/atomic_max.hpp"
+
 namespace uh::controllers {
 namespace {
 
@@ -37,10 +39,6 @@ void add(forcecomp::Wrench& sum, const forcecomp::Wrench& w) {
   sum.torque += w.torque;
 }
 
-// Raises an atomic maximum written by one thread (the haptic thread) and read by others.
-void raise_max(std::atomic<double>& max, double value) {
-  if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
-}
 
 }  // namespace
 
@@ -304,15 +302,18 @@ void ForceController::take_frame(const ContactFrame& frame, const Pose& world_fr
   }
 }
 
-void ForceController::on_force(const haptico::DeviceState& state, haptico::DeviceCommand& command) {
-  const double now = manager_ != nullptr ? manager_->tick_time_s() : state.time_s;
-  // a late tick must not make the proxy integration take one huge step (it would go unstable):
-  // integrate at most two nominal periods per tick
+// The period the coupling integrates over this tick [s]: a late tick must not make the proxy
+// integration take one huge step (it would go unstable), so at most two nominal periods.
+double ForceController::tick_period(double now) {
   const double elapsed = have_last_tick_ ? std::max(0.0, now - last_tick_s_) : 0.0;
-  const double dt = std::min(elapsed, 2.0 * options_.coupling.period_s);
   last_tick_s_ = now;
   have_last_tick_ = true;
+  return std::min(elapsed, 2.0 * options_.coupling.period_s);
+}
 
+void ForceController::on_force(const haptico::DeviceState& state, haptico::DeviceCommand& command) {
+  const double now = manager_ != nullptr ? manager_->tick_time_s() : state.time_s;
+  const double dt = tick_period(now);
   const Pose world_from_handle_tool = mapping_.world_from_tool(state);
   if (options_.use_coupling && !proxy_placed_) {
     coupling_.reset(world_from_handle_tool);
@@ -330,13 +331,8 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   const Pose world_from_tool = options_.use_coupling ? coupling_.world_from_proxy() : world_from_handle_tool;
   const forcecomp::BodyMotion tool_motion =
       component_.body_motion(world_from_tool, handle_velocity, handle_angular_velocity);
-
-  forcecomp::Wrench contact{};
-  std::int32_t pairs = 0;
-  double oldest_data_s = now;
+  TickSum sum{.oldest_data_s = now};
   const bool model = uses_model();
-  Vec3 exact_force{};  // check_model: the exact re-evaluation's force, beside the model's
-  std::uint64_t clamped = 0, held = 0;
   if ((!model || options_.check_model) && world_ != nullptr) {
     // the previous frames' slots go back to the collision thread: hold the new ones where they lie
     for (const collette::WatcherId watcher : watchers_)
@@ -344,106 +340,121 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
         take_frame(*frame, world_from_tool, tool_motion);
   }
   for (auto& w : watched_) {
-    if (model) {
-      if (w->models.update()) {
-        const FrameModels& f = w->models.read_buffer();
-        const forcecomp::WrenchModel& m = f.whole;
-        frames_received_.fetch_add(1, std::memory_order_relaxed);
-        w->renderer.take(m);
-        if (m.contact) w->world_from_object = m.world_from_other;
-        if (m.contact && w->has_surface) {
-          FrameContact found[forcecomp::kMaxContactPatches];
-          for (std::int32_t i = 0; i < f.patches.count; ++i) {
-            const forcecomp::WrenchModel& p = f.patch_models[i];
-            found[i] = {p.world_from_tool,       p.world_from_other, p.volume_centroid_world,
-                        p.volume_gradient_world, p.total_volume,     f.patches.patch[i].link};
-          }
-          take_patches(*w, {found, static_cast<std::size_t>(f.patches.count)}, world_from_tool);
-          w->modelled_patches = f.patches.count;
-          // one patch is the whole model, which w->renderer renders already
-          if (f.patches.count > 1)
-            for (PatchStage& s : w->stages)
-              if (s.live) s.renderer.take(f.patch_models[s.index]);
-        } else if (w->has_surface) {
-          w->modelled_patches = 0;
-          end_patches(*w);
-        }
-      }
-      if (options_.check_model && !w->held.empty())
-        exact_force += w->component
-                           .evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
-                                     w->coverage_product)
-                           .wrench.force;
-      clamped += w->renderer.clamped_ticks();
-      held += w->renderer.held_ticks();
-      if (!w->renderer.active(now)) continue;
-      const forcecomp::Wrench r = w->renderer.render(now, world_from_tool.rotation, tool_motion);
-      const forcecomp::WrenchModel& m = w->renderer.model();
-      contact.force += r.force;
-      contact.torque += r.torque;
-      // a patch's penalty: its own model's, or, for one patch, the whole one just rendered (as on
-      // the held paths below)
-      if (m.contact && w->has_surface)
-        for (PatchStage& s : w->stages)
-          if (s.live)
-            add(contact, add_surface(*w, s,
-                                     w->modelled_patches > 1
-                                         ? s.renderer.render(now, world_from_tool.rotation, tool_motion)
-                                         : r,
-                                     world_from_tool, tool_motion));
-      pairs += m.pair_count;
-      if (m.contact) oldest_data_s = std::min(oldest_data_s, m.time_s);
-      continue;
-    }
-    if (w->held.empty()) continue;
-    oldest_data_s = std::min(oldest_data_s, w->held.time_s());
-    forcecomp::Wrench penalty = w->held_wrench;
-    if (options_.multi_rate) {
-      const auto r = w->component.evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
-                                           w->coverage_product);
-      penalty = r.wrench;
-      pairs += r.pair_count;
-    } else {
-      pairs += w->held_pairs;
-    }
-    add(contact, penalty);
-    if (!w->has_surface) continue;
-    const bool one = w->held_patches.count <= 1;
-    for (PatchStage& s : w->stages) {
-      if (!s.live) continue;
-      // a patch's penalty: the pairs of the patch re-evaluated (or held); one patch is the whole
-      const forcecomp::Wrench patch =
-          one || !options_.multi_rate
-              ? (one ? penalty : s.held_wrench)
-              : w->component
-                    .evaluate(w->held, w->world_from_object, world_from_tool, tool_motion, {},
-                              w->coverage_product, {&w->held_patches, s.index})
-                    .wrench;
-      add(contact, add_surface(*w, s, patch, world_from_tool, tool_motion));
-    }
+    if (model)
+      add_modelled(*w, now, world_from_tool, tool_motion, sum);
+    else
+      add_held(*w, world_from_tool, tool_motion, sum);
   }
+  if (model) record_model_check(sum);
 
-  if (model) {
-    model_clamped_ticks_.store(clamped, std::memory_order_relaxed);
-    model_held_ticks_.store(held, std::memory_order_relaxed);
-    if (options_.check_model) {
-      const double error = norm(contact.force - exact_force);
-      model_checked_ticks_.fetch_add(1, std::memory_order_relaxed);
-      model_error_sum_sq_.store(model_error_sum_sq_.load(std::memory_order_relaxed) + error * error,
-                                std::memory_order_relaxed);
-      raise_max(model_error_max_n_, error);
-    }
-  }
-
-  forcecomp::Wrench to_device = contact;
+  forcecomp::Wrench to_device = sum.contact;
   if (options_.use_coupling) {
     // the coupling takes the contact torque about the proxy's origin, the penalty gives it about the CoM
-    forcecomp::Wrench on_proxy = contact;
-    on_proxy.torque += cross(tool_motion.center_of_mass_world - world_from_tool.position, contact.force);
+    forcecomp::Wrench on_proxy = sum.contact;
+    on_proxy.torque += cross(tool_motion.center_of_mass_world - world_from_tool.position, sum.contact.force);
     to_device = coupling_.step(world_from_handle_tool, handle_velocity, handle_angular_velocity, on_proxy, dt)
                     .device_wrench;
   }
-  finish_tick(contact, to_device, now, oldest_data_s, pairs, command);
+  finish_tick(sum.contact, to_device, now, sum.oldest_data_s, sum.pairs, command);
+}
+
+// kModel: the newest model the collision thread published for `w`, with its patches' (the
+// friction and texture stages follow the patches it found)
+void ForceController::take_model(Watched& w, const Pose& world_from_tool) {
+  const FrameModels& f = w.models.read_buffer();
+  const forcecomp::WrenchModel& m = f.whole;
+  frames_received_.fetch_add(1, std::memory_order_relaxed);
+  w.renderer.take(m);
+  if (m.contact) w.world_from_object = m.world_from_other;
+  if (!w.has_surface) return;
+  if (!m.contact) {
+    w.modelled_patches = 0;
+    end_patches(w);
+    return;
+  }
+  FrameContact found[forcecomp::kMaxContactPatches];
+  for (std::int32_t i = 0; i < f.patches.count; ++i) {
+    const forcecomp::WrenchModel& p = f.patch_models[i];
+    found[i] = {p.world_from_tool,       p.world_from_other, p.volume_centroid_world,
+                p.volume_gradient_world, p.total_volume,     f.patches.patch[i].link};
+  }
+  take_patches(w, {found, static_cast<std::size_t>(f.patches.count)}, world_from_tool);
+  w.modelled_patches = f.patches.count;
+  // one patch is the whole model, which w.renderer renders already
+  if (f.patches.count > 1)
+    for (PatchStage& s : w.stages)
+      if (s.live) s.renderer.take(f.patch_models[s.index]);
+}
+
+// kModel: `w`'s force from its local model at `now`, with its patches' surface stages
+void ForceController::add_modelled(Watched& w, double now, const Pose& world_from_tool,
+                                   const forcecomp::BodyMotion& tool_motion, TickSum& sum) {
+  if (w.models.update()) take_model(w, world_from_tool);
+  if (options_.check_model && !w.held.empty())
+    sum.exact_force +=
+        w.component.evaluate(w.held, w.world_from_object, world_from_tool, tool_motion, {}, w.coverage_product)
+            .wrench.force;
+  sum.clamped += w.renderer.clamped_ticks();
+  sum.held += w.renderer.held_ticks();
+  if (!w.renderer.active(now)) return;
+  const forcecomp::Wrench r = w.renderer.render(now, world_from_tool.rotation, tool_motion);
+  const forcecomp::WrenchModel& m = w.renderer.model();
+  add(sum.contact, r);
+  // a patch's penalty: its own model's, or, for one patch, the whole one just rendered (as on the
+  // held path)
+  if (m.contact && w.has_surface)
+    for (PatchStage& s : w.stages)
+      if (s.live)
+        add(sum.contact,
+            add_surface(w, s,
+                        w.modelled_patches > 1 ? s.renderer.render(now, world_from_tool.rotation, tool_motion) : r,
+                        world_from_tool, tool_motion));
+  sum.pairs += m.pair_count;
+  if (m.contact) sum.oldest_data_s = std::min(sum.oldest_data_s, m.time_s);
+}
+
+// Held frames: `w`'s pairs re-evaluated at the tool's pose this tick (multi_rate) or the frame's
+// force held, with its patches' surface stages
+void ForceController::add_held(Watched& w, const Pose& world_from_tool, const forcecomp::BodyMotion& tool_motion,
+                               TickSum& sum) {
+  if (w.held.empty()) return;
+  sum.oldest_data_s = std::min(sum.oldest_data_s, w.held.time_s());
+  forcecomp::Wrench penalty = w.held_wrench;
+  if (options_.multi_rate) {
+    const auto r =
+        w.component.evaluate(w.held, w.world_from_object, world_from_tool, tool_motion, {}, w.coverage_product);
+    penalty = r.wrench;
+    sum.pairs += r.pair_count;
+  } else {
+    sum.pairs += w.held_pairs;
+  }
+  add(sum.contact, penalty);
+  if (!w.has_surface) return;
+  const bool one = w.held_patches.count <= 1;
+  for (PatchStage& s : w.stages) {
+    if (!s.live) continue;
+    // a patch's penalty: the pairs of the patch re-evaluated (or held); one patch is the whole
+    const forcecomp::Wrench patch =
+        one || !options_.multi_rate
+            ? (one ? penalty : s.held_wrench)
+            : w.component
+                  .evaluate(w.held, w.world_from_object, world_from_tool, tool_motion, {}, w.coverage_product,
+                            {&w.held_patches, s.index})
+                  .wrench;
+    add(sum.contact, add_surface(w, s, patch, world_from_tool, tool_motion));
+  }
+}
+
+// kModel: the tick's model statistics, and with check_model its error against the exact force
+void ForceController::record_model_check(const TickSum& sum) {
+  model_clamped_ticks_.store(sum.clamped, std::memory_order_relaxed);
+  model_held_ticks_.store(sum.held, std::memory_order_relaxed);
+  if (!options_.check_model) return;
+  const double error = norm(sum.contact.force - sum.exact_force);
+  model_checked_ticks_.fetch_add(1, std::memory_order_relaxed);
+  model_error_sum_sq_.store(model_error_sum_sq_.load(std::memory_order_relaxed) + error * error,
+                            std::memory_order_relaxed);
+  raise_max(model_error_max_n_, error);
 }
 
 forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s,
@@ -461,8 +472,13 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
   holding = proxy_state_.active;
   const Pose proxy = proxy_->slide(proxy_state_, world_from_handle_tool);
   rendered_proxy_ = proxy;
+  // the spring of the contact holding it (kept after release, so the spring does not stiffen
+  // while the proxy catches up with the handle), never stiffer than the passivity-clamped coupling
+  if (proxy_state_.active > 0 && proxy_state_.stiffness_n_m > 0.0) contact_spring_n_m_ = proxy_state_.stiffness_n_m;
+  const double spring = contact_spring_n_m_ > 0.0 ? std::min(coupling_.stiffness(), contact_spring_n_m_)
+                                                  : coupling_.stiffness();
   forcecomp::Wrench w;
-  w.force = coupling_.stiffness() * (proxy.position - world_from_handle_tool.position);
+  w.force = spring * (proxy.position - world_from_handle_tool.position);
   if (component_.options().mode == forcecomp::ForceMode::k6Dof)
     w.torque = coupling_.angular_stiffness() *
                forcecomp::rotation_vector(proxy.rotation * conjugate(world_from_handle_tool.rotation));

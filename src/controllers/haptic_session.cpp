@@ -6,6 +6,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <map>
+#include <numbers>
 #include <thread>
 #include <tuple>
 
@@ -22,6 +23,17 @@ double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// The spring the proxy renders on a contact of `material` [N/m]: the gradient law's spring of a
+// round tip, 2 pi r k (docs/scenes.md, `stiffness`), r the tool's largest inner sphere (the tip of a
+// ball tool, the shaft of a stylus). 0 under the paper law, whose eps_c is no spring: the coupling's.
+double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::ContactMaterial& material,
+                        const collette::SphereTree& tool_tree) {
+  if (force.law != forcecomp::ForceLaw::kGradient) return 0.0;
+  double radius = 0.0;
+  for (const auto& leaf : tool_tree.leaves()) radius = std::max(radius, static_cast<double>(leaf.radius));
+  return 2.0 * std::numbers::pi * radius * material.stiffness;
+}
+
 // The scene as the session runs it: the options' rates, margins and force options over the
 // scene's (compile() then checks it as every scene is checked).
 Scene effective_scene(const Scene& scene, const SessionOptions& options) {
@@ -32,7 +44,10 @@ Scene effective_scene(const Scene& scene, const SessionOptions& options) {
   s.coherence_skin = options.coherence_skin.value_or(scene.coherence_skin);
   if (options.multi_rate) s.force.multi_rate = *options.multi_rate;
   if (options.tick_force) s.force.tick_force = *options.tick_force;
-  if (options.proxy) s.force.proxy.enabled = *options.proxy;
+  if (options.proxy)
+    s.force.proxy.enabled = *options.proxy;
+  else if (s.force.use_coupling)
+    s.force.proxy.enabled = false;  // the proxy is the default, the coupling a choice: it wins
   if (s.force.proxy.enabled) s.force.use_coupling = false;  // the proxy is the simulated tool
   s.force.check_model = options.check_model;
   return s;
@@ -124,6 +139,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(std::shared_ptr<con
     if (Status s = session->add_tool(t, options, registry); !s) return s.error();
   HapticSession& self = *session;
   self.collision_connection_ = self.world_->on_collision().connect<&HapticSession::on_collision>(self);
+  self.step_connection_ = self.world_->on_step().connect<&HapticSession::on_step>(self);  // after the proxies'
   self.report_.scene = self.model_->scene.name;
   return session;
 }
@@ -243,6 +259,7 @@ Status HapticSession::wire_controllers(ToolRig& rig) {
     if (rig.proxy)
       rig.proxy->watch(object_ids_[i], {.friction_static = material.friction_static,
                                         .friction_dynamic = material.friction_dynamic,
+                                        .stiffness_n_m = proxy_spring_n_m(tool.force, material, *model_->tools[t].tree),
                                         .object_texture = material.object_texture,
                                         .tool_texture = material.tool_texture,
                                         .surface = model_->objects[i].surface});
@@ -297,7 +314,7 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   ToolRig* rig = nullptr;
   for (auto& r : rigs_)
     if (r->tool_id == b) rig = r.get();
-  if (rig == nullptr) return;
+  if (rig == nullptr || rig->proxy) return;  // a proxy's contacts are its constraints' (on_step)
   auto& touching = rig->touching;
   if (a != ContactFrame::kEveryObject) {
     if (a < 0 || static_cast<std::size_t>(a) >= touching.size()) return;
@@ -317,6 +334,19 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   }
   for (std::size_t i = 0; i < touching.size(); ++i)
     if (now[i] == 0) contact_edge(*rig, static_cast<collette::ObjectId>(i), false, frame.time_s, 0.0, 0);
+}
+
+void HapticSession::on_step(double time_s) {
+  // collision thread, after every proxy's own step: through a proxy the tool rests on the surface
+  // (on the mesh, above the spheres), so its contact is its constraint rows in contact, not overlap
+  for (auto& rig : rigs_) {
+    if (!rig->proxy) continue;
+    const ToolProxy& proxy = *rig->proxy;
+    for (std::size_t k = 0; k < proxy.watched_count(); ++k) {
+      const std::int32_t rows = proxy.contact_rows(k);
+      contact_edge(*rig, proxy.watched_object(k), rows > 0, time_s, 0.0, rows);
+    }
+  }
 }
 
 void HapticSession::contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s,

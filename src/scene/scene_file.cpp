@@ -315,7 +315,11 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
     // saturated into the field's type (a cast of a value beyond it is undefined); validate() then
     // refuses what is outside the range
     x.max_constraints = static_cast<std::int32_t>(std::clamp(capacity, -2.0e9, 2.0e9));
+    // a file that asks for both names the clash (force.coupling alone turns the proxy off)
+    if (x.enabled && o.use_coupling && it->contains("enabled"))
+      return r.error(p, "the proxy and force.coupling (the simulated tool of the penalty path) exclude each other");
   }
+  if (o.use_coupling) o.proxy.enabled = false;  // the proxy is the default, the coupling a choice
   return Ok{};
 }
 

@@ -170,6 +170,21 @@ class ForceController {
     }
   };
   Watched* find_watched(collette::ObjectId object);
+  // one tick's sums over the watched objects (penalty paths)
+  struct TickSum {
+    forcecomp::Wrench contact{};
+    std::int32_t pairs = 0;
+    double oldest_data_s = 0.0;  // the oldest collision data the force used [s]
+    Vec3 exact_force{};          // check_model: the exact re-evaluation's force, beside the model's
+    std::uint64_t clamped = 0;   // kModel: the renderers' clamped and held ticks
+    std::uint64_t held = 0;
+  };
+  double tick_period(double now);
+  void take_model(Watched& w, const Pose& world_from_tool);
+  void add_modelled(Watched& w, double now, const Pose& world_from_tool, const forcecomp::BodyMotion& tool_motion,
+                    TickSum& sum);
+  void add_held(Watched& w, const Pose& world_from_tool, const forcecomp::BodyMotion& tool_motion, TickSum& sum);
+  void record_model_check(const TickSum& sum);
   // proxy mode: the spring between the handle and the proxy slid towards it; sets the data's time
   // and the constraints holding the proxy
   forcecomp::Wrench proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s, std::int32_t& holding);
@@ -197,6 +212,7 @@ class ForceController {
   ProxyState proxy_state_{};      // haptic thread: the newest proxy taken
   Pose rendered_proxy_{};         // haptic thread: it, slid towards the handle
   bool have_proxy_state_ = false;
+  double contact_spring_n_m_ = 0.0;  // haptic thread: the last holding contact's ProxyContact::stiffness_n_m
 
   // haptic thread state
   double last_tick_s_ = 0.0;

@@ -14,7 +14,10 @@ namespace uh::scene {
 
 /// Options of a ToolProxy (aggregate; scene field `force.proxy`, docs/scenes.md).
 struct ToolProxyOptions {
-  bool enabled = false;           ///< render through the proxy (the penalty path when false)
+  /// Render through the proxy, or the penalty path when false (the default until every shipped
+  /// scene's test passes on the proxy: docs/forcecomp.md, "Not yet"). A scene that enables
+  /// force.coupling gets the penalty path with the coupling unless it asks for the proxy too.
+  bool enabled = false;
   /// Most any point of the tool moves in one collision step [m] (a hand faster than step_m times
   /// the collision rate drags the proxy behind it). The world's contact margin is raised to it.
   double step_m = 0.002;
