@@ -72,26 +72,12 @@ Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh
         fmt::format("{}: give exactly one of shape.mesh_path, shape.ist_path, shape.tree or "
                     "shape.vertices with shape.indices (got {})",
                     what, sources)};
-  if (def.spheres <= 0 || def.spheres > 2'000'000)
-    return Error{fmt::format("{}: shape.spheres must be in [1, 2000000] (got {})", what, def.spheres)};
-  if (!(def.meters_per_unit > 0.0) || !std::isfinite(def.meters_per_unit))
-    return Error{
-        fmt::format("{}: shape.meters_per_unit must be positive (got {})", what, def.meters_per_unit)};
+  // the numbers and the files are the scene's to check (uh::scene::validate_shape, by the caller)
   controllers::SceneShape shape{.spheres = def.spheres, .meters_per_unit = def.meters_per_unit};
-  const auto existing_file = [&](const char* path, const char* field) -> Result<std::filesystem::path> {
-    std::filesystem::path p = std::filesystem::absolute(path);
-    if (!std::filesystem::exists(p))
-      return Error{fmt::format("{}: shape.{}: file not found: {}", what, field, p.string())};
-    return p;
-  };
   if (def.mesh_path != nullptr) {
-    auto p = existing_file(def.mesh_path, "mesh_path");
-    if (!p) return p.error();
-    shape.mesh = *p;
+    shape.mesh = std::filesystem::absolute(def.mesh_path);
   } else if (def.ist_path != nullptr) {
-    auto p = existing_file(def.ist_path, "ist_path");
-    if (!p) return p.error();
-    shape.ist = *p;
+    shape.ist = std::filesystem::absolute(def.ist_path);
   } else if (def.tree.bits != 0) {
     const auto box = tree_table().find(def.tree.bits);
     if (!box) return Error{fmt::format("{}: shape.tree is not a valid tree id", what)};
@@ -150,21 +136,9 @@ Result<controllers::SceneTool> tool_from_def(const std::string& what, const uh_t
   if (def.law != UH_FORCE_LAW_GRADIENT && def.law != UH_FORCE_LAW_PAPER)
     return invalid(
         fmt::format("{}: law {} is neither UH_FORCE_LAW_GRADIENT nor UH_FORCE_LAW_PAPER", what, def.law));
-  const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
-  const auto non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
-  if (!non_negative(def.stiffness) || !non_negative(def.force_scale) || !non_negative(def.damping) ||
-      !non_negative(def.damping_full_volume) || !positive(def.mass_kg) || !positive(def.max_force_n) ||
-      !positive(def.max_torque_nm) || !positive(def.workspace_scale))
-    return invalid(fmt::format(
-        "{}: stiffness, force_scale, damping and damping_full_volume must be >= 0; mass_kg, max_force_n, "
-        "max_torque_nm and workspace_scale > 0 (all finite)",
-        what));
-  if (def.device_driver == nullptr || *def.device_driver == '\0')
-    return invalid(fmt::format("{}: device_driver is empty", what));
+  // the numbers' ranges are the scene's to check (uh::scene::validate_tool, by the caller)
   const Vec3 com{def.center_of_mass[0], def.center_of_mass[1], def.center_of_mass[2]};
-  if (!is_finite(com)) return invalid(fmt::format("{}: center_of_mass is not finite", what));
   const Vec3 tool_offset{def.tool_offset[0], def.tool_offset[1], def.tool_offset[2]};
-  if (!is_finite(tool_offset)) return invalid(fmt::format("{}: tool_offset is not finite", what));
   auto shape = shape_from_def(what, def.shape);
   if (!shape) return shape.error();
   auto workspace = pose_from_arrays(def.workspace_offset, def.workspace_rotation);
@@ -188,7 +162,8 @@ Result<controllers::SceneTool> tool_from_def(const std::string& what, const uh_t
       .damping_full_volume = def.damping_full_volume,
       .max_force_n = def.max_force_n,
       .max_torque_nm = def.max_torque_nm};
-  tool.device = {.driver = def.device_driver, .config = std::move(config).value()};
+  tool.device = {.driver = def.device_driver != nullptr ? def.device_driver : "",
+                 .config = std::move(config).value()};
   tool.workspace = {.world_from_device_base = *workspace,
                     .scale = def.workspace_scale,
                     .handle_from_tool = Pose{Quat{}, tool_offset}};
@@ -203,6 +178,11 @@ uh_status read_tool(const char* fn, const uh_tool_def* def, const controllers::S
   if (auto s = read_def(fn, "def", def, d); s != UH_OK) return s;
   auto tool = tool_from_def(fmt::format("{}: tool", fn), d);
   if (!tool) return fail(tool.error(), UH_ERROR_INVALID_ARGUMENT);
+  // its place in the scene once it is in (`tool` while it is the only one)
+  const std::size_t count = std::max(scene.tools.size(), replaced + 1);
+  const std::string path = count > 1 ? fmt::format("tools[{}]", replaced) : std::string("tool");
+  if (Status valid = uh::scene::validate_tool(*tool, path); !valid)
+    return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", fn, valid.error().message));
   for (std::size_t i = 0; i < scene.tools.size(); ++i)
     if (i != replaced && scene.tools[i].name == tool->name)
       return fail(UH_ERROR_INVALID_ARGUMENT,
@@ -293,7 +273,10 @@ uh_status uh_scene_add_object(uh_scene_id scene, const uh_object_def* def, int32
     if (!pose) return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", what, pose.error().message));
     auto shape = shape_from_def(what, d.shape);
     if (!shape) return fail(shape.error(), UH_ERROR_INVALID_ARGUMENT);
-    sc.objects.push_back({.name = d.name, .shape = std::move(shape).value(), .pose = *pose});
+    controllers::SceneObject object{.name = d.name, .shape = std::move(shape).value(), .pose = *pose};
+    if (Status valid = uh::scene::validate_object(object, fmt::format("objects[{}]", sc.objects.size())); !valid)
+      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", what, valid.error().message));
+    sc.objects.push_back(std::move(object));
     if (d.watch != 0) sc.watch.push_back(d.name);
     if (out_index != nullptr) *out_index = static_cast<int32_t>(sc.objects.size() - 1);
     return UH_OK;
@@ -395,11 +378,8 @@ uh_status uh_scene_set_rates(uh_scene_id scene, double haptic_hz, double collisi
   return guarded(fn, [&]() -> uh_status {
     const auto box = scene_table().find(scene.bits);
     if (!box) return stale(fn, "scene");
-    if (!(haptic_hz >= 1.0 && haptic_hz <= 10000.0) || !(collision_hz >= 0.0 && collision_hz <= 10000.0))
-      return fail(
-          UH_ERROR_INVALID_ARGUMENT,
-          fmt::format("{}: haptic_hz must be in [1, 10000] and collision_hz in [0, 10000] (got {} and {})",
-                      fn, haptic_hz, collision_hz));
+    if (Status valid = uh::scene::validate_rates(haptic_hz, collision_hz); !valid)
+      return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", fn, valid.error().message));
     box->scene.haptic_hz = haptic_hz;
     box->scene.collision_hz = collision_hz;
     box->scene.force.coupling.period_s = 1.0 / haptic_hz;

@@ -34,29 +34,23 @@ double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::Co
   return 2.0 * std::numbers::pi * radius * material.stiffness;
 }
 
-// Per object of the scene: its mesh surface in metres when a tool watches it and it has a mesh
-// file (the proxy rests on it), else null. Objects of one mesh share it.
-using ObjectSurfaces = std::vector<std::shared_ptr<const collette::MeshInside>>;
-Result<ObjectSurfaces> load_watched_surfaces(const Scene& scene) {
-  ObjectSurfaces surfaces(scene.objects.size());
-  std::map<std::pair<std::string, double>, std::shared_ptr<const collette::MeshInside>> by_mesh;
-  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-    const SceneObject& object = scene.objects[i];
-    if (std::find(scene.watch.begin(), scene.watch.end(), object.name) == scene.watch.end()) continue;
-    const auto key = std::make_pair(object.shape.mesh.string(), object.shape.meters_per_unit);
-    if (object.shape.mesh.empty() || object.shape.tree) continue;
-    if (const auto it = by_mesh.find(key); it != by_mesh.end()) {
-      surfaces[i] = it->second;
-      continue;
-    }
-    auto surface = load_shape_surface(object.shape);
-    if (!surface)
-      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, surface.error().message),
-                   surface.error().kind};
-    surfaces[i] = *surface;
-    by_mesh.emplace(key, *surface);
-  }
-  return surfaces;
+// The scene as the session runs it: the options' rates, margins and force options over the
+// scene's (compile() then checks it as every scene is checked).
+Scene effective_scene(const Scene& scene, const SessionOptions& options) {
+  Scene s = scene;
+  s.haptic_hz = options.haptic_hz.value_or(scene.haptic_hz);
+  s.collision_hz = options.collision_hz.value_or(scene.collision_hz);
+  s.contact_margin = options.contact_margin.value_or(scene.contact_margin);
+  s.coherence_skin = options.coherence_skin.value_or(scene.coherence_skin);
+  if (options.multi_rate) s.force.multi_rate = *options.multi_rate;
+  if (options.tick_force) s.force.tick_force = *options.tick_force;
+  if (options.proxy)
+    s.force.proxy.enabled = *options.proxy;
+  else if (s.force.use_coupling)
+    s.force.proxy.enabled = false;  // the proxy is the default, the coupling a choice: it wins
+  if (s.force.proxy.enabled) s.force.use_coupling = false;  // the proxy is the simulated tool
+  s.force.check_model = options.check_model;
+  return s;
 }
 
 }  // namespace
@@ -125,70 +119,120 @@ HapticSession::~HapticSession() {
 
 Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene, const SessionOptions& options,
                                                              const haptico::DeviceRegistry& registry) {
-  std::unique_ptr<HapticSession> session(new HapticSession());
-  session->scene_ = scene;
-  session->haptic_hz_ = options.haptic_hz.value_or(scene.haptic_hz);
-  session->collision_hz_ = options.collision_hz.value_or(scene.collision_hz);
-  if (!(session->haptic_hz_ > 0.0) || session->haptic_hz_ > 10000.0)
-    return Error{fmt::format("{}: haptic rate {} Hz is outside (0, 10000]", scene.source, session->haptic_hz_),
-                 ErrorKind::kInvalid};
-  if (session->collision_hz_ < 0.0 || session->collision_hz_ > 10000.0)
-    return Error{fmt::format("{}: collision rate {} Hz is outside [0, 10000]", scene.source, session->collision_hz_),
-                 ErrorKind::kInvalid};
-  if (scene.tools.empty()) return Error{fmt::format("{}: the scene has no tool", scene.source), ErrorKind::kInvalid};
-  ForceControllerOptions force_options = scene.force;
-  if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
-  if (options.tick_force) force_options.tick_force = *options.tick_force;
-  force_options.check_model = options.check_model;
-  if (options.proxy)
-    force_options.proxy.enabled = *options.proxy;
-  else if (force_options.use_coupling)
-    force_options.proxy.enabled = false;  // the proxy is the default, the coupling a choice: it wins
-  if (force_options.proxy.enabled) force_options.use_coupling = false;  // the proxy is the simulated tool
-  force_options.coupling.period_s = 1.0 / session->haptic_hz_;
-  const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
+  collette::IstCache cache(options.cache_dir);
+  auto model = compile(effective_scene(scene, options), cache,
+                       {.surface_beside_given_tree = false, .progress = options.build_progress});
+  if (!model) return model.error();
+  return create(std::move(model).value(), {.raise_priority = options.raise_priority}, registry);
+}
 
-  // objects of one shape share its tree (a room repeats a few meshes): loaded once
-  std::map<std::tuple<std::string, std::string, std::int64_t, double, double>, ShapeTree> loaded;
-  const auto load_shared = [&](const SceneShape& shape) -> Result<ShapeTree> {
-    const auto key = std::make_tuple(shape.mesh.string(), shape.ist.string(), shape.spheres,
-                                     shape.meters_per_unit, shape.max_sphere_radius);
-    if (const auto it = loaded.find(key); it != loaded.end() && !shape.tree) return it->second;
-    auto tree = load_shape_tree(shape, cache, options.build_progress);
-    if (tree && !shape.tree) loaded.emplace(key, *tree);
-    return tree;
-  };
-  std::vector<ShapeTree> object_trees;
-  for (const SceneObject& object : scene.objects) {
-    auto tree = load_shared(object.shape);
-    if (!tree)
-      return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, tree.error().message),
-                   tree.error().kind};
-    object_trees.push_back(*tree);
-  }
-  Result<ObjectSurfaces> surfaces =
-      force_options.proxy.enabled ? load_watched_surfaces(scene) : ObjectSurfaces(scene.objects.size());
-  if (!surfaces) return surfaces.error();
-  session->world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
-      .rate_hz = session->collision_hz_,
+Result<std::unique_ptr<HapticSession>> HapticSession::create(std::shared_ptr<const SessionModel> model,
+                                                             const SessionRunOptions& options,
+                                                             const haptico::DeviceRegistry& registry) {
+  assert(model != nullptr && "uh::controllers::HapticSession::create(): no model");
+  std::unique_ptr<HapticSession> session(new HapticSession());
+  session->model_ = std::move(model);
+  session->haptic_hz_ = session->model_->scene.haptic_hz;
+  session->collision_hz_ = session->model_->scene.collision_hz;
+  if (Status s = session->add_objects(options); !s) return s.error();
+  for (std::size_t t = 0; t < session->model_->scene.tools.size(); ++t)
+    if (Status s = session->add_tool(t, options, registry); !s) return s.error();
+  HapticSession& self = *session;
+  self.collision_connection_ = self.world_->on_collision().connect<&HapticSession::on_collision>(self);
+  self.step_connection_ = self.world_->on_step().connect<&HapticSession::on_step>(self);  // after the proxies'
+  self.report_.scene = self.model_->scene.name;
+  return session;
+}
+
+Status HapticSession::add_objects(const SessionRunOptions& options) {
+  const Scene& scene = model_->scene;
+  world_ = std::make_unique<collette::CollisionWorld>(collette::CollisionWorldOptions{
+      .rate_hz = collision_hz_,
       .raise_priority = options.raise_priority,
       // the proxy's constraints are the pairs within the margin: it may step no farther than that
       // (its mesh rows come with the pairs: docs/forcecomp.md, "Resting on the mesh")
-      .contact_margin = std::max(options.contact_margin.value_or(scene.contact_margin),
-                                 force_options.proxy.enabled ? force_options.proxy.step_m : 0.0),
-      .coherence_skin = options.coherence_skin.value_or(scene.coherence_skin)});
-  auto& world = *session->world_;
-  std::vector<collette::ObjectId> object_ids;
-  std::vector<double> object_coverages;
+      .contact_margin = std::max(scene.contact_margin, scene.force.proxy.enabled ? scene.force.proxy.step_m : 0.0),
+      .coherence_skin = scene.coherence_skin});
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& object = scene.objects[i];
-    auto id = world.add_object({.tree = object_trees[i].tree,
-                                .world_from_object = object.pose,
-                                .coverage = object_trees[i].coverage,
-                                .name = object.name});
+    auto id = world_->add_object({.tree = model_->objects[i].tree,
+                                  .world_from_object = object.pose,
+                                  .coverage = model_->objects[i].coverage,
+                                  .name = object.name});
     if (!id) return id.error();
-    object_ids.push_back(*id);
-    object_coverages.push_back(object_trees[i].coverage);
+    object_ids_.push_back(*id);
+  }
+  return Ok{};
+}
+
+Status HapticSession::add_tool(std::size_t t, const SessionRunOptions& options,
+                               const haptico::DeviceRegistry& registry) {
+  const Scene& scene = model_->scene;
+  const SceneTool& tool = scene.tools[t];
+  auto rig = std::make_unique<ToolRig>();
+  rig->session = this;
+  rig->index = static_cast<std::int32_t>(t);
+  rig->path = uh::scene::tool_path(scene, t);
+  // the tool's pose comes from its device on its first haptic tick (BridgingController)
+  auto tool_id = world_->add_object({.tree = model_->tools[t].tree,
+                                     .has_initial_pose = false,
+                                     .coverage = model_->tools[t].coverage,
+                                     .name = tool.name});
+  if (!tool_id) return tool_id.error();
+  rig->tool_id = *tool_id;
+  if (Status s = open_device(*rig, options, registry); !s) return s;
+  if (Status s = wire_controllers(*rig); !s) return s;
+  ToolRig& r = *rig;
+  r.sent_connection = r.manager->sent_on_haptic_tick().connect<&ToolRig::on_tick_sent>(r);
+  r.touching.assign(scene.objects.size(), 0);
+  r.touching_now.assign(scene.objects.size(), 0);
+  r.report.tool = tool.name;
+  rigs_.push_back(std::move(rig));
+  return Ok{};
+}
+
+Status HapticSession::open_device(ToolRig& rig, const SessionRunOptions& options,
+                                  const haptico::DeviceRegistry& registry) {
+  const Scene& scene = model_->scene;
+  const SceneTool& tool = scene.tools[static_cast<std::size_t>(rig.index)];
+  // a simulated device advances its own time by one period per tick: it runs at the haptic rate
+  // unless the scene says otherwise (else a 4 kHz session would play its script four times too fast)
+  haptico::DeviceConfig device_config = tool.device.config;
+  if (tool.device.driver.rfind("sim-", 0) == 0 && !device_config.has("rate_hz"))
+    device_config.set("rate_hz", haptic_hz_);
+  auto device = registry.create(tool.device.driver, device_config);
+  if (!device)
+    return Error{fmt::format("{}: {}.device: {}", scene.source, rig.path, device.error().message),
+                 device.error().kind};
+  const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, haptic_hz_ * 0.5));
+  rig.manager = std::make_unique<haptico::HapticManager>(
+      std::move(device).value(),
+      haptico::HapticManagerOptions{.rate_hz = haptic_hz_,
+                                    .raise_priority = options.raise_priority,
+                                    .trace_capacity = trace_capacity,
+                                    .limits = {.tool = {.max_force_n = tool.force.max_force_n,
+                                                        .max_torque_nm = tool.force.max_torque_nm},
+                                               .safety = scene.safety_limits,
+                                               .rate = scene.rate_limit},
+                                    .fault_group = &fault_group_});
+  if (auto opened = rig.manager->open(); !opened)
+    return Error{fmt::format("{}: {}.device: {}", scene.source, rig.path, opened.error().message),
+                 opened.error().kind};
+  return Ok{};
+}
+
+Status HapticSession::wire_controllers(ToolRig& rig) {
+  const Scene& scene = model_->scene;
+  const std::size_t t = static_cast<std::size_t>(rig.index);
+  const SceneTool& tool = scene.tools[t];
+  const ForceControllerOptions& force_options = scene.force;
+  const forcecomp::ForceComponent component(
+      {.params = tool.force, .mode = tool.mode, .side = forcecomp::ContactSide::kB});
+  rig.force_controller = std::make_unique<ForceController>(rig.tool_id, component, tool.workspace, force_options);
+  if (force_options.proxy.enabled) {
+    rig.proxy = std::make_unique<ToolProxy>(*world_, rig.tool_id, *model_->tools[t].tree, force_options.proxy,
+                                            tool.mode == forcecomp::ForceMode::k6Dof);
+    rig.force_controller->render_through(rig.proxy.get());
   }
   // the tool is B of every watcher: the frames' forces push it out of the objects. Watching every
   // object is one watcher of the tool against everything (the broad phase picks the objects it
@@ -196,101 +240,36 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   // A tool against everything also meets the other tools: the force controller renders only its
   // watched objects, so tools pass through each other.
   const bool watch_all = scene.watch.size() == scene.objects.size() && !scene.objects.empty() &&
-                         !(options.coherence_skin.value_or(scene.coherence_skin) > 0.0);
-  const bool several = scene.tools.size() > 1;
-  for (std::size_t t = 0; t < scene.tools.size(); ++t) {
-    const SceneTool& tool = scene.tools[t];
-    auto rig = std::make_unique<ToolRig>();
-    rig->session = session.get();
-    rig->index = static_cast<std::int32_t>(t);
-    rig->path = several ? fmt::format("tools[{}]", t) : std::string("tool");
-    auto tool_tree = load_shared(tool.shape);
-    if (!tool_tree)
-      return Error{fmt::format("{}: tool '{}': {}", scene.source, tool.name, tool_tree.error().message),
-                   tool_tree.error().kind};
-    // the tool's pose comes from its device on its first haptic tick (BridgingController)
-    auto tool_id = world.add_object({.tree = tool_tree->tree,
-                                     .has_initial_pose = false,
-                                     .coverage = tool_tree->coverage,
-                                     .name = tool.name});
-    if (!tool_id) return tool_id.error();
-    rig->tool_id = *tool_id;
-
-    // a simulated device advances its own time by one period per tick: it runs at the haptic rate
-    // unless the scene says otherwise (else a 4 kHz session would play its script four times too fast)
-    haptico::DeviceConfig device_config = tool.device.config;
-    if (tool.device.driver.rfind("sim-", 0) == 0 && !device_config.has("rate_hz"))
-      device_config.set("rate_hz", session->haptic_hz_);
-    auto device = registry.create(tool.device.driver, device_config);
-    if (!device)
-      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, device.error().message),
-                   device.error().kind};
-    const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, session->haptic_hz_ * 0.5));
-    rig->manager = std::make_unique<haptico::HapticManager>(
-        std::move(device).value(),
-        haptico::HapticManagerOptions{.rate_hz = session->haptic_hz_,
-                                      .raise_priority = options.raise_priority,
-                                      .trace_capacity = trace_capacity,
-                                      .limits = {.tool = {.max_force_n = tool.force.max_force_n,
-                                                          .max_torque_nm = tool.force.max_torque_nm},
-                                                 .safety = scene.safety_limits,
-                                                 .rate = scene.rate_limit},
-                                      .fault_group = &session->fault_group_});
-    if (auto opened = rig->manager->open(); !opened)
-      return Error{fmt::format("{}: {}.device: {}", scene.source, rig->path, opened.error().message),
-                   opened.error().kind};
-
-    const forcecomp::ForceComponent component(
-        {.params = tool.force, .mode = tool.mode, .side = forcecomp::ContactSide::kB});
-    rig->force_controller =
-        std::make_unique<ForceController>(rig->tool_id, component, tool.workspace, force_options);
-    if (force_options.proxy.enabled) {
-      rig->proxy = std::make_unique<ToolProxy>(world, rig->tool_id, *tool_tree->tree, force_options.proxy,
-                                               tool.mode == forcecomp::ForceMode::k6Dof);
-      rig->force_controller->render_through(rig->proxy.get());
-    }
-    if (watch_all) {
-      auto w = world.add_tool_watcher(rig->tool_id);
-      if (!w) return w.error();
-      rig->force_controller->read_frames_of(*w);
-    }
-    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-      if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end())
-        continue;
-      if (!watch_all) {
-        auto w = world.add_collision_watcher(object_ids[i], rig->tool_id);
-        if (!w) return w.error();
-        rig->force_controller->read_frames_of(*w);
-      }
-      const forcecomp::ContactMaterial material =
-          forcecomp::combine_materials(scene.objects[i].material, tool.material, tool.force);
-      rig->force_controller->add_watched(object_ids[i], object_coverages[i] * tool_tree->coverage, &material);
-      if (rig->proxy)
-        rig->proxy->watch(object_ids[i], {.friction_static = material.friction_static,
-                                          .friction_dynamic = material.friction_dynamic,
-                                          .stiffness_n_m = proxy_spring_n_m(tool.force, material, *tool_tree->tree),
-                                          .object_texture = material.object_texture,
-                                          .tool_texture = material.tool_texture,
-                                          .surface = surfaces->at(i)});
-    }
-    if (rig->proxy) rig->proxy->bind();
-    rig->bridging_controller = std::make_unique<BridgingController>(world, rig->tool_id, tool.workspace,
-                                                                    rig->force_controller.get(), rig->proxy.get());
-    rig->bridging_controller->bind(*rig->manager);
-    rig->force_controller->bind(world, *rig->manager);
-    ToolRig& r = *rig;
-    r.sent_connection = r.manager->sent_on_haptic_tick().connect<&ToolRig::on_tick_sent>(r);
-    r.touching.assign(scene.objects.size(), 0);
-    r.touching_now.assign(scene.objects.size(), 0);
-    r.report.tool = tool.name;
-    session->rigs_.push_back(std::move(rig));
+                         !(scene.coherence_skin > 0.0);
+  if (watch_all) {
+    auto w = world_->add_tool_watcher(rig.tool_id);
+    if (!w) return w.error();
+    rig.force_controller->read_frames_of(*w);
   }
-  HapticSession& self = *session;
-  self.collision_connection_ = world.on_collision().connect<&HapticSession::on_collision>(self);
-  self.step_connection_ = world.on_step().connect<&HapticSession::on_step>(self);  // after the proxies'
-  self.object_ids_ = object_ids;
-  self.report_.scene = scene.name;
-  return session;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    if (std::find(scene.watch.begin(), scene.watch.end(), scene.objects[i].name) == scene.watch.end()) continue;
+    if (!watch_all) {
+      auto w = world_->add_collision_watcher(object_ids_[i], rig.tool_id);
+      if (!w) return w.error();
+      rig.force_controller->read_frames_of(*w);
+    }
+    const forcecomp::ContactMaterial& material = model_->materials[t][i];
+    rig.force_controller->add_watched(object_ids_[i], model_->objects[i].coverage * model_->tools[t].coverage,
+                                      &material);
+    if (rig.proxy)
+      rig.proxy->watch(object_ids_[i], {.friction_static = material.friction_static,
+                                        .friction_dynamic = material.friction_dynamic,
+                                        .stiffness_n_m = proxy_spring_n_m(tool.force, material, *model_->tools[t].tree),
+                                        .object_texture = material.object_texture,
+                                        .tool_texture = material.tool_texture,
+                                        .surface = model_->objects[i].surface});
+  }
+  if (rig.proxy) rig.proxy->bind();
+  rig.bridging_controller = std::make_unique<BridgingController>(*world_, rig.tool_id, tool.workspace,
+                                                                 rig.force_controller.get(), rig.proxy.get());
+  rig.bridging_controller->bind(*rig.manager);
+  rig.force_controller->bind(*world_, *rig.manager);
+  return Ok{};
 }
 
 DelegateSink<const SessionState&> HapticSession::on_haptic_tick(std::size_t tool) {
@@ -396,7 +375,7 @@ SessionState HapticSession::state(std::size_t tool) {
 Status HapticSession::set_object_pose(std::int32_t object, const Pose& world_from_object) {
   if (object < 0 || static_cast<std::size_t>(object) >= object_ids_.size())
     return Error{
-        fmt::format("{}: there is no object {} (the scene has {})", scene_.name, object, object_ids_.size())};
+        fmt::format("{}: there is no object {} (the scene has {})", model_->scene.name, object, object_ids_.size())};
   world_->set_pose(object_ids_[static_cast<std::size_t>(object)], world_from_object);
   return Ok{};
 }
@@ -486,7 +465,7 @@ Status HapticSession::start(std::ostream* trace) {
       for (std::size_t u = 0; u < t; ++u) rigs_[u]->manager->stop();
       world_->stop();
       if (rigs_.size() == 1) return started;
-      return Error{fmt::format("{}: {}.device: {}", scene_.source, rigs_[t]->path, started.error().message),
+      return Error{fmt::format("{}: {}.device: {}", model_->scene.source, rigs_[t]->path, started.error().message),
                    started.error().kind};
     }
   }
@@ -507,14 +486,14 @@ std::string HapticSession::tool_label(std::int32_t tool) const {
   // one-tool sessions say nothing more (their messages are as they always were)
   if (rigs_.size() == 1) return {};
   return fmt::format("{} '{}': ", rigs_[static_cast<std::size_t>(tool)]->path,
-                     scene_.tools[static_cast<std::size_t>(tool)].name);
+                     model_->scene.tools[static_cast<std::size_t>(tool)].name);
 }
 
 Status HapticSession::thread_error() const {
   // the first haptic thread that ended by a throw (the others were zeroed with it)
   for (const auto& rig : rigs_)
     if (Status s = rig->manager->thread_status(); !s)
-      return Error{fmt::format("{}: {}{}", scene_.source, tool_label(rig->index), s.error().message),
+      return Error{fmt::format("{}: {}{}", model_->scene.source, tool_label(rig->index), s.error().message),
                    s.error().kind};
   return Ok{};
 }
@@ -524,7 +503,7 @@ Status HapticSession::device_error() const {
   // message names the tool too
   for (const auto& rig : rigs_) {
     if (Status device = rig->manager->device_status(); !device)
-      return Error{fmt::format("{}: {}{}{}", scene_.source, tool_label(rig->index), device.error().message,
+      return Error{fmt::format("{}: {}{}{}", model_->scene.source, tool_label(rig->index), device.error().message,
                                rigs_.size() > 1 ? "; every device was sent zero force" : ""),
                    device.error().kind};
   }
@@ -646,7 +625,7 @@ void HapticSession::collect_report(double seconds, bool stepped) {
     t.haptic_target_hz = haptic_hz_;
     t.haptic_ticks = hs.ticks;
     const haptico::DeviceInfo& info = rig->manager->device_info();
-    t.device = {.driver = scene_.tools[static_cast<std::size_t>(rig->index)].device.driver,
+    t.device = {.driver = model_->scene.tools[static_cast<std::size_t>(rig->index)].device.driver,
                 .name = info.name,
                 .model = info.model,
                 .serial = info.serial,

@@ -8,7 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "uh/collette/ist_cache.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/controllers/session_model.hpp"
 #include "uh/core/least_squares.hpp"
 #include "uh/core/split_mix.hpp"
 #include "uh/core/statistics.hpp"
@@ -268,26 +270,28 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   if (!pad_tree) return pad_tree.error();
   const auto tip = std::make_shared<const collette::SphereTree>(std::move(*tool_tree));
   const auto pad = std::make_shared<const collette::SphereTree>(std::move(*pad_tree));
-  auto piece_tree = controllers::load_shape_tree(piece.shape, cache_dir);
-  if (!piece_tree) return Error{fmt::format("{}: {}", piece.name, piece_tree.error().message)};
-
   controllers::Scene scene;
   scene.name = "museum table";
   scene.source = "the museum's table";
   scene.objects = {piece};
-  scene.objects[0].shape.tree = piece_tree->tree;
-  scene.objects[0].shape.coverage = piece_tree->coverage;
   scene.tool().name = "stylus";
   scene.tool().shape.tree = tip;
   scene.tool().shape.coverage = 1.0;
   scene.watch = {piece.name};
   scene.haptic_hz = options.haptic_hz;
   scene.collision_hz = options.haptic_hz;
+  // the piece compiled once; each site's exploration reuses its tree
+  collette::IstCache cache(cache_dir);
+  auto model = controllers::compile(scene, cache);
+  if (!model) return Error{fmt::format("{}: {}", piece.name, model.error().message)};
+  const controllers::CompiledShape& piece_shape = (*model)->objects[0];
+  scene.objects[0].shape.tree = piece_shape.tree;
+  scene.objects[0].shape.coverage = piece_shape.coverage;
 
   controllers::SessionOptions session;
   session.cache_dir = cache_dir;
   PieceSurvey survey;
-  for (SurveySite& site : plan_survey(world_bounds(*piece_tree->tree, piece.pose), options)) {
+  for (SurveySite& site : plan_survey(world_bounds(*piece_shape.tree, piece.pose), options)) {
     site.options.max_seconds = std::max(1.0, options.max_piece_seconds - survey.simulated_s);
     scene.tool().shape.tree = site.pad ? pad : tip;
     auto explored = exploration::explore_scene(scene, piece.name, site.options, session);

@@ -5,7 +5,9 @@
 
 #include <fmt/format.h>
 
+#include "uh/collette/ist_cache.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/controllers/session_model.hpp"
 #include "uh/core/log.hpp"
 #include "uh/devices/device_probe.hpp"
 #include "uh/devices/hardware_drivers.hpp"
@@ -258,15 +260,6 @@ Status Station::load_piece(const InHand& h) {
     return Error{fmt::format("the server sent the form of a '{}' for a '{}'", h.form.kind, h.kind)};
   auto object = museum_artifacts::artifact_object(h.form, options_.cache_dir, h.kind, Pose{});
   if (!object) return object.error();
-  auto tree = controllers::load_shape_tree(object->shape, options_.cache_dir, options_.build_progress);
-  if (!tree) return tree.error();
-  // the highest point of the piece (a rim, a lid, the top of a slab)
-  Vec3 peak{};
-  for (const Sphere& s : tree->tree->leaves())
-    if (static_cast<double>(s.z + s.radius) > peak.z)
-      peak = {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z + s.radius)};
-  const double top = peak.z;
-
   const Sphere ball{0.f, 0.f, 0.f, static_cast<float>(kStylusRadiusM)};
   auto stylus = collette::build_sphere_tree(std::span<const Sphere>(&ball, 1));
   if (!stylus) return stylus.error();
@@ -275,8 +268,6 @@ Status Station::load_piece(const InHand& h) {
   scene.name = "museum station";
   scene.source = "Phantom's table";
   scene.objects = {*object};
-  scene.objects[0].shape.tree = tree->tree;
-  scene.objects[0].shape.coverage = tree->coverage;
   scene.tool().name = "stylus";
   scene.tool().shape.tree = std::make_shared<const collette::SphereTree>(std::move(*stylus));
   scene.tool().shape.coverage = 1.0;
@@ -285,17 +276,30 @@ Status Station::load_piece(const InHand& h) {
   scene.collision_hz = options_.haptic_hz;
   scene.tool().device.driver = device_driver_;
   scene.tool().device.config = device_config_;
+  collette::IstCache cache(options_.cache_dir);
+  auto compiled = controllers::compile(scene, cache, {.progress = options_.build_progress});
+  if (!compiled) return compiled.error();
+  std::shared_ptr<const controllers::SessionModel> model = *compiled;
+
+  // the highest point of the piece (a rim, a lid, the top of a slab)
+  Vec3 peak{};
+  for (const Sphere& s : model->objects[0].tree->leaves())
+    if (static_cast<double>(s.z + s.radius) > peak.z)
+      peak = {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z + s.radius)};
+  const double top = peak.z;
   if (device_driver_ == kSimulatedHand && !device_config_.has("target_start")) {
     // the simulated hand comes down onto the piece's highest point from over the middle, pressing
-    // in 4 mm, and back, again and again
-    scene.tool().device.config.set("target_start", Vec3{0.0, 0.0, top + kStylusRadiusM + 0.015});
-    scene.tool().device.config.set("target_end", Vec3{peak.x, peak.y, top + kStylusRadiusM - 0.004});
-    scene.tool().device.config.set("duration_s", 1.5);
-    scene.tool().device.config.set("bounce", 1.0);
+    // in 4 mm, and back, again and again: its script is the compiled piece's (a copy of the
+    // model, its trees and surface shared)
+    auto scripted = std::make_shared<controllers::SessionModel>(*model);
+    haptico::DeviceConfig& config = scripted->scene.tool().device.config;
+    config.set("target_start", Vec3{0.0, 0.0, top + kStylusRadiusM + 0.015});
+    config.set("target_end", Vec3{peak.x, peak.y, top + kStylusRadiusM - 0.004});
+    config.set("duration_s", 1.5);
+    config.set("bounce", 1.0);
+    model = std::move(scripted);
   }
-  controllers::SessionOptions session_options;
-  session_options.cache_dir = options_.cache_dir;
-  auto session = controllers::HapticSession::create(scene, session_options);
+  auto session = controllers::HapticSession::create(model);
   if (!session) return session.error();
   guide_ = std::make_unique<HomeGuide>(options_.home);
   guide_->set_home({0.0, 0.0, top + kHomeAboveTopM});

@@ -24,40 +24,14 @@
 #include "uh/forcecomp/virtual_coupling.hpp"
 #include "uh/forcecomp/wrench_model.hpp"
 #include "uh/haptico/haptic_manager.hpp"
+#include "uh/scene/force_options.hpp"
 
 namespace uh::controllers {
 
-/// How a multi-rate tick computes the contact wrench from the newest collision frame.
-enum class TickForce {
-  /// Default. The frame's local wrench model (forcecomp/wrench_model.hpp), built on the collision
-  /// thread, evaluated at the current pose in constant time and blended between frames.
-  kModel,
-  /// Every held sphere pair re-evaluated at the current pose (HeldContactSet): O(pairs) per tick,
-  /// the reference the model is measured against.
-  kExact,
-};
-
-/// Options of a ForceController (aggregate; designated initialisers).
-struct ForceControllerOptions {
-  /// Follow the tool between collision frames (multi-rate), as `tick_force` says. When false,
-  /// the force computed from the newest collision frame is held until the next frame.
-  bool multi_rate = true;
-  TickForce tick_force = TickForce::kModel;
-  forcecomp::WrenchModelOptions model{};  ///< trust range, fallback and blend of kModel
-  /// Measurement only: with kModel, also re-evaluate the held pairs every tick and record how far
-  /// the model's force is from it (ForceControllerStats::model_error_*). The tick is then O(pairs).
-  bool check_model = false;
-  /// NaN guard and contact-age watchdog applied before the command leaves the controller (the
-  /// limits are the haptic manager's limit chain, applied to the summed command).
-  forcecomp::ForceSafetyOptions safety{};
-  /// Optional spring-damper between the handle and a simulated tool (proxy).
-  bool use_coupling = false;
-  forcecomp::VirtualCouplingOptions coupling{};
-  /// The 6-DOF god-object (controllers/tool_proxy.hpp): when enabled, the device feels the spring
-  /// of `coupling` (its passivity-bounded stiffness) between the handle and the proxy instead of
-  /// the penalty forces, and the tool in the collision world is the proxy.
-  ToolProxyOptions proxy{};
-};
+/// How a tick computes the force, and the controller's options: described by the scene
+/// (uh/scene/force_options.hpp).
+using uh::scene::ForceControllerOptions;
+using uh::scene::TickForce;
 
 /// What the controller did so far; a snapshot, plain data.
 struct ForceControllerStats {

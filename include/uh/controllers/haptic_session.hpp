@@ -22,6 +22,7 @@
 #include "uh/controllers/bridging_controller.hpp"
 #include "uh/controllers/force_controller.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/controllers/session_model.hpp"
 #include "uh/core/delegator.hpp"
 #include "uh/core/event_counter.hpp"
 #include "uh/core/latest_value.hpp"
@@ -32,6 +33,11 @@
 #include "uh/haptico/haptic_manager.hpp"
 
 namespace uh::controllers {
+
+/// What a session of a compiled model does beyond its model (aggregate).
+struct SessionRunOptions {
+  bool raise_priority = false;  ///< ask for SCHED_FIFO for the haptic (80) and collision (70) threads
+};
 
 /// Overrides of the scene for one session (aggregate; unset fields keep the scene's value).
 struct SessionOptions {
@@ -181,13 +187,19 @@ struct ContactEvent {
 
 class HapticSession {
  public:
-  /// Builds everything a scene needs (loads or builds the sphere trees, creates and opens each
-  /// tool's device through the registry), without starting threads. Errors name the scene and
-  /// the part. Each tool gets its own HapticManager (its own haptic loop, limit chain and device
-  /// limits); the tools share the collision world and its thread, and one FaultGroup: a fault of
-  /// any device zeroes every device's force.
+  /// compile() then create(model, ...): the scene with the options' overrides, its trees through
+  /// a cache of `options.cache_dir`, for callers that create one session of a scene.
   static Result<std::unique_ptr<HapticSession>> create(
       const Scene& scene, const SessionOptions& options = {},
+      const haptico::DeviceRegistry& registry = devices::all_drivers());
+  /// A session of a compiled model (compile(), session_model.hpp), which it shares read-only: a
+  /// program that creates many sessions of one scene compiles it once. Loads nothing: creates
+  /// the collision world and opens each tool's device through the registry, without starting
+  /// threads. Errors name the scene and the part. Each tool gets its own HapticManager (its own
+  /// haptic loop, limit chain and device limits); the tools share the collision world and its
+  /// thread, and one FaultGroup: a fault of any device zeroes every device's force.
+  static Result<std::unique_ptr<HapticSession>> create(
+      std::shared_ptr<const SessionModel> model, const SessionRunOptions& options = {},
       const haptico::DeviceRegistry& registry = devices::all_drivers());
   ~HapticSession();
   HapticSession(const HapticSession&) = delete;
@@ -265,7 +277,9 @@ class HapticSession {
 
   /// The report of the run (complete after stop() or run_stepped()).
   const SessionReport& report() const { return report_; }
-  const Scene& scene() const { return scene_; }
+  /// The scene the session runs (the model's: with the options' overrides when created from a scene).
+  const Scene& scene() const { return model_->scene; }
+  const SessionModel& model() const { return *model_; }
   const collette::CollisionWorld& world() const { return *world_; }
 
  private:
@@ -273,6 +287,11 @@ class HapticSession {
   struct ToolRig;  // one tool with its device, its loop, its controllers and its published state
 
   HapticSession();
+  // create()'s stages: the world and the objects, then each tool (its device, its controllers)
+  Status add_objects(const SessionRunOptions& options);
+  Status add_tool(std::size_t tool, const SessionRunOptions& options, const haptico::DeviceRegistry& registry);
+  Status open_device(ToolRig& rig, const SessionRunOptions& options, const haptico::DeviceRegistry& registry);
+  Status wire_controllers(ToolRig& rig);
   Status begin_run();
   // the run's statistics into each tool's report (before the loops stop), then (after the last
   // trace is taken) the tools' reports into report_
@@ -290,7 +309,7 @@ class HapticSession {
   Status thread_error() const;
   std::string tool_label(std::int32_t tool) const;
 
-  Scene scene_;
+  std::shared_ptr<const SessionModel> model_;
   double haptic_hz_ = 1000.0;
   double collision_hz_ = 1000.0;
   std::unique_ptr<collette::CollisionWorld> world_;

@@ -1,148 +1,57 @@
 #pragma once
 /// \file
-/// Scene files: the objects, the tool and its device, the watched pairs, rates and safety limits of
-/// a haptic session, as JSON. The CLI (`uh run SCENE`), the tests and the benchmarks use the same
-/// files (scenes/*.json). Format: docs/scenes.md.
+/// Scenes as the controllers use them: the description (uh/scene/scene.hpp, checked by
+/// uh/scene/validate.hpp) under its controllers names, and the loading of a shape's tree and mesh
+/// surface for a session.
 
-#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
-#include <string_view>
-#include <vector>
 
+#include "uh/collette/ist_cache.hpp"
 #include "uh/collette/mesh_inside.hpp"
 #include "uh/collette/sphere_tree.hpp"
 #include "uh/controllers/force_controller.hpp"
 #include "uh/controllers/workspace_mapping.hpp"
-#include "uh/core/math.hpp"
 #include "uh/core/result.hpp"
-#include "uh/forcecomp/force_params.hpp"
-#include "uh/forcecomp/material.hpp"
-#include "uh/haptico/device_config.hpp"
+#include "uh/scene/scene.hpp"
+#include "uh/scene/validate.hpp"
 
 namespace uh::controllers {
 
-/// Where an object's Inner Sphere Tree comes from: a mesh (packed on first use, cached), a .ist
-/// file, or a tree already in memory (built by the program, e.g. through the C API).
-struct SceneShape {
-  std::filesystem::path mesh{};      ///< mesh file (absolute after loading), or empty when `ist` or `tree` is set
-  std::filesystem::path ist{};       ///< prebuilt .ist file, or empty
-  std::shared_ptr<const collette::SphereTree> tree{};  ///< a tree in metres, shared; used as it is when set
-  /// With `tree`: its packing's coverage (sphere volume / mesh volume, (0, 1]), which calibrates the
-  /// gradient force law; 1 when unknown. Meshes and .ist files bring their own.
-  double coverage = 1.0;
-  std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
-  /// Largest sphere radius when packing the mesh [m]; 0 = unbounded (collette::PackingOptions::max_radius).
-  double max_sphere_radius = 0.0;
-  double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
-};
+using uh::scene::default_scene;
+using uh::scene::load_scene;
+using uh::scene::parse_device_config;
+using uh::scene::parse_scene;
+using uh::scene::read_scene_file;
+using uh::scene::Scene;
+using uh::scene::SceneDevice;
+using uh::scene::SceneObject;
+using uh::scene::SceneShape;
+using uh::scene::SceneTool;
+using uh::scene::write_default_scene;
 
-/// A static object of the scene.
-struct SceneObject {
-  std::string name;
-  SceneShape shape;
-  Pose pose{};                       ///< world_from_object [m]
-  /// `objects[].material`: what the surface feels like (stiffness, damping, friction, texture);
-  /// nothing set = as the tool's force parameters say (docs/scenes.md, "Materials").
-  forcecomp::Material material{};
-};
-
-/// The device a tool is bound to: a registered driver name and its settings.
-struct SceneDevice {
-  std::string driver = "sim-line";
-  haptico::DeviceConfig config;
-};
-
-/// A tool: a shape moved by its own device, with its force component. A scene holds one or more.
-struct SceneTool {
-  std::string name = "tool";
-  SceneShape shape;
-  forcecomp::ForceParams force{};
-  /// `tool.material`: the tool's own surface, combined with each object's (forcecomp::combine_materials).
-  forcecomp::Material material{};
-  forcecomp::ForceMode mode = forcecomp::ForceMode::k6Dof;
-  SceneDevice device;
-  WorkspaceMapping workspace{};
-};
-
-/// A whole session description.
-struct Scene {
-  std::string name;                    ///< for messages and reports
-  std::string source;                  ///< file the scene came from ("<embedded>" for the default)
-  std::vector<SceneObject> objects;
-  /// The tools, each bound to its own device (`tool`, or `tools` for several: two hands, two
-  /// users); never empty. Each touches the objects; tools pass through each other.
-  std::vector<SceneTool> tools{1};
-  std::vector<std::string> watch;      ///< object names watched against every tool
-  double haptic_hz = 1000.0;           ///< haptic thread rate [Hz]
-  double collision_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running
-  double seconds = 10.0;               ///< default session length [s]
-  double contact_margin = 0.001;       ///< collision pairs delivered this far [m] before they touch (multi-rate)
-  double coherence_skin = 0.0;         ///< frame-to-frame coherence skin of the volume query [m]; 0 = off
-  ForceControllerOptions force{};      ///< multi-rate, watchdog, coupling
-  /// The session's safety limits (`force.safety.max_force_n`, `max_torque_nm`); the session's
-  /// limit chain applies the smallest of these, the tool's (`tool.force`) and the device's.
-  haptico::WrenchLimit safety_limits{.max_force_n = 10.0, .max_torque_nm = 0.5};
-  /// `force.safety.max_force_rate_n_per_s`, `max_torque_rate_nm_per_s`: the largest change of the
-  /// command per second (per tick: divided by the haptic rate); zero is always sent at once.
-  haptico::ForceRateLimit rate_limit{};
-
-  /// The first tool (the only one in one-tool scenes).
-  SceneTool& tool() { return tools.front(); }
-  const SceneTool& tool() const { return tools.front(); }
-};
-
-/// Reads a scene file. Errors name the file, the field (as a JSON path such as
-/// `tool.device.driver`) and what is expected; unknown fields are errors too (typos).
-/// Relative mesh and .ist paths are resolved against the scene file's directory.
-/// The file must be a regular file of at most kMaxSceneFileBytes (uh/core/regular_file.hpp); a
-/// mesh or .ist it names must be a regular file too.
-Result<Scene> load_scene(const std::filesystem::path& path);
-
-/// The text of a scene file, read as load_scene() reads it (a regular file, size-limited).
-Result<std::string> read_scene_file(const std::filesystem::path& path);
-
-/// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
-Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);
-
-/// Reads a device's settings from a JSON object (numbers, strings, booleans, [x, y, z]) as a
-/// scene's `tool.device.config` (or `tools[i].device.config`) is read; a relative `file` resolves against
-/// `base_dir`. Errors name `source` and the key.
-Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, const std::string& source,
-                                                  const std::filesystem::path& base_dir);
-
-/// The embedded default scene: the bunny explored by a stylus on a raster sweep into deep contact.
-/// Its meshes are written into `cache_dir` on first use.
-Result<Scene> default_scene(const std::filesystem::path& cache_dir);
-
-/// Writes the embedded default scene file and its meshes into `cache_dir` (unless they are there
-/// already) and returns the scene file's path, for callers that edit the scene as JSON.
-Result<std::filesystem::path> write_default_scene(const std::filesystem::path& cache_dir);
-
-/// Where built .ist files are cached: $UH_CACHE_DIR, else $XDG_CACHE_HOME/unrealhaptics, else
-/// (Windows) %LOCALAPPDATA%\unrealhaptics\cache, else ~/.cache/unrealhaptics, else a folder in the
-/// system temp directory.
+/// Where built .ist files are cached: collette::IstCache::default_dir().
 std::filesystem::path default_cache_dir();
 
 /// A shape's tree in metres with its packing's coverage (sphere volume / mesh volume, (0, 1]).
-struct ShapeTree {
-  std::shared_ptr<const collette::SphereTree> tree;
-  double coverage = 1.0;
-};
+using ShapeTree = collette::CachedTree;
 
-/// Loads the shape's tree in metres: the .ist file, or the cached build of the mesh (keyed by the
-/// mesh file's hash and the sphere count), building and caching it on first use; the coverage
-/// comes from the .ist metadata (SceneShape::coverage for a tree in memory). `progress` gets
-/// the packing progress when a build is needed. Setup only.
+/// The shape's tree in metres: the tree in memory as it is (with SceneShape::coverage), else the
+/// .ist file's or the mesh's packing through `cache` (collette::IstCache: built and cached on
+/// first use; a cache shares one tree between the shapes that ask for the same). Setup only.
+Result<ShapeTree> tree_of(const SceneShape& shape, collette::IstCache& cache,
+                          const collette::IstCache::Progress& progress = {});
+
+/// tree_of() through a cache of `cache_dir` made for this call, for callers that load one tree.
 Result<ShapeTree> load_shape_tree(
     const SceneShape& shape, const std::filesystem::path& cache_dir,
     const std::function<void(const std::string& what, double fraction)>& progress = {});
 
 /// The shape's mesh surface in metres, for exact nearest-point queries (the proxy rests on it rather
-/// than on the packing's grain); null when the shape has no mesh file or comes as a tree (a .ist, a
-/// tree in memory, or one preloaded by `uh explore`: see docs/forcecomp.md, "Not yet").
+/// than on the packing's grain); null when the shape has no mesh file (a .ist file; a tree in memory
+/// without the mesh it was packed from).
 /// The mesh is read and validated as for packing. Setup only.
 Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape);
 

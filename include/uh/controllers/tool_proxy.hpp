@@ -36,31 +36,12 @@
 #include "uh/core/latest_value.hpp"
 #include "uh/forcecomp/material.hpp"
 #include "uh/forcecomp/proxy_solver.hpp"
+#include "uh/scene/force_options.hpp"
 
 namespace uh::controllers {
 
-/// Options of a ToolProxy (aggregate; scene field `force.proxy`, docs/scenes.md).
-struct ToolProxyOptions {
-  /// Render through the proxy, or the penalty path when false (the default until every shipped
-  /// scene's test passes on the proxy: docs/forcecomp.md, "Not yet"). A scene that enables
-  /// force.coupling gets the penalty path with the coupling unless it asks for the proxy too.
-  bool enabled = false;
-  /// Most any point of the tool moves in one collision step [m] (a hand faster than step_m times
-  /// the collision rate drags the proxy behind it). The world's contact margin is raised to it.
-  double step_m = 0.002;
-  /// How far the proxy's spheres may overlap the object's [m]: the proxy rests this deep.
-  double penetration_m = 0.0001;
-  /// Most sphere pairs a step takes as constraints (the nearest; the rest shrink the step).
-  std::int32_t max_constraints = 4096;
-  /// The length over which the packed surface is smoothed [m] (0: the spheres' union as it is):
-  /// each tool sphere near the object also gets a constraint on the soft minimum of its gaps,
-  /// -e log sum exp(-gap_i / e), which lies above the caps of a packed face by at most
-  /// e log(count) and rounds the kinks between them, so a tool sliding on it does not ride over
-  /// the packing's grain. It only adds constraints: the pairs' own still hold. Keep it well below
-  /// step_m (the pairs beyond the margin are not in the sum). A ball sliding on a face packed with
-  /// 10,000 spheres ripples 19 % of its normal force on the spheres' union, 11 % at 0.2 mm.
-  double smoothing_m = 0.0002;
-};
+/// Options of a ToolProxy: described by the scene (uh/scene/force_options.hpp).
+using uh::scene::ToolProxyOptions;
 
 /// What a watched object is to the proxy (ToolProxy::watch). Plain data.
 struct ProxyContact {

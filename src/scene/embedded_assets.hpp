@@ -5,7 +5,7 @@
 #include <span>
 #include <string_view>
 
-namespace uh::controllers::embedded {
+namespace uh::scene::embedded {
 
 struct File {
   std::string_view path;  ///< relative path, as in the source tree
@@ -15,4 +15,4 @@ struct File {
 std::span<const File> files();
 std::string_view default_scene_json();
 
-}  // namespace uh::controllers::embedded
+}  // namespace uh::scene::embedded

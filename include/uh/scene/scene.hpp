@@ -1,0 +1,128 @@
+#pragma once
+/// \file
+/// A scene: the objects, the tools and their devices, the watched pairs, rates and safety limits
+/// of a haptic session, as plain data a user edits (MuJoCo's description). Read from JSON files
+/// (scenes/*.json; the CLI, the tests and the benchmarks use the same files; format:
+/// docs/scenes.md), built by the C API or edited by `uh serve`; uh::scene::validate() checks every
+/// field in one place; uh::controllers compiles it into the model a session runs.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "uh/core/math.hpp"
+#include "uh/core/result.hpp"
+#include "uh/forcecomp/force_params.hpp"
+#include "uh/forcecomp/material.hpp"
+#include "uh/haptico/device_config.hpp"
+#include "uh/haptico/force_limiter.hpp"
+#include "uh/scene/force_options.hpp"
+#include "uh/scene/workspace_mapping.hpp"
+
+namespace uh::collette {
+class SphereTree;
+}  // namespace uh::collette
+
+namespace uh::scene {
+
+/// Where an object's Inner Sphere Tree comes from: a mesh (packed on first use, cached), a .ist
+/// file, or a tree already in memory (built by the program, e.g. through the C API).
+struct SceneShape {
+  std::filesystem::path mesh{};      ///< mesh file (absolute after loading), or empty when `ist` or `tree` is set
+  std::filesystem::path ist{};       ///< prebuilt .ist file, or empty
+  std::shared_ptr<const collette::SphereTree> tree{};  ///< a tree in metres, shared; used as it is when set
+  /// With `tree`: its packing's coverage (sphere volume / mesh volume, (0, 1]), which calibrates the
+  /// gradient force law; 1 when unknown. Meshes and .ist files bring their own.
+  double coverage = 1.0;
+  std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
+  /// Largest sphere radius when packing the mesh [m]; 0 = unbounded (collette::PackingOptions::max_radius).
+  double max_sphere_radius = 0.0;
+  double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
+};
+
+/// A static object of the scene.
+struct SceneObject {
+  std::string name;
+  SceneShape shape;
+  Pose pose{};                       ///< world_from_object [m]
+  /// `objects[].material`: what the surface feels like (stiffness, damping, friction, texture);
+  /// nothing set = as the tool's force parameters say (docs/scenes.md, "Materials").
+  forcecomp::Material material{};
+};
+
+/// The device a tool is bound to: a registered driver name and its settings.
+struct SceneDevice {
+  std::string driver = "sim-line";
+  haptico::DeviceConfig config;
+};
+
+/// A tool: a shape moved by its own device, with its force component. A scene holds one or more.
+struct SceneTool {
+  std::string name = "tool";
+  SceneShape shape;
+  forcecomp::ForceParams force{};
+  /// `tool.material`: the tool's own surface, combined with each object's (forcecomp::combine_materials).
+  forcecomp::Material material{};
+  forcecomp::ForceMode mode = forcecomp::ForceMode::k6Dof;
+  SceneDevice device;
+  WorkspaceMapping workspace{};
+};
+
+/// A whole session description.
+struct Scene {
+  std::string name;                    ///< for messages and reports
+  std::string source;                  ///< file the scene came from ("<embedded>" for the default)
+  std::vector<SceneObject> objects;
+  /// The tools, each bound to its own device (`tool`, or `tools` for several: two hands, two
+  /// users); never empty. Each touches the objects; tools pass through each other.
+  std::vector<SceneTool> tools{1};
+  std::vector<std::string> watch;      ///< object names watched against every tool
+  double haptic_hz = 1000.0;           ///< haptic thread rate [Hz]
+  double collision_hz = 1000.0;        ///< collision thread rate [Hz]; 0 = free-running
+  double seconds = 10.0;               ///< default session length [s]
+  double contact_margin = 0.001;       ///< collision pairs delivered this far [m] before they touch (multi-rate)
+  double coherence_skin = 0.0;         ///< frame-to-frame coherence skin of the volume query [m]; 0 = off
+  ForceControllerOptions force{};      ///< multi-rate, watchdog, coupling
+  /// The session's safety limits (`force.safety.max_force_n`, `max_torque_nm`); the session's
+  /// limit chain applies the smallest of these, the tool's (`tool.force`) and the device's.
+  haptico::WrenchLimit safety_limits{.max_force_n = 10.0, .max_torque_nm = 0.5};
+  /// `force.safety.max_force_rate_n_per_s`, `max_torque_rate_nm_per_s`: the largest change of the
+  /// command per second (per tick: divided by the haptic rate); zero is always sent at once.
+  haptico::ForceRateLimit rate_limit{};
+
+  /// The first tool (the only one in one-tool scenes).
+  SceneTool& tool() { return tools.front(); }
+  const SceneTool& tool() const { return tools.front(); }
+};
+
+/// Reads a scene file. Errors name the file, the field (as a JSON path such as
+/// `tool.device.driver`) and what is expected; unknown fields are errors too (typos).
+/// Relative mesh and .ist paths are resolved against the scene file's directory.
+/// The file must be a regular file of at most kMaxSceneFileBytes (uh/core/regular_file.hpp); a
+/// mesh or .ist it names must be a regular file too.
+Result<Scene> load_scene(const std::filesystem::path& path);
+
+/// The text of a scene file, read as load_scene() reads it (a regular file, size-limited).
+Result<std::string> read_scene_file(const std::filesystem::path& path);
+
+/// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
+Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);
+
+/// Reads a device's settings from a JSON object (numbers, strings, booleans, [x, y, z]) as a
+/// scene's `tool.device.config` (or `tools[i].device.config`) is read; a relative `file` resolves against
+/// `base_dir`. Errors name `source` and the key.
+Result<haptico::DeviceConfig> parse_device_config(std::string_view json_text, const std::string& source,
+                                                  const std::filesystem::path& base_dir);
+
+/// The embedded default scene: the bunny explored by a stylus on a raster sweep into deep contact.
+/// Its meshes are written into `cache_dir` on first use.
+Result<Scene> default_scene(const std::filesystem::path& cache_dir);
+
+/// Writes the embedded default scene file and its meshes into `cache_dir` (unless they are there
+/// already) and returns the scene file's path, for callers that edit the scene as JSON.
+Result<std::filesystem::path> write_default_scene(const std::filesystem::path& cache_dir);
+
+}  // namespace uh::scene

@@ -1,0 +1,82 @@
+#include "uh/controllers/session_model.hpp"
+
+#include <map>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "uh/scene/validate.hpp"
+
+namespace uh::controllers {
+namespace {
+
+// One mesh's surface per (file, scale), shared by the objects that repeat it.
+class SurfaceLoader {
+ public:
+  explicit SurfaceLoader(bool beside_given_tree) : beside_given_tree_(beside_given_tree) {}
+
+  Result<std::shared_ptr<const collette::MeshInside>> load(const SceneShape& shape) {
+    if (shape.mesh.empty() || (shape.tree && !beside_given_tree_)) return std::shared_ptr<const collette::MeshInside>{};
+    const auto key = std::make_pair(shape.mesh.string(), shape.meters_per_unit);
+    if (const auto it = loaded_.find(key); it != loaded_.end()) return it->second;
+    auto surface = load_shape_surface(shape);
+    if (surface) loaded_.emplace(key, *surface);
+    return surface;
+  }
+
+ private:
+  bool beside_given_tree_;
+  std::map<std::pair<std::string, double>, std::shared_ptr<const collette::MeshInside>> loaded_;
+};
+
+Error named(const Scene& scene, const std::string& part, const Error& error) {
+  return Error{fmt::format("{}: {}: {}", scene.source, part, error.message), error.kind};
+}
+
+Status compile_objects(collette::IstCache& cache, const CompileOptions& options, SessionModel& model) {
+  const Scene& scene = model.scene;
+  SurfaceLoader surfaces(options.surface_beside_given_tree);
+  for (SceneObject& object : model.scene.objects) {
+    const std::string part = fmt::format("object '{}'", object.name);
+    auto tree = tree_of(object.shape, cache, options.progress);
+    if (!tree) return named(scene, part, tree.error());
+    auto surface = surfaces.load(object.shape);
+    if (!surface) return named(scene, part, surface.error());
+    model.objects.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = *surface});
+    object.shape.tree = tree->tree;
+    object.shape.coverage = tree->coverage;
+  }
+  return Ok{};
+}
+
+Status compile_tools(collette::IstCache& cache, const CompileOptions& options, SessionModel& model) {
+  const Scene& scene = model.scene;
+  for (SceneTool& tool : model.scene.tools) {
+    auto tree = tree_of(tool.shape, cache, options.progress);
+    if (!tree) return named(scene, fmt::format("tool '{}'", tool.name), tree.error());
+    // a tool's surface is not used: the proxy rests the tool's spheres on the objects' surfaces
+    model.tools.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = nullptr});
+    tool.shape.tree = tree->tree;
+    tool.shape.coverage = tree->coverage;
+    auto& row = model.materials.emplace_back();
+    for (const SceneObject& object : scene.objects)
+      row.push_back(forcecomp::combine_materials(object.material, tool.material, tool.force));
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<std::shared_ptr<const SessionModel>> compile(const Scene& scene, collette::IstCache& cache,
+                                                    const CompileOptions& options) {
+  if (Status valid = uh::scene::validate(scene); !valid)
+    return Error{fmt::format("{}: {}", scene.source, valid.error().message), ErrorKind::kInvalid};
+  auto model = std::make_shared<SessionModel>();
+  model->scene = scene;
+  model->scene.force.coupling.period_s = 1.0 / scene.haptic_hz;
+  if (Status s = compile_objects(cache, options, *model); !s) return s.error();
+  if (Status s = compile_tools(cache, options, *model); !s) return s.error();
+  return std::shared_ptr<const SessionModel>(std::move(model));
+}
+
+}  // namespace uh::controllers

@@ -1,0 +1,96 @@
+#include "uh/controllers/session_model.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "scene_test_support.hpp"
+#include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/controllers/haptic_session.hpp"
+
+namespace uh::controllers {
+namespace {
+
+using testing::small_scene_json;
+using testing::test_assets;
+
+Scene small_scene() {
+  auto scene = parse_scene(small_scene_json(), "small.json", test_assets());
+  EXPECT_TRUE(scene.has_value()) << scene.error().message;
+  return *scene;
+}
+
+TEST(SessionModel, OneModelServesTwoSessionsWithOneTree) {
+  collette::IstCache cache(testing::fresh_cache("model-two"));
+  auto model = compile(small_scene(), cache);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  ASSERT_EQ((*model)->objects.size(), 1u);
+  ASSERT_EQ((*model)->tools.size(), 1u);
+  EXPECT_NE((*model)->objects[0].surface, nullptr) << "the bunny has a mesh file";
+  ASSERT_EQ((*model)->materials.size(), 1u);
+  ASSERT_EQ((*model)->materials[0].size(), 1u);
+
+  auto first = HapticSession::create(*model);
+  auto second = HapticSession::create(*model);
+  ASSERT_TRUE(first.has_value()) << first.error().message;
+  ASSERT_TRUE(second.has_value()) << second.error().message;
+  EXPECT_EQ(&(*first)->model(), &(*second)->model());
+  EXPECT_EQ((*first)->model().objects[0].tree.get(), (*model)->objects[0].tree.get());
+  EXPECT_EQ((*second)->model().objects[0].tree.get(), (*model)->objects[0].tree.get());
+
+  // both run as a session created from the scene does, bit for bit
+  std::ostringstream trace_a, trace_b;
+  ASSERT_TRUE((*first)->run_stepped(0.5, 4, &trace_a).has_value());
+  ASSERT_TRUE((*second)->run_stepped(0.5, 4, &trace_b).has_value());
+  EXPECT_GT((*first)->report().contact_ticks, 0u);
+  EXPECT_EQ(trace_a.str(), trace_b.str());
+  SessionOptions options;
+  options.cache_dir = cache.dir();
+  auto from_scene = HapticSession::create(small_scene(), options);
+  ASSERT_TRUE(from_scene.has_value()) << from_scene.error().message;
+  std::ostringstream trace_c;
+  ASSERT_TRUE((*from_scene)->run_stepped(0.5, 4, &trace_c).has_value());
+  EXPECT_EQ(trace_a.str(), trace_c.str());
+
+  // a second compile through the same cache shares the trees as well
+  auto again = compile(small_scene(), cache);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ((*again)->objects[0].tree.get(), (*model)->objects[0].tree.get());
+  EXPECT_EQ((*again)->tools[0].tree.get(), (*model)->tools[0].tree.get());
+}
+
+TEST(SessionModel, ATreeGivenForTheToolOrTheObjectKeepsTheObjectsMeshSurface) {
+  collette::IstCache cache(testing::fresh_cache("model-tree"));
+  Scene scene = small_scene();
+  const Sphere ball{0.f, 0.f, 0.f, 0.004f};
+  auto tip = collette::build_sphere_tree(std::span<const Sphere>(&ball, 1));
+  ASSERT_TRUE(tip.has_value());
+  scene.tool().shape.tree = std::make_shared<const collette::SphereTree>(std::move(*tip));
+  auto model = compile(scene, cache);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  EXPECT_EQ((*model)->tools[0].tree.get(), scene.tool().shape.tree.get()) << "a tree given is used as it is";
+  ASSERT_NE((*model)->objects[0].surface, nullptr);
+
+  // a program that preloads the object's tree beside its mesh still gets the surface
+  scene.objects[0].shape.tree = (*model)->objects[0].tree;
+  scene.objects[0].shape.coverage = (*model)->objects[0].coverage;
+  auto preloaded = compile(scene, cache);
+  ASSERT_TRUE(preloaded.has_value()) << preloaded.error().message;
+  EXPECT_EQ((*preloaded)->objects[0].tree.get(), (*model)->objects[0].tree.get());
+  ASSERT_NE((*preloaded)->objects[0].surface, nullptr);
+  EXPECT_EQ((*preloaded)->objects[0].surface->distance(Vec3{0.0, 0.0, 0.1}),
+            (*model)->objects[0].surface->distance(Vec3{0.0, 0.0, 0.1}));
+}
+
+TEST(SessionModel, CompileRefusesAnInvalidSceneNamingTheField) {
+  collette::IstCache cache(testing::fresh_cache("model-invalid"));
+  Scene scene = small_scene();
+  scene.objects[0].shape.spheres = 0;
+  auto model = compile(scene, cache);
+  ASSERT_FALSE(model.has_value());
+  EXPECT_EQ(model.error().message,
+            "small.json: field 'objects[0].spheres': expected a whole number in [1, 2000000], got 0");
+}
+
+}  // namespace
+}  // namespace uh::controllers
