@@ -34,9 +34,9 @@ double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::Co
   return 2.0 * std::numbers::pi * radius * material.stiffness;
 }
 
-// The scene as the session runs it: the options' rates, margins and force options over the
-// scene's (compile() then checks it as every scene is checked).
-Scene effective_scene(const Scene& scene, const SessionOptions& options) {
+}  // namespace
+
+Scene with_session_options(const Scene& scene, const SessionOptions& options) {
   Scene s = scene;
   s.haptic_hz = options.haptic_hz.value_or(scene.haptic_hz);
   s.collision_hz = options.collision_hz.value_or(scene.collision_hz);
@@ -52,8 +52,6 @@ Scene effective_scene(const Scene& scene, const SessionOptions& options) {
   s.force.check_model = options.check_model;
   return s;
 }
-
-}  // namespace
 
 // One tool: its device's manager (its own haptic loop and limit chain), its controllers, what
 // its haptic thread publishes and what the monitor accumulates of its run.
@@ -120,7 +118,7 @@ HapticSession::~HapticSession() {
 Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene, const SessionOptions& options,
                                                              const haptico::DeviceRegistry& registry) {
   collette::IstCache cache(options.cache_dir);
-  auto model = compile(effective_scene(scene, options), cache,
+  auto model = compile(with_session_options(scene, options), cache,
                        {.surface_beside_given_tree = false, .progress = options.build_progress});
   if (!model) return model.error();
   return create(std::move(model).value(), {.raise_priority = options.raise_priority}, registry);

@@ -185,6 +185,10 @@ struct ContactEvent {
                              ///< its constraint rows in contact)
 };
 
+/// The scene as a session runs it: the options' rates, margins and force options over the scene's
+/// (compile() then checks it as every scene is checked). For a caller that compiles a model itself.
+Scene with_session_options(const Scene& scene, const SessionOptions& options);
+
 class HapticSession {
  public:
   /// compile() then create(model, ...): the scene with the options' overrides, its trees through
