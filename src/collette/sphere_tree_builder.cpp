@@ -90,11 +90,8 @@ SphereTreeNode enclose(std::span<const Sphere> leaves, std::span<const int> idx,
   return node;
 }
 
-// Splits idx into at most k clusters by volume-weighted k-means on the centres; returns the
-// cluster sizes after reordering idx so that clusters are contiguous. Deterministic.
-std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k, int iterations) {
-  const std::size_t m = idx.size();
-  // seed: volume quantiles along the longest axis of the centres' box
+// The axis (0 x, 1 y, 2 z) along which the leaves' centres spread the most.
+int longest_axis(std::span<const Sphere> leaves, std::span<const int> idx) {
   Vec3d lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
   Vec3d hi{-lo.x, -lo.y, -lo.z};
   for (int i : idx) {
@@ -103,64 +100,74 @@ std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k
     hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
   }
   const double ex = hi.x - lo.x, ey = hi.y - lo.y, ez = hi.z - lo.z;
-  const int axis = (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
-  auto coord = [&](int i) {
-    const Sphere& s = leaves[static_cast<std::size_t>(i)];
-    return axis == 0 ? s.x : (axis == 1 ? s.y : s.z);
-  };
-  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
-  double total = 0.0;
-  for (int i : idx) total += sphere_volume(leaves[static_cast<std::size_t>(i)]);
+  return (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
+}
 
-  std::vector<int> label(m, 0);
-  {
-    double acc = 0.0;
-    for (std::size_t j = 0; j < m; ++j) {
-      const double v = sphere_volume(leaves[static_cast<std::size_t>(idx[j])]);
-      label[j] = std::min(k - 1, static_cast<int>((acc + 0.5 * v) / total * k));
-      acc += v;
+// Volume-weighted k-means over the leaves idx[j], from their first labels; the centres and
+// weights are the clusters' (a cluster that lost every leaf keeps weight 0 and takes none).
+class KMeans {
+ public:
+  KMeans(std::span<const Sphere> leaves, std::span<const int> idx, std::vector<int> label, int k)
+      : leaves_(leaves), idx_(idx), label_(std::move(label)), centre_(static_cast<std::size_t>(k)),
+        weight_(static_cast<std::size_t>(k)) {}
+
+  std::vector<int> run(int iterations) {
+    update_centres();
+    for (int it = 0; it < iterations; ++it) {
+      if (!reassign()) break;
+      update_centres();
     }
+    return std::move(label_);
   }
-  std::vector<Vec3d> centre(static_cast<std::size_t>(k));
-  std::vector<double> weight(static_cast<std::size_t>(k));
-  auto update_centres = [&]() {
-    std::fill(centre.begin(), centre.end(), Vec3d{0, 0, 0});
-    std::fill(weight.begin(), weight.end(), 0.0);
-    for (std::size_t j = 0; j < m; ++j) {
-      const Sphere& s = leaves[static_cast<std::size_t>(idx[j])];
+
+ private:
+  void update_centres() {
+    std::fill(centre_.begin(), centre_.end(), Vec3d{0, 0, 0});
+    std::fill(weight_.begin(), weight_.end(), 0.0);
+    for (std::size_t j = 0; j < idx_.size(); ++j) {
+      const Sphere& s = leaves_[static_cast<std::size_t>(idx_[j])];
       const double v = sphere_volume(s);
-      Vec3d& c = centre[static_cast<std::size_t>(label[j])];
+      Vec3d& c = centre_[static_cast<std::size_t>(label_[j])];
       c = {c.x + v * static_cast<double>(s.x), c.y + v * static_cast<double>(s.y), c.z + v * static_cast<double>(s.z)};
-      weight[static_cast<std::size_t>(label[j])] += v;
+      weight_[static_cast<std::size_t>(label_[j])] += v;
     }
-    for (std::size_t c = 0; c < centre.size(); ++c)
-      if (weight[c] > 0.0) centre[c] = {centre[c].x / weight[c], centre[c].y / weight[c], centre[c].z / weight[c]};
-  };
-  update_centres();
-  for (int it = 0; it < iterations; ++it) {
+    for (std::size_t c = 0; c < centre_.size(); ++c)
+      if (weight_[c] > 0.0) centre_[c] = {centre_[c].x / weight_[c], centre_[c].y / weight_[c], centre_[c].z / weight_[c]};
+  }
+
+  // moves every leaf to its nearest centre; whether any moved
+  bool reassign() {
     bool changed = false;
-    for (std::size_t j = 0; j < m; ++j) {
-      const Vec3d p = centre_of(leaves[static_cast<std::size_t>(idx[j])]);
-      int best = label[j];
+    for (std::size_t j = 0; j < idx_.size(); ++j) {
+      const Vec3d p = centre_of(leaves_[static_cast<std::size_t>(idx_[j])]);
+      int best = label_[j];
       double best_d = std::numeric_limits<double>::max();
-      for (int c = 0; c < k; ++c) {
-        if (weight[static_cast<std::size_t>(c)] <= 0.0) continue;
-        const double d = dist(p, centre[static_cast<std::size_t>(c)]);
+      for (std::size_t c = 0; c < centre_.size(); ++c) {
+        if (weight_[c] <= 0.0) continue;
+        const double d = dist(p, centre_[c]);
         if (d < best_d) {
           best_d = d;
-          best = c;
+          best = static_cast<int>(c);
         }
       }
-      if (best != label[j]) {
-        label[j] = best;
+      if (best != label_[j]) {
+        label_[j] = best;
         changed = true;
       }
     }
-    if (!changed) break;
-    update_centres();
+    return changed;
   }
 
-  // reorder idx by label (stable, so the result is deterministic)
+  std::span<const Sphere> leaves_;
+  std::span<const int> idx_;
+  std::vector<int> label_;
+  std::vector<Vec3d> centre_;
+  std::vector<double> weight_;
+};
+
+// Reorders idx by label (stable, so the result is deterministic); returns the non-empty clusters' sizes.
+std::vector<int> group_by_label(std::span<int> idx, const std::vector<int>& label, int k) {
+  const std::size_t m = idx.size();
   std::vector<int> order(m);
   for (std::size_t j = 0; j < m; ++j) order[j] = static_cast<int>(j);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
@@ -174,6 +181,32 @@ std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k
   }
   std::copy(sorted.begin(), sorted.end(), idx.begin());
   std::erase(sizes, 0);
+  return sizes;
+}
+
+// Splits idx into at most k clusters by volume-weighted k-means on the centres; returns the
+// cluster sizes after reordering idx so that clusters are contiguous. Deterministic.
+std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k, int iterations) {
+  const std::size_t m = idx.size();
+  // seed: volume quantiles along the longest axis of the centres' box
+  const int axis = longest_axis(leaves, idx);
+  auto coord = [&](int i) {
+    const Sphere& s = leaves[static_cast<std::size_t>(i)];
+    return axis == 0 ? s.x : (axis == 1 ? s.y : s.z);
+  };
+  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
+  double total = 0.0;
+  for (int i : idx) total += sphere_volume(leaves[static_cast<std::size_t>(i)]);
+  std::vector<int> label(m, 0);
+  double acc = 0.0;
+  for (std::size_t j = 0; j < m; ++j) {
+    const double v = sphere_volume(leaves[static_cast<std::size_t>(idx[j])]);
+    label[j] = std::min(k - 1, static_cast<int>((acc + 0.5 * v) / total * k));
+    acc += v;
+  }
+
+  label = KMeans(leaves, idx, std::move(label), k).run(iterations);
+  std::vector<int> sizes = group_by_label(idx, label, k);
   if (sizes.size() < 2) {
     // all centres coincide (or k-means collapsed): split evenly in the axis order instead
     std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
