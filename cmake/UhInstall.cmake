@@ -13,7 +13,7 @@ if(WIN32)
 endif()
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/uh DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(TARGETS uh_core uh_collette uh_forcecomp uh_haptico uh_devices uh_controllers uh_capi uh_net uh_service uh_museum uh_museum_protocol uh_museum_service uh_museum_artifacts uh_readerwriterqueue
+install(TARGETS uh_core uh_collette uh_forcecomp uh_haptico uh_devices uh_controllers uh_exploration uh_capi uh_net uh_service uh_museum uh_museum_protocol uh_museum_service uh_museum_artifacts uh_readerwriterqueue
         EXPORT UnrealHapticsTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

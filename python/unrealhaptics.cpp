@@ -403,6 +403,7 @@ struct State {
   std::uint64_t haptic_ticks = 0, missed_deadlines = 0;
   double haptic_rate_hz = 0.0, collision_rate_hz = 0.0;
   std::uint32_t buttons = 0;
+  py::array_t<double> handle_position;
 };
 
 struct ContactEvent {
@@ -421,8 +422,12 @@ class Session {
   Session& operator=(const Session&) = delete;
 
   static uh_session_def session_def(const py::object& cache_dir, double haptic_hz, double collision_hz,
-                                    bool raise_priority, std::string& cache) {
+                                    bool raise_priority, const py::object& proxy, std::string& cache) {
     uh_session_def def = uh_default_session_def();
+    if (!proxy.is_none() && !py::isinstance<py::bool_>(proxy))
+      throw py::type_error("Session.open: proxy is None (the scene's), True or False, got " +
+                           py::repr(proxy).cast<std::string>());
+    def.proxy = proxy.is_none() ? -1 : (proxy.cast<bool>() ? 1 : 0);
     def.haptic_hz = haptic_hz;
     def.collision_hz = collision_hz;
     def.raise_priority = raise_priority ? 1 : 0;
@@ -434,9 +439,9 @@ class Session {
   }
 
   static std::unique_ptr<Session> open(const py::object& scene, const py::object& cache_dir, double haptic_hz,
-                                       double collision_hz, bool raise_priority) {
+                                       double collision_hz, bool raise_priority, const py::object& proxy) {
     std::string cache;
-    const uh_session_def def = session_def(cache_dir, haptic_hz, collision_hz, raise_priority, cache);
+    const uh_session_def def = session_def(cache_dir, haptic_hz, collision_hz, raise_priority, proxy, cache);
     uh_session_id s{0};
     if (py::isinstance<Scene>(scene)) {
       const uh_scene_id sc = scene.cast<const Scene&>().handle();
@@ -476,7 +481,8 @@ class Session {
                  st.missed_deadlines,
                  st.haptic_rate_hz,
                  st.collision_rate_hz,
-                 st.buttons};
+                 st.buttons,
+                 vector_array(st.handle_position, 3)};
   }
 
   std::vector<ContactEvent> events() {
@@ -639,7 +645,10 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def_readonly("missed_deadlines", &State::missed_deadlines)
       .def_readonly("haptic_rate_hz", &State::haptic_rate_hz)
       .def_readonly("collision_rate_hz", &State::collision_rate_hz)
-      .def_readonly("buttons", &State::buttons, "the device's buttons (bit i: button i)");
+      .def_readonly("buttons", &State::buttons, "the device's buttons (bit i: button i)")
+      .def_readonly("handle_position", &State::handle_position,
+                    "(3,) where the handle puts the tool [m]: tool_position without a proxy; with one, the tool "
+                    "rests on the surface above it");
 
   py::class_<ContactEvent>(m, "ContactEvent", "A contact between a tool and a watched object began or ended.")
       .def_readonly("kind", &ContactEvent::kind, "'begin' or 'end'")
@@ -659,8 +668,10 @@ PYBIND11_MODULE(unrealhaptics, m) {
       "threads joined) and closes.")
       .def_static("open", &Session::open, py::arg("scene") = py::none(), py::kw_only(),
                   py::arg("cache_dir") = py::none(), py::arg("haptic_hz") = 0.0,
-                  py::arg("collision_hz") = -1.0, py::arg("raise_priority") = false,
-                  "Opens a session of a scene file path, a Scene, or None (the default scene).")
+                  py::arg("collision_hz") = -1.0, py::arg("raise_priority") = false, py::arg("proxy") = py::none(),
+                  "Opens a session of a scene file path, a Scene, or None (the default scene). proxy: None (the "
+                  "scene's force.proxy), True (the 6-DOF proxy: the tool never passes through a surface) or False "
+                  "(the penalty path).")
       .def("start", &Session::start, "Starts the haptic, collision and monitor threads; returns at once.")
       .def("state", &Session::state, py::arg("tool") = 0,
            "The newest state of a tool (the first by default; never waits for its haptic thread).")

@@ -10,8 +10,8 @@
 #include "commands.hpp"
 #include "progress_bar.hpp"
 #include "session_plot.hpp"
-#include "uh/controllers/exploration.hpp"
 #include "uh/controllers/scene.hpp"
+#include "uh/exploration/exploration.hpp"
 
 namespace uh::cli {
 namespace {
@@ -38,7 +38,7 @@ std::string shown(const std::optional<double>& v, const char* format_unit) {
 int explore(const ExploreArgs& args) {
   auto scene = controllers::load_scene(args.scene);
   if (!scene) return fail(scene.error().message);
-  controllers::ExploreOptions options;
+  exploration::ExploreOptions options;
   options.seed = args.seed;
   if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
   options.ticks_per_collision_step = args.ticks_per_collision;
@@ -47,7 +47,7 @@ int explore(const ExploreArgs& args) {
   if (!args.proxy.empty()) session.proxy = args.proxy == "on";
   StagedProgress bars;
   session.build_progress = bars.callback();
-  auto explored = controllers::explore_scene(*scene, args.object, options, session);
+  auto explored = exploration::explore_scene(*scene, args.object, options, session);
   bars.finish();
   if (!explored) return fail(explored.error().message);
   if (!args.plot.empty())

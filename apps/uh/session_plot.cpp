@@ -186,7 +186,7 @@ Status write_session_plot(const controllers::SessionReport& report, const std::f
 }
 
 Status write_exploration_plot(const std::string& scene,
-                              const std::vector<controllers::ObjectExploration>& objects,
+                              const std::vector<exploration::ObjectExploration>& objects,
                               const std::filesystem::path& png) {
   std::vector<Panel> panels;
   double t_max = 0.0;
@@ -197,8 +197,8 @@ Status write_exploration_plot(const std::string& scene,
     std::vector<double> t_press, pressed;
     bool pressing = false;
     for (const auto& s : o.trace.samples) {
-      const bool first = (s.phase == controllers::ExplorePhase::kPress && s.leg <= 0) ||
-                         (pressing && s.phase == controllers::ExplorePhase::kRelease);
+      const bool first = (s.phase == exploration::ExplorePhase::kPress && s.leg <= 0) ||
+                         (pressing && s.phase == exploration::ExplorePhase::kRelease);
       if (!first && pressing) break;
       pressing = pressing || first;
       if (!first) continue;
@@ -209,7 +209,7 @@ Status write_exploration_plot(const std::string& scene,
     const double press_end = t_press.empty() ? 0.0 : t_press.back() + 0.2;
     std::vector<double> t, normal, friction;
     double last = -1.0, shift = 0.0;
-    for (const auto& f : controllers::stroke_forces(o.trace)) {
+    for (const auto& f : exploration::stroke_forces(o.trace)) {
       if (last >= 0.0 && f.time_s - last > 0.01) shift += f.time_s - last - 0.01;  // close the gaps
       last = f.time_s;
       t.push_back(f.time_s - shift);

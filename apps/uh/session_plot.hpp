@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "uh/controllers/exploration.hpp"
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/core/result.hpp"
+#include "uh/exploration/exploration.hpp"
 
 namespace uh::cli {
 
@@ -20,7 +20,7 @@ Status write_session_plot(const controllers::SessionReport& report, const std::f
 /// The forces felt while stroking each explored object (`uh explore --plot`): one panel per
 /// object, the normal force and the friction (against the motion) over the strokes and the contour.
 Status write_exploration_plot(const std::string& scene,
-                              const std::vector<controllers::ObjectExploration>& objects,
+                              const std::vector<exploration::ObjectExploration>& objects,
                               const std::filesystem::path& png);
 
 }  // namespace uh::cli

@@ -328,6 +328,9 @@ typedef struct uh_session_def {
   double collision_hz;     /* override the collision rate [Hz] (< 0: the scene's; 0 = free-running) */
   int32_t raise_priority;  /* nonzero: ask for SCHED_FIFO for the haptic and collision threads */
   const char* cache_dir;   /* where packed meshes are cached (NULL: $UH_CACHE_DIR or ~/.cache/unrealhaptics) */
+  /* --- added in API version 2's second layout --- */
+  int32_t proxy;           /* how contact is rendered: -1 the scene's (force.proxy), 0 the penalty path,
+                            * 1 the 6-DOF proxy, which never lets the tool through a surface */
 } uh_session_def;
 
 UH_API uh_status uh_session_def_init(uh_session_def* def);
@@ -353,6 +356,9 @@ typedef struct uh_state {
   double haptic_rate_hz;       /* haptic ticks per second over the last ~100 ms [Hz] */
   double collision_rate_hz;    /* collision steps per second over the last ~100 ms [Hz] */
   uint32_t buttons;            /* the device's buttons as read that tick (bit i: button i) */
+  /* --- added in API version 2's second layout --- */
+  double handle_position[3];   /* where the device's handle puts the tool's origin [m]: tool_position
+                                * without a proxy; with one, the tool rests on the surface above it */
 } uh_state;
 
 /* A contact between a tool and a watched object began or ended. */

@@ -184,3 +184,23 @@ def test_tools_added_through_calls_each_name_their_contacts():
     assert begins == {(0, 0), (1, 1)}  # the left stylus meets the bunny, the right one the ball
     scene.remove_tool("right")
     assert scene.tool_count == 1
+
+
+def test_the_proxy_is_chosen_per_session_and_keeps_the_tool_on_the_surface(scene):
+    """proxy=False: the tool is at the handle, inside the bunny at the press's deepest; proxy=True: on the surface
+    above it, with contact events from its constraints; the handle's position is in the state either way."""
+    held = {}
+    for proxy in (False, True):
+        with uh.Session.open(scene, proxy=proxy) as s:
+            report = s.run_stepped(0.5, 4)
+            st = s.state()
+            events = s.events()
+        assert isinstance(st.handle_position, np.ndarray) and st.handle_position.shape == (3,)
+        assert abs(st.handle_position[2] - 0.045) < 1e-3
+        assert report["force"]["max_n"] > 0.5
+        assert any(e.kind == "begin" and e.pairs > 0 for e in events)
+        held[proxy] = st.tool_position[2] - st.handle_position[2]
+    assert held[False] == 0.0
+    assert held[True] > 0.001
+    with pytest.raises(TypeError, match="proxy is None"):
+        uh.Session.open(scene, proxy="yes")

@@ -80,11 +80,11 @@ Result<Pose> pose_from_arrays(const double position[3], const double orientation
 // older struct's end: its padding was never the caller's to set)
 static_assert(offsetof(uh_tool_def, tool_offset) >= sizeof(uh_v2_0_tool_def));
 static_assert(offsetof(uh_contact_event, tool) >= offsetof(uh_v2_0_contact_event, pairs) + sizeof(int32_t));
+static_assert(offsetof(uh_session_def, proxy) >= sizeof(uh_v2_0_session_def));
+static_assert(offsetof(uh_state, handle_position) >= sizeof(uh_v2_0_state));
 static_assert(sizeof(uh_tree_build_def) == sizeof(uh_v2_0_tree_build_def) &&
                   sizeof(uh_shape_def) == sizeof(uh_v2_0_shape_def) &&
                   sizeof(uh_object_def) == sizeof(uh_v2_0_object_def) &&
-                  sizeof(uh_session_def) == sizeof(uh_v2_0_session_def) &&
-                  sizeof(uh_state) == sizeof(uh_v2_0_state) &&
                   sizeof(uh_tree_info) == sizeof(uh_v2_0_tree_info) &&
                   sizeof(uh_query_result) == sizeof(uh_v2_0_query_result),
               "a struct grew: keep its older layout in uh_v2_0_structs.h and add the new fields at its end");

@@ -53,6 +53,9 @@ void fill_state(const controllers::SessionState& s, uh_state& out) {
   out.haptic_rate_hz = s.haptic_rate_hz;
   out.collision_rate_hz = s.collision_rate_hz;
   out.buttons = s.buttons;
+  out.handle_position[0] = s.handle_position_world.x;
+  out.handle_position[1] = s.handle_position_world.y;
+  out.handle_position[2] = s.handle_position_world.z;
 }
 
 // haptic thread: hands each tick's state to the program's callback (real-time; no allocation)
@@ -75,6 +78,7 @@ uh_session_def default_session_def() {
   uh_session_def def{};
   def.struct_size = sizeof def;
   def.collision_hz = -1.0;
+  def.proxy = -1;
   return def;
 }
 
@@ -83,7 +87,12 @@ uh_status open_session(const char* function, const controllers::Scene& scene, co
   if (scene.tools.empty())
     return fail(UH_ERROR_INVALID_ARGUMENT,
                 fmt::format("{}: {} has no tool (uh_scene_set_tool)", function, scene.source));
+  if (def.proxy < -1 || def.proxy > 1)
+    return fail(UH_ERROR_INVALID_ARGUMENT,
+                fmt::format("{}: def.proxy is {}: -1 (the scene's), 0 (the penalty path) or 1 (the proxy)", function,
+                            def.proxy));
   controllers::SessionOptions options;
+  if (def.proxy >= 0) options.proxy = def.proxy == 1;
   if (def.haptic_hz != 0.0) options.haptic_hz = def.haptic_hz;
   if (def.collision_hz >= 0.0) options.collision_hz = def.collision_hz;
   options.raise_priority = def.raise_priority != 0;

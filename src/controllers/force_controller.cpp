@@ -461,8 +461,13 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
   holding = proxy_state_.active;
   const Pose proxy = proxy_->slide(proxy_state_, world_from_handle_tool);
   rendered_proxy_ = proxy;
+  // the spring of the contact holding it (kept after release, so the spring does not stiffen
+  // while the proxy catches up with the handle), never stiffer than the passivity-clamped coupling
+  if (proxy_state_.active > 0 && proxy_state_.stiffness_n_m > 0.0) contact_spring_n_m_ = proxy_state_.stiffness_n_m;
+  const double spring = contact_spring_n_m_ > 0.0 ? std::min(coupling_.stiffness(), contact_spring_n_m_)
+                                                  : coupling_.stiffness();
   forcecomp::Wrench w;
-  w.force = coupling_.stiffness() * (proxy.position - world_from_handle_tool.position);
+  w.force = spring * (proxy.position - world_from_handle_tool.position);
   if (component_.options().mode == forcecomp::ForceMode::k6Dof)
     w.torque = coupling_.angular_stiffness() *
                forcecomp::rotation_vector(proxy.rotation * conjugate(world_from_handle_tool.rotation));

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <map>
+#include <numbers>
 #include <thread>
 #include <tuple>
 
@@ -20,6 +21,17 @@ namespace {
 
 double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The spring the proxy renders on a contact of `material` [N/m]: the gradient law's spring of a
+// round tip, 2 pi r k (docs/scenes.md, `stiffness`), r the tool's largest inner sphere (the tip of a
+// ball tool, the shaft of a stylus). 0 under the paper law, whose eps_c is no spring: the coupling's.
+double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::ContactMaterial& material,
+                        const collette::SphereTree& tool_tree) {
+  if (force.law != forcecomp::ForceLaw::kGradient) return 0.0;
+  double radius = 0.0;
+  for (const auto& leaf : tool_tree.leaves()) radius = std::max(radius, static_cast<double>(leaf.radius));
+  return 2.0 * std::numbers::pi * radius * material.stiffness;
 }
 
 // Per object of the scene: its mesh surface in metres when a tool watches it and it has a mesh
@@ -128,7 +140,10 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   if (options.multi_rate) force_options.multi_rate = *options.multi_rate;
   if (options.tick_force) force_options.tick_force = *options.tick_force;
   force_options.check_model = options.check_model;
-  if (options.proxy) force_options.proxy.enabled = *options.proxy;
+  if (options.proxy)
+    force_options.proxy.enabled = *options.proxy;
+  else if (force_options.use_coupling)
+    force_options.proxy.enabled = false;  // the proxy is the default, the coupling a choice: it wins
   if (force_options.proxy.enabled) force_options.use_coupling = false;  // the proxy is the simulated tool
   force_options.coupling.period_s = 1.0 / session->haptic_hz_;
   const std::filesystem::path cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
@@ -253,6 +268,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
       if (rig->proxy)
         rig->proxy->watch(object_ids[i], {.friction_static = material.friction_static,
                                           .friction_dynamic = material.friction_dynamic,
+                                          .stiffness_n_m = proxy_spring_n_m(tool.force, material, *tool_tree->tree),
                                           .object_texture = material.object_texture,
                                           .tool_texture = material.tool_texture,
                                           .surface = surfaces->at(i)});
@@ -271,6 +287,7 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
   }
   HapticSession& self = *session;
   self.collision_connection_ = world.on_collision().connect<&HapticSession::on_collision>(self);
+  self.step_connection_ = world.on_step().connect<&HapticSession::on_step>(self);  // after the proxies'
   self.object_ids_ = object_ids;
   self.report_.scene = scene.name;
   return session;
@@ -318,7 +335,7 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   ToolRig* rig = nullptr;
   for (auto& r : rigs_)
     if (r->tool_id == b) rig = r.get();
-  if (rig == nullptr) return;
+  if (rig == nullptr || rig->proxy) return;  // a proxy's contacts are its constraints' (on_step)
   auto& touching = rig->touching;
   if (a != ContactFrame::kEveryObject) {
     if (a < 0 || static_cast<std::size_t>(a) >= touching.size()) return;
@@ -338,6 +355,19 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   }
   for (std::size_t i = 0; i < touching.size(); ++i)
     if (now[i] == 0) contact_edge(*rig, static_cast<collette::ObjectId>(i), false, frame.time_s, 0.0, 0);
+}
+
+void HapticSession::on_step(double time_s) {
+  // collision thread, after every proxy's own step: through a proxy the tool rests on the surface
+  // (on the mesh, above the spheres), so its contact is its constraint rows in contact, not overlap
+  for (auto& rig : rigs_) {
+    if (!rig->proxy) continue;
+    const ToolProxy& proxy = *rig->proxy;
+    for (std::size_t k = 0; k < proxy.watched_count(); ++k) {
+      const std::int32_t rows = proxy.contact_rows(k);
+      contact_edge(*rig, proxy.watched_object(k), rows > 0, time_s, 0.0, rows);
+    }
+  }
 }
 
 void HapticSession::contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s,

@@ -341,9 +341,10 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
                      fmt::format("{} m is more than a quarter of step_m ({} m): the pairs beyond the step are "
                                  "not in the smoothing's sum, so it would jump as they come and go",
                                  x.smoothing_m, x.step_m));
-    if (x.enabled && o.use_coupling)
+    if (x.enabled && o.use_coupling && it->contains("enabled"))
       return r.error(p, "the proxy and force.coupling (the simulated tool of the penalty path) exclude each other");
   }
+  if (o.use_coupling) o.proxy.enabled = false;  // the proxy is the default, the coupling a choice
   return Ok{};
 }
 

@@ -101,6 +101,7 @@ ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, c
 
 void ToolProxy::bind() {
   texture_contact_.assign(watched_.size(), TextureContact{});
+  contact_rows_.assign(watched_.size(), 0);
   const std::size_t slots = smooth_.size() * watched_.size();
   surface_seen_.assign(slots, 0);
   near_surface_.reserve(slots);
@@ -283,10 +284,23 @@ ToolProxy::HoldingFriction ToolProxy::holding_friction(std::span<const forcecomp
       const ProxyContact& contact = watched_[static_cast<std::size_t>(c.tag)].contact;
       h.friction_static = std::max(h.friction_static, contact.friction_static);
       h.friction_dynamic = std::max(h.friction_dynamic, contact.friction_dynamic);
+      h.stiffness_n_m = std::max(h.stiffness_n_m, contact.stiffness_n_m);
     }
   }
   h.normal = norm(sum) > 0.0 ? normalized(sum) : Vec3{};
   return h;
+}
+
+// Per watched object, its rows in contact after the step (t, w): within a tenth of a millimetre of
+// their allowed depth at the new pose, as contact_normal counts them. The rows the step leaves
+// farther are apart, so a contact ends the step the proxy lifts off.
+void ToolProxy::count_contacts(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w) {
+  std::fill(contact_rows_.begin(), contact_rows_.end(), 0);
+  for (const forcecomp::ProxyConstraint& c : rows) {
+    const double gap_after = c.gap - dot(c.normal, t) - dot(cross(c.lever, c.normal), w);
+    if (gap_after < 1e-4 && c.tag >= 0 && static_cast<std::size_t>(c.tag) < contact_rows_.size())
+      ++contact_rows_[static_cast<std::size_t>(c.tag)];
+  }
 }
 
 // The mean normal of the pairs in contact (within a tenth of a millimetre of their allowed depth),
@@ -341,6 +355,7 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   HoldingFriction held = holding_friction(rows, step.active_index, rows.empty() ? 0 : step.active);
   out.friction_static = held.friction_static;
   out.friction_dynamic = held.friction_dynamic;
+  out.stiffness_n_m = held.stiffness_n_m;
   if (held.friction_static > 0.0) held.normal = contact_normal(rows, held.normal);
   out.contact_normal = held.normal;
   if (step.active > 0 && held.friction_static > 0.0 && norm(held.normal) > 0.0)
@@ -354,6 +369,7 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   Pose next;
   next.position = from.position + step.translation;
   next.rotation = normalized(turn * from.rotation);
+  count_contacts(rows, step.translation, turns ? step.rotation : w);
   // the constraints that hold it, carried to the new pose (met exactly there)
   out.active = 0;
   for (std::int32_t i = 0; i < step.active && !rows.empty(); ++i) {

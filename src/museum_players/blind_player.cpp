@@ -9,16 +9,17 @@
 #include <fmt/format.h>
 
 #include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/core/least_squares.hpp"
 #include "uh/core/split_mix.hpp"
 #include "uh/core/statistics.hpp"
 
 namespace uh::museum_players {
 
-using controllers::ContourPath;
-using controllers::ExploreOptions;
-using controllers::ExplorePhase;
-using controllers::ExploreSite;
-using controllers::ExploreTrace;
+using exploration::ContourPath;
+using exploration::ExploreOptions;
+using exploration::ExplorePhase;
+using exploration::ExploreSite;
+using exploration::ExploreTrace;
 
 const char* to_string(Verdict verdict) { return verdict == Verdict::genuine ? "genuine" : "forgery"; }
 
@@ -289,9 +290,9 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   for (SurveySite& site : plan_survey(world_bounds(*piece_tree->tree, piece.pose), options)) {
     site.options.max_seconds = std::max(1.0, options.max_piece_seconds - survey.simulated_s);
     scene.tool().shape.tree = site.pad ? pad : tip;
-    auto explored = controllers::explore_scene(scene, piece.name, site.options, session);
+    auto explored = exploration::explore_scene(scene, piece.name, site.options, session);
     if (!explored) return Error{fmt::format("{} ({}): {}", piece.name, site.name, explored.error().message)};
-    const controllers::ObjectExploration& e = explored->front();
+    const exploration::ObjectExploration& e = explored->front();
     if (site.name == "top") survey.material = e.estimate;
     if (site.pad)
       if (const auto k = stiffness_at_depth(e.trace, kPressReadDepthM))
@@ -339,12 +340,14 @@ std::vector<double> detrended_difference(const double* a, const double* b, std::
   }
   mx /= static_cast<double>(n);
   my /= static_cast<double>(n);
-  double sxy = 0.0, sxx = 0.0;
+  // the line's slope, fitted in the centred variables
+  std::vector<double> u(n), v(n);
   for (std::size_t i = 0; i < n; ++i) {
-    sxy += (static_cast<double>(i) - mx) * (d[i] - my);
-    sxx += (static_cast<double>(i) - mx) * (static_cast<double>(i) - mx);
+    u[i] = static_cast<double>(i) - mx;
+    v[i] = d[i] - my;
   }
-  const double slope = sxx > 0.0 ? sxy / sxx : 0.0;
+  const core::LeastSquaresFit line = core::least_squares(u, 1, v);
+  const double slope = line.coefficients.empty() ? 0.0 : line.coefficients[0];
   for (std::size_t i = 0; i < n; ++i) d[i] -= my + slope * (static_cast<double>(i) - mx);
   return d;
 }

@@ -794,6 +794,40 @@ static void test_older_caller(void) {
   uh_session_destroy(s);
 }
 
+/* The session def chooses how contact is rendered: the penalty path leaves the tool at the handle
+ * (inside the bunny at the press's deepest), the proxy keeps it on the surface above the handle
+ * (the state's handle_position says where the handle is); an unknown choice is refused by name. */
+static void test_proxy_choice(void) {
+  uh_scene_id scene = small_scene();
+  uh_session_id s = {0};
+  uh_session_def def = uh_default_session_def();
+  uh_state state;
+  const char* report = NULL;
+  int32_t proxy;
+  CHECK(def.proxy == -1); /* the scene's */
+  for (proxy = 0; proxy <= 1; ++proxy) {
+    def.proxy = proxy;
+    REQUIRE_OK(uh_session_create(scene, &def, &s));
+    REQUIRE_OK(uh_session_run_stepped(s, 0.5, 4));
+    memset(&state, 0, sizeof state);
+    state.struct_size = (uint32_t)sizeof state;
+    REQUIRE_OK(uh_session_poll(s, &state));
+    CHECK(fabs(state.handle_position[2] - 0.045) < 1e-3); /* the press's deepest */
+    if (proxy == 0) {
+      CHECK(memcmp(state.tool_position, state.handle_position, sizeof state.tool_position) == 0);
+    } else {
+      CHECK(state.tool_position[2] > state.handle_position[2] + 0.001); /* held on the surface */
+    }
+    REQUIRE_OK(uh_session_report_json(s, &report));
+    CHECK(json_number(report, "\"force\"", "max_n") > 0.5); /* pushed back, either way */
+    uh_session_destroy(s);
+  }
+  def.proxy = 2;
+  CHECK_STATUS(uh_session_create(scene, &def, &s), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "def.proxy is 2") != NULL);
+  uh_scene_destroy(scene);
+}
+
 /* Two tools added through calls, each on its own device: the left stylus presses into the bunny,
  * the right one into a ball; each contact event names its tool. */
 static void test_several_tools(void) {
@@ -871,7 +905,8 @@ int main(int argc, char** argv) {
                {"mesh_formats", test_mesh_formats},
                {"two_tools", test_two_tools},
                {"older_caller", test_older_caller},
-               {"several_tools", test_several_tools}};
+               {"several_tools", test_several_tools},
+               {"proxy_choice", test_proxy_choice}};
   size_t i;
   if (argc != 2) {
     fprintf(stderr, "usage: %s TEST\n", argv[0]);

@@ -491,6 +491,9 @@ double energy_into_hand(const SessionReport& r, double device_damping) {
 TEST(ToolProxy, RepeatedPressesPutNoEnergyIntoAReactingHand) {
   auto scene = load_scene(testing::test_assets().parent_path() / "scenes" / "bunny_hand_press.json");
   ASSERT_TRUE(scene) << scene.error().message;
+  // a hard material, so that the spring rendered is the coupling's clamp (the bound under test), not
+  // the material's own, softer spring (2 pi r k: 0.4 kN/m for this stylus at the scene's k)
+  scene->tool().force.stiffness = 1e6;
   const double b = hand_device_damping(*scene);
   const std::filesystem::path cache = testing::fresh_cache("hand_press_proxy");
   for (const double hz : {1000.0, 4000.0}) {
@@ -515,6 +518,7 @@ TEST(ToolProxy, RepeatedPressesPutNoEnergyIntoAReactingHand) {
   // measure catches whatever the mechanism dissipates
   auto too_stiff = load_scene(testing::test_assets().parent_path() / "scenes" / "bunny_hand_press_too_stiff.json");
   ASSERT_TRUE(too_stiff) << too_stiff.error().message;
+  too_stiff->tool().force.stiffness = 1e6;
   SessionOptions options;
   options.cache_dir = cache;
   options.proxy = true;
@@ -566,6 +570,57 @@ TEST(ToolProxy, AStalledCollisionThreadFadesTheSpringToZero) {
   EXPECT_GT(pushed, 20) << "the presses are pushed back while the data is fresh";
   EXPECT_GT(late, 1000);
   EXPECT_EQ(late_with_force, 0) << "force sent on data older than the watchdog's age and ramp";
+  std::filesystem::remove_all(cache);
+}
+
+// The spring a ball pressed straight down into scenes/materials_block.json's `object` feels [N/m]:
+// the slope of the force against the handle's depth over the force's middle range (0.3 to 2.5 N),
+// fitted over the descent's ticks, rendered through the proxy or the penalty path.
+double pressed_spring_n_m(const std::string& object, bool proxy, const std::filesystem::path& cache) {
+  auto scene = load_scene(testing::test_assets().parent_path() / "scenes" / "materials_block.json");
+  EXPECT_TRUE(scene) << scene.error().message;
+  if (!scene) return 0.0;
+  std::erase_if(scene->objects, [&](const SceneObject& o) { return o.name != object; });
+  scene->watch = {object};
+  // a device damped enough that the proxy's spring may reach the stiffer material's (Colgate's bound
+  // 2 b / T is 10 kN/m): the coupling's clamp, 1.5 kN/m by default, would cap it below the penalty's
+  scene->force.coupling.stiffness = 5000.0;
+  scene->force.coupling.device_damping = 5.0;
+  const double x = scene->objects[0].pose.position.x;
+  scene->tool().device.config.set("start", Vec3{x, 0.0, 0.012}).set("end", Vec3{x, 0.0, -0.004});
+  SessionOptions options;
+  options.cache_dir = cache;
+  options.proxy = proxy;
+  auto session = HapticSession::create(*scene, options);
+  EXPECT_TRUE(session) << session.error().message;
+  if (!session) return 0.0;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  auto seen = (*session)->on_haptic_tick().connect([&](const SessionState& s) {
+    const double depth = -s.handle_position_world.z, force = s.force_world.z;
+    if (s.time_s > 1.9 || force < 0.3 || force > 2.5) return;  // the descent, the force's middle range
+    n += 1, sx += depth, sy += force, sxx += depth * depth, sxy += depth * force;
+  });
+  EXPECT_TRUE((*session)->run_stepped(2.0, 1).has_value());
+  EXPECT_GT(n, 50) << object << (proxy ? ", proxy" : ", penalty") << ": the press reaches the force's middle range";
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+// A material's stiffness is felt through the proxy as through the penalty path: the proxy renders
+// the gradient law's spring of a round tip, and the reference is the penalty path's own force
+// against depth, summed from the sphere pairs' overlaps in the same run (the default material and
+// a stiffer one, which must also feel stiffer), within 20 %.
+TEST(ToolProxy, AMaterialFeelsAsStiffThroughTheProxyAsThroughThePenaltyPath) {
+  const std::filesystem::path cache = testing::fresh_cache("proxy_material");
+  double proxy_springs[2] = {};
+  int i = 0;
+  for (const char* object : {"plain", "stiff"}) {
+    const double penalty = pressed_spring_n_m(object, false, cache);
+    const double proxy = pressed_spring_n_m(object, true, cache);
+    std::printf("%s: penalty %.0f N/m, proxy %.0f N/m\n", object, penalty, proxy);
+    EXPECT_NEAR(proxy / penalty, 1.0, 0.2) << object;
+    proxy_springs[i++] = proxy;
+  }
+  EXPECT_GT(proxy_springs[1], 1.2 * proxy_springs[0]) << "the stiffer material feels stiffer";
   std::filesystem::remove_all(cache);
 }
 

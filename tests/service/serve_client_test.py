@@ -1,4 +1,4 @@
-"""`uh serve` as a script sees it (Debian's python3-websockets): the README's client flow on the
+"""`uh serve` as a script sees it (Debian's python3-websockets): the client flow of docs/cli.md on the
 default scene, an error that leaves the connection usable, and the controller's disconnect
 stopping the session for a watcher. Then `uh run --view`: a watcher sees its session, may not stop
 it, and the program ends with its report.

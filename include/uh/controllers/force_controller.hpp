@@ -223,6 +223,7 @@ class ForceController {
   ProxyState proxy_state_{};      // haptic thread: the newest proxy taken
   Pose rendered_proxy_{};         // haptic thread: it, slid towards the handle
   bool have_proxy_state_ = false;
+  double contact_spring_n_m_ = 0.0;  // haptic thread: the last holding contact's ProxyContact::stiffness_n_m
 
   // haptic thread state
   double last_tick_s_ = 0.0;

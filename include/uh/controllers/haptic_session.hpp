@@ -163,7 +163,8 @@ struct SessionState {
 
 /// Whether a contact began or ended.
 enum class ContactEventKind : std::uint8_t {
-  kBegin,  ///< the tool started to overlap the object (positive overlap volume)
+  kBegin,  ///< the tool started to overlap the object (positive overlap volume; through the proxy,
+           ///< which rests on the surface: its constraint rows with the object came into contact)
   kEnd,    ///< the overlap ended
 };
 
@@ -173,8 +174,9 @@ struct ContactEvent {
   std::int32_t object = -1;  ///< index of the object in Scene::objects
   std::int32_t tool = 0;     ///< index of the tool in Scene::tools
   double time_s = 0.0;       ///< time of the collision step that saw it, since start() [s]
-  double volume = 0.0;       ///< overlap volume of that step [m^3] (0 for kEnd)
-  std::int32_t pairs = 0;    ///< overlapping sphere pairs of that step (0 for kEnd)
+  double volume = 0.0;       ///< overlap volume of that step [m^3] (0 for kEnd; 0 through the proxy)
+  std::int32_t pairs = 0;    ///< overlapping sphere pairs of that step (0 for kEnd; through the proxy,
+                             ///< its constraint rows in contact)
 };
 
 class HapticSession {
@@ -279,6 +281,7 @@ class HapticSession {
   void take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
   void monitor(std::stop_token stop);
   void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
+  void on_step(double time_s);
   void contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s, double volume,
                     std::int32_t pairs);
   bool any_fault() const;
@@ -295,6 +298,7 @@ class HapticSession {
   std::vector<std::unique_ptr<ToolRig>> rigs_;
   SessionReport report_;
   ScopedConnection collision_connection_;
+  ScopedConnection step_connection_;
 
   static_assert(std::atomic<bool>::is_always_lock_free, "request_stop() must be async-signal-safe");
   std::atomic<bool> stop_requested_{false};

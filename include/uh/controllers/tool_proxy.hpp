@@ -41,7 +41,10 @@ namespace uh::controllers {
 
 /// Options of a ToolProxy (aggregate; scene field `force.proxy`, docs/scenes.md).
 struct ToolProxyOptions {
-  bool enabled = false;           ///< render through the proxy (the penalty path when false)
+  /// Render through the proxy, or the penalty path when false (the default until every shipped
+  /// scene's test passes on the proxy: docs/forcecomp.md, "Not yet"). A scene that enables
+  /// force.coupling gets the penalty path with the coupling unless it asks for the proxy too.
+  bool enabled = false;
   /// Most any point of the tool moves in one collision step [m] (a hand faster than step_m times
   /// the collision rate drags the proxy behind it). The world's contact margin is raised to it.
   double step_m = 0.002;
@@ -65,6 +68,11 @@ struct ProxyContact {
   /// friction cone: a stick point, breakaway at `friction_static`, sliding at `friction_dynamic`.
   double friction_static = 0.0;
   double friction_dynamic = 0.0;
+  /// The pair's stiffness as the spring the device renders while the proxy rests on it [N/m]; 0:
+  /// the coupling's. The session gives the gradient law's spring of a round tip, 2 pi r k (k the
+  /// combined material stiffness, r the tool's largest inner sphere), so a soft material feels as
+  /// soft through the proxy as through the penalty path; the passivity bound still caps it.
+  double stiffness_n_m = 0.0;
   /// The textures of the pair (`object_texture` in the object's frame, `tool_texture` in the
   /// tool's, forcecomp::texture_height): each raises the surface the proxy rests on by its height
   /// where it touches (with a mesh surface: at the contact point, the nearest row's, for all the
@@ -96,6 +104,8 @@ struct ProxyState {
   /// friction_static times how deep it presses, then trails it at friction_dynamic.
   double friction_static = 0.0;
   double friction_dynamic = 0.0;
+  /// The stiffest ProxyContact::stiffness_n_m of the contacts holding it [N/m]; 0: none given.
+  double stiffness_n_m = 0.0;
   bool sliding = false;          ///< broke away (the dynamic coefficient holds) or sticking
   /// The surface's normal the friction cone is about: the mean of the normals of every pair in
   /// contact, not only the few holding it, so that the packing's grain tilts it less [unit, world].
@@ -144,6 +154,13 @@ class ToolProxy {
   /// follows the handle at the haptic rate (zero in free space). Haptic thread; real-time safe.
   Pose slide(const ProxyState& state, const Pose& world_from_handle_tool);
 
+  /// The objects watched, in watch() order, and how many of the last step's constraint rows with
+  /// each are in contact at the proxy's new pose (0: apart). Collision thread, after on_step (an
+  /// OnStep handler bound after bind()): the session's contact events come from here.
+  std::size_t watched_count() const { return watched_.size(); }
+  collette::ObjectId watched_object(std::size_t k) const { return watched_[k].id; }
+  std::int32_t contact_rows(std::size_t k) const { return contact_rows_[k]; }
+
   ToolProxyStats stats() const;
   /// The proxy's pose. Only while the collision thread does not run (before start, after stop).
   const Pose& pose() const { return proxy_; }
@@ -157,8 +174,10 @@ class ToolProxy {
     Vec3 normal{};
     double friction_static = 0.0;
     double friction_dynamic = 0.0;
+    double stiffness_n_m = 0.0;
   };
   Vec3 contact_normal(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& holding) const;
+  void count_contacts(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w);
   HoldingFriction holding_friction(std::span<const forcecomp::ProxyConstraint> rows, const std::int32_t* active,
                                    std::int32_t count) const;
   void add_to_smooth(std::int32_t leaf, const Vec3& centre_world, double radius, const Vec3& normal, double gap,
@@ -220,6 +239,7 @@ class ToolProxy {
     Vec3 on_tool{};    // world frame
   };
   std::vector<TextureContact> texture_contact_;
+  std::vector<std::int32_t> contact_rows_;  // per watched object: rows in contact after the step
   std::int32_t constraint_count_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;

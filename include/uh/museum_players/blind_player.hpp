@@ -2,9 +2,9 @@
 /// \file
 /// The automated blind player (Phantom): tells a genuine artifact from a forgery by touch alone.
 /// It explores the piece on a simulated device in simulated time with the exploration script of
-/// `uh explore` (controllers::explore_scene: presses, strokes, contour following and taps) at
+/// `uh explore` (exploration::explore_scene: presses, strokes, contour following and taps) at
 /// sites spread over the piece, planned from the packed shape's bounds only, and reads the device's
-/// position and force trace: the material (controllers::estimate_material) and the surface its hand
+/// position and force trace: the material (exploration::estimate_material) and the surface its hand
 /// traced along each stroke and contour. It compares them with a genuine reference of the same kind,
 /// explored the same way, and calls the piece a forgery when a difference stands out of what two
 /// explorations of the reference itself differ by. It never reads which piece is which, nor the
@@ -19,10 +19,10 @@
 #include <utility>
 #include <vector>
 
-#include "uh/controllers/exploration.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/result.hpp"
 #include "uh/core/split_mix.hpp"
+#include "uh/exploration/exploration.hpp"
 #include "uh/museum/level.hpp"
 #include "uh/museum_artifacts/artifact.hpp"
 
@@ -41,7 +41,7 @@ struct SurfaceTrack {
 
 /// What the blind player read off one piece.
 struct PieceSurvey {
-  controllers::MaterialEstimate material;  ///< from the press, strokes and contour on the top
+  exploration::MaterialEstimate material;  ///< from the press, strokes and contour on the top
   /// Each pad press on the top: the force 0.8 mm past first contact over that depth [N/mm], by site
   /// ("top press 1" ..)
   std::vector<std::pair<std::string, double>> site_stiffness;

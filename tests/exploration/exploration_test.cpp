@@ -2,7 +2,7 @@
 // a plane, Coulomb friction with a breakaway, a sine grating): what they must read back is known
 // exactly, independent of the rendering that `uh explore` checks end to end (tests/cli).
 
-#include "uh/controllers/exploration.hpp"
+#include "uh/exploration/exploration.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 
 #include "uh/forcecomp/material.hpp"
 
-namespace uh::controllers {
+namespace uh::exploration {
 namespace {
 
 struct Synthetic {
@@ -259,4 +259,4 @@ TEST(Exploration, AnEmptyTraceGivesNoEstimates) {
 }
 
 }  // namespace
-}  // namespace uh::controllers
+}  // namespace uh::exploration

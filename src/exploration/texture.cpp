@@ -1,0 +1,155 @@
+// Texture: the spectrum of the normal force ripple along each stroke axis (both strokes of the
+// axis), after the breakaway (past 15 % of the stroke); the dominant spatial frequencies of the two
+// axes are the components of the texture's wave vector in the stroke plane, so period = 1 / |(f_1,
+// f_2)|, reported only where one plane wave also explains the contour's ripple (plane_wave.hpp).
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "estimators.hpp"
+#include "plan.hpp"
+#include "plane_wave.hpp"
+#include "uh/core/least_squares.hpp"
+#include "uh/core/statistics.hpp"
+
+namespace uh::exploration {
+namespace {
+
+// the share of the contour's ripple a grating's plane wave must explain to count as periodic
+constexpr double kPlaneWaveShare = 0.45;
+constexpr double kResampleM = 2.5e-5;  // resampling step [m]: 40 samples per millimetre
+
+// Power of the detrended, Hann-windowed signal y(s) (uniformly resampled) at spatial frequency f [1/m]
+struct Spectrum {
+  std::vector<double> frequency;
+  std::vector<double> power;
+};
+
+// `grid` resampled residuals over a common length; adds the power at each frequency
+void add_spectrum(const std::vector<double>& residual, double ds, Spectrum& spectrum) {
+  const std::size_t n = residual.size();
+  for (std::size_t k = 0; k < spectrum.frequency.size(); ++k) {
+    double re = 0.0, im = 0.0;
+    const double w = 2.0 * kPi * spectrum.frequency[k] * ds;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double hann = 0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(i) / static_cast<double>(n - 1));
+      re += hann * residual[i] * std::cos(w * static_cast<double>(i));
+      im += hann * residual[i] * std::sin(w * static_cast<double>(i));
+    }
+    spectrum.power[k] += re * re + im * im;
+  }
+}
+
+// The normal force over the sliding part of a stroke, resampled every `ds` metres, minus its line
+std::vector<double> ripple_of(const Slide& s, double from_m, double to_m, double ds) {
+  std::vector<double> out;
+  std::size_t j = 0;
+  for (double at = from_m; at <= to_m; at += ds) {
+    while (j + 1 < s.travel.size() && s.travel[j + 1] < at) ++j;
+    if (j + 1 >= s.travel.size()) break;
+    const double span = s.travel[j + 1] - s.travel[j];
+    const double u = span > 0.0 ? std::clamp((at - s.travel[j]) / span, 0.0, 1.0) : 0.0;
+    out.push_back(s.normal_n[j] + u * (s.normal_n[j + 1] - s.normal_n[j]));
+  }
+  if (out.size() < 16) return {};
+  // minus the least-squares cubic: what the hand's force loop and the shape's curvature add
+  // varies over the whole stroke, the texture over millimetres
+  const double half = 0.5 * static_cast<double>(out.size() - 1);
+  std::vector<double> rows;
+  rows.reserve(4 * out.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double u = (static_cast<double>(i) - half) / half;  // in [-1, 1]
+    rows.insert(rows.end(), {1.0, u, u * u, u * u * u});
+  }
+  const core::LeastSquaresFit cubic = core::least_squares(rows, 4, out);
+  if (cubic.coefficients.empty()) return {};
+  const std::vector<double>& c = cubic.coefficients;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double u = (static_cast<double>(i) - half) / half;
+    out[i] -= c[0] + u * (c[1] + u * (c[2] + u * c[3]));
+  }
+  return out;
+}
+
+// Both strokes of one axis: the summed spectrum of their ripples and the ripple's sum of squares
+struct AxisRipple {
+  Spectrum spectrum;
+  double span = 0.0;  // the window's length [m]
+  double sum_sq = 0.0;
+  std::size_t count = 0;
+};
+
+AxisRipple axis_ripple(const StrokeSlides& slides, const ExploreOptions& o, int axis) {
+  AxisRipple a;
+  const double from = 0.15 * leg_length(o, 2 * axis), to = 0.97 * leg_length(o, 2 * axis);
+  a.span = to - from;
+  for (double f = 2.0 / a.span; f <= 1.0 / (8.0 * kResampleM); f += 1.0 / (16.0 * a.span))
+    a.spectrum.frequency.push_back(f);
+  a.spectrum.power.assign(a.spectrum.frequency.size(), 0.0);
+  for (int leg = 2 * axis; leg < 2 * axis + 2; ++leg) {
+    const std::vector<double> r = ripple_of(slides.legs[leg], from, to, kResampleM);
+    if (r.empty()) continue;
+    for (double v : r) a.sum_sq += v * v;
+    a.count += r.size();
+    add_spectrum(r, kResampleM, a.spectrum);
+  }
+  return a;
+}
+
+// The strongest local maximum with at least 2.5 periods in the window (slower variation left over
+// by the detrending leaks into the lowest frequencies and is no texture), between the grid points;
+// empty unless it stands out of the packing's own grain by an order of magnitude and more
+std::optional<double> spectral_peak(const Spectrum& spectrum, double span) {
+  if (spectrum.power.size() < 3) return std::nullopt;
+  std::size_t peak = 0;
+  for (std::size_t k = 1; k + 1 < spectrum.power.size(); ++k) {
+    if (spectrum.frequency[k] * span < 2.5) continue;
+    if (spectrum.power[k] < spectrum.power[k - 1] || spectrum.power[k] < spectrum.power[k + 1]) continue;
+    if (peak == 0 || spectrum.power[k] > spectrum.power[peak]) peak = k;
+  }
+  const double background = core::median(spectrum.power);
+  if (!(spectrum.power[peak] > 30.0 * background) || peak == 0 || peak + 1 >= spectrum.power.size())
+    return std::nullopt;
+  // a parabola through the three grid points around the peak
+  const double p0 = spectrum.power[peak - 1], p1 = spectrum.power[peak], p2 = spectrum.power[peak + 1];
+  const double denom = p0 - 2.0 * p1 + p2;
+  const double shift = denom != 0.0 ? 0.5 * (p0 - p2) / denom : 0.0;
+  return spectrum.frequency[peak] + shift * (spectrum.frequency[1] - spectrum.frequency[0]);
+}
+
+}  // namespace
+
+void estimate_texture(const StrokeSlides& slides, const ExploreTrace& trace, MaterialEstimate& e) {
+  const ExploreOptions& o = trace.options;
+  double sum_sq = 0.0;
+  std::size_t count = 0;
+  double axis_frequency[2] = {0.0, 0.0};  // [1/m], 0 = no peak along that axis
+  for (int axis = 0; axis < 2; ++axis) {
+    const AxisRipple a = axis_ripple(slides, o, axis);
+    sum_sq += a.sum_sq;
+    count += a.count;
+    if (a.count == 0) continue;
+    e.ripple_axis_n[axis] = std::sqrt(a.sum_sq / static_cast<double>(a.count));
+    // a ripple under 0.5 % of the stroke force is the hand's own wobble, not a texture
+    if (std::sqrt(a.sum_sq / static_cast<double>(a.count)) < 0.005 * o.stroke_force_n) continue;
+    if (const auto f = spectral_peak(a.spectrum, a.span)) {
+      e.period_axis_m[axis] = 1.0 / *f;
+      axis_frequency[axis] = *f;
+    }
+  }
+  if (count > 0) e.texture_ripple_n = std::sqrt(sum_sq / static_cast<double>(count));
+  if (axis_frequency[0] > 0.0 || axis_frequency[1] > 0.0) {
+    // a grating is one plane wave over the whole surface: the wave vector the strokes found must
+    // also explain the ripple along the contour, a third path; a random texture (or a packing's
+    // grain) has its strongest component differ from path to path, and then has no period
+    const double f_low = 2.5 / (0.82 * std::min(leg_length(o, 0), leg_length(o, 2)));
+    const PlaneWaveFit fit = fit_plane_wave(slides.contour, trace.stroke_axes, axis_frequency, f_low,
+                                            e.stiffness_n_per_mm.value_or(0.0) * 1e3, e.ripple_axis_n);
+    e.texture_wave_share = fit.share;
+    if (fit.share >= kPlaneWaveShare) e.texture_period_m = 1.0 / std::hypot(fit.f1, fit.f2);
+  }
+}
+
+}  // namespace uh::exploration
