@@ -17,14 +17,15 @@ python3 - "$UH" "$uh_root" "$out" "$seconds" <<'EOF'
 import json, math, subprocess, sys
 uh, root, out, seconds = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
 
+sys.path.insert(0, f"{root}/scripts")
+from uh_mesh import write_mesh
+
 def plate_obj(path, thickness_mm):
     h = thickness_mm / 20.0  # half thickness in cm units
     v = [(x, y, z) for z in (-h, h) for (x, y) in ((-3, -3), (3, -3), (3, 3), (-3, 3))]
-    f = [(1, 3, 2), (1, 4, 3), (5, 6, 7), (5, 7, 8), (1, 2, 6), (1, 6, 5), (4, 8, 7), (4, 7, 3),
-         (1, 5, 8), (1, 8, 4), (2, 3, 7), (2, 7, 6)]
-    with open(path, "w") as o:
-        o.writelines(f"v {x} {y} {z}\n" for x, y, z in v)
-        o.writelines(f"f {a} {b} {c}\n" for a, b, c in f)
+    f = [(0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7), (0, 1, 5), (0, 5, 4), (3, 7, 6), (3, 6, 2),
+         (0, 4, 7), (0, 7, 3), (1, 2, 6), (1, 6, 5)]
+    write_mesh(path, v, f, f"a {thickness_mm} mm plate", uh=uh)
 
 base = json.load(open(f"{root}/scenes/thin_wall.json"))
 print("| plate | tilt | hand | pull | path | ball ends (mm from the mid-plane) | largest force [N] |")

@@ -1,7 +1,6 @@
 // uh explore SCENE [--object NAME] [--json] [--plot OUT.png] [--seed N]
 #include <cmath>
 #include <cstdio>
-#include <memory>
 #include <optional>
 #include <string>
 
@@ -46,17 +45,10 @@ int explore(const ExploreArgs& args) {
   controllers::SessionOptions session;
   session.cache_dir = controllers::default_cache_dir();
   if (!args.proxy.empty()) session.proxy = args.proxy == "on";
-  std::unique_ptr<ProgressBar> bar;
-  std::string bar_label;
-  session.build_progress = [&](const std::string& what, double fraction) {
-    if (what != bar_label) {
-      bar = std::make_unique<ProgressBar>(what);
-      bar_label = what;
-    }
-    bar->update(fraction);
-  };
+  StagedProgress bars;
+  session.build_progress = bars.callback();
   auto explored = exploration::explore_scene(*scene, args.object, options, session);
-  bar.reset();
+  bars.finish();
   if (!explored) return fail(explored.error().message);
   if (!args.plot.empty())
     if (auto plotted = write_exploration_plot(scene->name, *explored, args.plot); !plotted)

@@ -3,7 +3,6 @@
 // uh museum judge [--level easy|hard] [--seed N] [--kinds K,...] [--json]
 // uh museum play: cmd_museum_play.cpp
 #include <cstdio>
-#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -94,11 +93,10 @@ int museum_judge(const MuseumJudgeArgs& args) {
       options.kinds.push_back(*kind);
     }
   }
-  std::unique_ptr<ProgressBar> bar = std::make_unique<ProgressBar>("judging");
-  options.progress = [&bar](const std::string&, double fraction) { bar->update(fraction); };
+  ProgressBar bar("judging");  // one bar over all of the judge's stages
+  options.progress = [&bar](const std::string&, double fraction) { bar.update(fraction); };
   auto report = museum_players::run_judge(options);
-  bar->finish();
-  bar.reset();
+  bar.finish();
   if (!report) return fail(report.error().message);
   if (args.json) {
     nlohmann::json pairs = nlohmann::json::array();

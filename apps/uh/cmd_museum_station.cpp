@@ -100,8 +100,7 @@ int museum_station_run(const StationArgs& args) {
                    made.error().message.c_str());
     }
   }
-  std::unique_ptr<ProgressBar> bar;
-  std::string bar_label;
+  StagedProgress bars;
   museum_station::StationOptions options;
   options.device = args.device;
   options.trace = args.trace;
@@ -109,13 +108,7 @@ int museum_station_run(const StationArgs& args) {
     std::printf("  %s\n", caption.c_str());
     std::fflush(stdout);
   };
-  options.build_progress = [&](const std::string& what, double fraction) {
-    if (what != bar_label) {
-      bar = std::make_unique<ProgressBar>(what);
-      bar_label = what;
-    }
-    bar->update(fraction);
-  };
+  options.build_progress = bars.callback();
   auto station = museum_station::Station::create((*link)->welcome(), options, std::move(sound), link->get());
   if (!station) return fail(station.error().message);
   std::printf("uh museum station: Phantom at %s, %s%s\n%s", args.server.c_str(),

@@ -167,17 +167,10 @@ int run_session(const RunArgs& args) {
   options.check_model = args.check_model;
   options.raise_priority = !args.no_realtime;
   options.cache_dir = cache;
-  std::unique_ptr<ProgressBar> bar;
-  std::string bar_label;
-  options.build_progress = [&](const std::string& what, double fraction) {
-    if (what != bar_label) {
-      bar = std::make_unique<ProgressBar>(what);
-      bar_label = what;
-    }
-    bar->update(fraction);
-  };
+  StagedProgress bars;
+  options.build_progress = bars.callback();
   auto session = controllers::HapticSession::create(*scene, options);
-  bar.reset();
+  bars.finish();
   if (!session) return fail(session.error().message);
 
   // the trace replaces an earlier file only once it is complete

@@ -21,6 +21,7 @@ using CommandRunner = std::function<int()>;
 void add_devices_command(CLI::App& app, CommandRunner& runner);
 void add_explore_command(CLI::App& app, CommandRunner& runner);
 void add_ist_commands(CLI::App& app, CommandRunner& runner);
+void add_mesh_command(CLI::App& app, CommandRunner& runner);
 void add_query_command(CLI::App& app, CommandRunner& runner);
 void add_run_command(CLI::App& app, CommandRunner& runner);
 void add_serve_command(CLI::App& app, CommandRunner& runner);

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   uh::cli::add_devices_command(app, runner);
   uh::cli::add_explore_command(app, runner);
   uh::cli::add_ist_commands(app, runner);
+  uh::cli::add_mesh_command(app, runner);
   uh::cli::add_query_command(app, runner);
   uh::cli::add_run_command(app, runner);
   uh::cli::add_serve_command(app, runner);

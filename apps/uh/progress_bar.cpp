@@ -43,4 +43,13 @@ void ProgressBar::finish() {
   std::fputc('\n', stderr);
 }
 
+void StagedProgress::update(const std::string& stage, double fraction) {
+  if (!bar_ || stage != stage_) {
+    bar_.reset();  // ends the stage before with its line, before the next bar draws
+    bar_ = std::make_unique<ProgressBar>(stage);
+    stage_ = stage;
+  }
+  bar_->update(fraction);
+}
+
 }  // namespace uh::cli

@@ -6,14 +6,17 @@
 
 #include <algorithm>
 #include <cassert>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "uh/core/slot_table.hpp"
 
 namespace uh::audio {
 namespace {
 
 // enough for every guard, the contact loop, speech and overlapping earcons
-constexpr std::size_t kMaxVoices = 64;
+constexpr std::uint32_t kMaxVoices = 64;
 
 }  // namespace
 
@@ -34,10 +37,9 @@ const char* to_string(Channel channel) {
 }
 
 struct AudioScene::Impl {
+  // a voice's slot keeps its OpenAL source when the voice ends, for the next voice in that slot
   struct Voice {
     ALuint source = 0;
-    std::uint32_t generation = 0;
-    bool active = false;
     Channel channel = Channel::earcons;
     double gain = 1.0;
   };
@@ -49,15 +51,17 @@ struct AudioScene::Impl {
   bool hrtf = false;
   int rate_hz = 0;
   std::vector<ALuint> buffers{};
-  std::vector<Voice> voices{};
+  core::SlotTable<Voice> voices{kMaxVoices};
   double volumes[kChannelCount] = {1.0, 1.0, 1.0, 1.0, 1.0};
   double duck = 1.0;
 
   ~Impl() {
     if (context != nullptr) {
       alcMakeContextCurrent(context);
-      for (Voice& v : voices) alSourceStop(v.source);
-      for (Voice& v : voices) alDeleteSources(1, &v.source);
+      for (std::uint32_t i = 0; i < voices.slots_used(); ++i) {
+        alSourceStop(voices.item(i).source);
+        alDeleteSources(1, &voices.item(i).source);
+      }
       if (!buffers.empty()) alDeleteBuffers(static_cast<ALsizei>(buffers.size()), buffers.data());
       alcMakeContextCurrent(nullptr);
       alcDestroyContext(context);
@@ -68,10 +72,17 @@ struct AudioScene::Impl {
   // OpenAL's calls act on the current context, one per process: every entry point makes ours current
   void current() const { alcMakeContextCurrent(context); }
 
-  Voice* find(VoiceId id) {
-    if (id.index >= voices.size()) return nullptr;
-    Voice& v = voices[id.index];
-    return v.active && v.generation == id.generation ? &v : nullptr;
+  Voice* find(VoiceId id) { return voices.find({id.index, id.generation}); }
+
+  // frees the slots of the voices whose clip ended
+  void release_ended() {
+    voices.for_each_live([this](core::SlotId id, const Voice& v) {
+      if (!is_playing(v)) voices.release(id);
+    });
+  }
+
+  void apply_gains() {
+    voices.for_each_live([this](core::SlotId, const Voice& v) { apply_gain(v); });
   }
 
   bool is_playing(const Voice& v) const {
@@ -173,27 +184,20 @@ Result<VoiceId> AudioScene::play(SoundId sound, const VoiceDef& def) {
     return Error{"audio: no sound " + std::to_string(sound.index) + " was loaded"};
   impl_->current();
   // reuse a voice whose clip ended, else open a new one
-  std::size_t slot = impl_->voices.size();
-  for (std::size_t i = 0; i < impl_->voices.size(); ++i) {
-    Impl::Voice& v = impl_->voices[i];
-    if (!v.active || !impl_->is_playing(v)) {
-      slot = i;
-      break;
+  impl_->release_ended();
+  const std::optional<core::SlotId> id = impl_->voices.occupy();
+  if (!id) return Error{"audio: all " + std::to_string(kMaxVoices) + " voices are playing"};
+  Impl::Voice& v = impl_->voices.item(id->index);
+  if (v.source == 0) {
+    alGetError();
+    alGenSources(1, &v.source);
+    if (alGetError() != AL_NO_ERROR) {
+      v.source = 0;
+      impl_->voices.release(*id);
+      return Error{"audio: OpenAL has no source left"};
     }
   }
-  if (slot == impl_->voices.size()) {
-    if (impl_->voices.size() >= kMaxVoices)
-      return Error{"audio: all " + std::to_string(kMaxVoices) + " voices are playing"};
-    Impl::Voice fresh;
-    alGetError();
-    alGenSources(1, &fresh.source);
-    if (alGetError() != AL_NO_ERROR) return Error{"audio: OpenAL has no source left"};
-    impl_->voices.push_back(fresh);
-  }
-  Impl::Voice& v = impl_->voices[slot];
   alSourceStop(v.source);
-  v.generation += 1;
-  v.active = true;
   v.channel = def.channel;
   v.gain = def.gain;
   alSourcei(v.source, AL_BUFFER, static_cast<ALint>(impl_->buffers[sound.index]));
@@ -205,7 +209,7 @@ Result<VoiceId> AudioScene::play(SoundId sound, const VoiceDef& def) {
   alSourcef(v.source, AL_PITCH, static_cast<ALfloat>(std::clamp(def.pitch, 0.25, 4.0)));
   impl_->apply_gain(v);
   alSourcePlay(v.source);
-  return VoiceId{static_cast<std::uint32_t>(slot), v.generation};
+  return VoiceId{id->index, id->generation};
 }
 
 void AudioScene::set_position(VoiceId voice, Vec3 p) {
@@ -234,7 +238,7 @@ void AudioScene::stop(VoiceId voice) {
   impl_->current();
   if (Impl::Voice* v = impl_->find(voice)) {
     alSourceStop(v->source);
-    v->active = false;
+    impl_->voices.release({voice.index, voice.generation});
   }
 }
 
@@ -257,9 +261,7 @@ void AudioScene::set_listener(Vec3 position, Vec3 forward, Vec3 up) {
 void AudioScene::set_volume(Channel channel, double volume) {
   impl_->volumes[static_cast<int>(channel)] = std::clamp(volume, 0.0, 1.0);
   impl_->current();
-  for (const Impl::Voice& v : impl_->voices) {
-    if (v.active) impl_->apply_gain(v);
-  }
+  impl_->apply_gains();
 }
 
 double AudioScene::volume(Channel channel) const { return impl_->volumes[static_cast<int>(channel)]; }
@@ -268,11 +270,10 @@ double AudioScene::duck_factor() const { return impl_->duck; }
 
 void AudioScene::update(double dt_s) {
   impl_->current();
+  impl_->release_ended();
   bool speaking = false;
-  for (Impl::Voice& v : impl_->voices) {
-    if (v.active && !impl_->is_playing(v)) v.active = false;  // its clip ended
-    speaking = speaking || (v.active && v.channel == Channel::speech);
-  }
+  impl_->voices.for_each_live(
+      [&speaking](core::SlotId, const Impl::Voice& v) { speaking = speaking || v.channel == Channel::speech; });
   // a linear ramp between 1 and duck_gain over duck_ramp_s, both ways
   const double target = speaking ? impl_->def.duck_gain : 1.0;
   const double span = 1.0 - impl_->def.duck_gain;
@@ -282,9 +283,7 @@ void AudioScene::update(double dt_s) {
     impl_->duck = std::max(target, impl_->duck - step);
   else
     impl_->duck = std::min(target, impl_->duck + step);
-  for (const Impl::Voice& v : impl_->voices) {
-    if (v.active) impl_->apply_gain(v);
-  }
+  impl_->apply_gains();
 }
 
 void AudioScene::render(std::span<float> interleaved_stereo) {

@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <random>
+
+#include "uh/core/split_mix.hpp"
 
 namespace uh::audio {
 
@@ -32,10 +33,9 @@ Sound synthesize_notes(std::span<const Note> notes, int sample_rate_hz) {
 Sound synthesize_contact_loop(const ContactTimbre& timbre, int sample_rate_hz) {
   Sound sound{.sample_rate_hz = sample_rate_hz};
   const auto count = static_cast<std::size_t>(std::max(0.05, timbre.seconds) * sample_rate_hz);
-  std::mt19937 random(timbre.seed);
-  std::normal_distribution<float> white(0.0f, 1.0f);
+  core::SplitMix64 random{timbre.seed};
   std::vector<float> noise(count);
-  for (float& x : noise) x = white(random);
+  for (float& x : noise) x = static_cast<float>(random.normal());
 
   // a one-pole low-pass: polished surfaces are dull (cutoff ~300 Hz), grainy ones hiss (~6 kHz)
   const double roughness = std::clamp(timbre.roughness, 0.0, 1.0);

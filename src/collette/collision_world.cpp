@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
@@ -22,6 +23,7 @@ std::int32_t slot_of(std::int32_t id) {
   return static_cast<std::int32_t>(static_cast<std::uint32_t>(id) & kSlotMask);
 }
 std::uint32_t generation_of(std::int32_t id) { return static_cast<std::uint32_t>(id) >> kSlotBits; }
+core::SlotId slot_id(std::int32_t id) { return {static_cast<std::uint32_t>(slot_of(id)), generation_of(id)}; }
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -99,45 +101,32 @@ CollisionWorld::~CollisionWorld() {
 
 template <typename T>
 CollisionWorld::SlotTable<T>::SlotTable(int capacity)
-    : slots_(new Slot[static_cast<std::size_t>(capacity)]), capacity_(capacity) {
-  free_.reserve(static_cast<std::size_t>(capacity));
-}
+    : slots_(static_cast<std::uint32_t>(capacity), kGenerationMask, /*first_generation=*/0) {}
 
 template <typename T>
 std::int32_t CollisionWorld::SlotTable<T>::next_id() const {
-  const std::int32_t slot = !free_.empty() ? free_.back() : used_ < capacity_ ? used_ : -1;
-  return slot < 0 ? -1 : make_id(slot, generation(slot));
+  const std::optional<core::SlotId> id = slots_.next_id();
+  return id ? make_id(static_cast<std::int32_t>(id->index), id->generation) : -1;
 }
 
 template <typename T>
 void CollisionWorld::SlotTable<T>::occupy(T* item) {
-  const std::int32_t slot = slot_of(next_id());
-  if (!free_.empty())
-    free_.pop_back();
-  else
-    ++used_;
-  slots_[static_cast<std::size_t>(slot)].item.store(item, std::memory_order_release);
-  ++count_;
+  const std::optional<core::SlotId> id = slots_.occupy();
+  slots_.item(id->index).store(item, std::memory_order_release);
 }
 
 template <typename T>
 void CollisionWorld::SlotTable<T>::release(std::int32_t id) {
-  Slot& s = slots_[static_cast<std::size_t>(slot_of(id))];
-  s.item.store(nullptr, std::memory_order_release);
-  s.generation.store((generation_of(id) + 1) & kGenerationMask, std::memory_order_release);
-  free_.push_back(slot_of(id));
-  --count_;
+  slots_.item(static_cast<std::uint32_t>(slot_of(id))).store(nullptr, std::memory_order_release);
+  slots_.release(slot_id(id));
 }
 
 template <typename T>
 T* CollisionWorld::SlotTable<T>::find(std::int32_t id) const {
-  if (id < 0 || slot_of(id) >= used_) return nullptr;
-  const Slot& slot = slots_[static_cast<std::size_t>(slot_of(id))];
-  if (slot.generation.load(std::memory_order_acquire) != generation_of(id)) return nullptr;
-  T* item = slot.item.load(std::memory_order_acquire);
+  if (id < 0 || !slots_.is_live(slot_id(id))) return nullptr;
+  T* item = slots_.item(static_cast<std::uint32_t>(slot_of(id))).load(std::memory_order_acquire);
   // released meanwhile (the slot's generation moved on): not this id's item
-  if (slot.generation.load(std::memory_order_acquire) != generation_of(id)) return nullptr;
-  return item;
+  return slots_.is_live(slot_id(id)) ? item : nullptr;
 }
 
 CollisionWorld::Object* CollisionWorld::find_object(ObjectId id) const { return objects_by_id_.find(id); }

@@ -149,12 +149,9 @@ std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t i) {
   return i;
 }
 
-}  // namespace
-
-Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& options) {
+// Refuses an empty mesh, an index out of range and a non-finite coordinate.
+Status check_mesh_input(const TriangleMesh& mesh) {
   const std::string& name = mesh.source_name;
-  MeshReport report{};
-  report.input_vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
   if (mesh.triangles.empty() || mesh.vertices.empty()) {
     return Error{
         fmt::format("{}: mesh is empty: {} vertices, {} triangles (a closed triangle mesh is required)", name,
@@ -171,20 +168,26 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
   for (const Vec3& v : mesh.vertices) {
     if (!is_finite(v)) return Error{fmt::format("{}: mesh has a vertex with a non-finite coordinate", name)};
   }
-  const double diag = bbox_diagonal(mesh.vertices);
+  return Ok{};
+}
 
-  // weld: every index now names the representative of its cluster in the input array
-  const std::vector<std::int32_t> map = weld_map(mesh.vertices, options.weld_tolerance * diag);
+// Welds vertices closer than `tolerance`: every index then names the representative of its
+// cluster in the input array. Returns how many vertices were merged away.
+std::int64_t weld_vertices(TriangleMesh& mesh, double tolerance) {
+  const std::vector<std::int32_t> map = weld_map(mesh.vertices, tolerance);
   for (auto& t : mesh.triangles) {
     for (std::int32_t& i : t) i = map[static_cast<std::size_t>(i)];
   }
   std::int64_t distinct_inputs = 0;
   for (std::size_t i = 0; i < map.size(); ++i)
     distinct_inputs += (map[i] == static_cast<std::int32_t>(i)) ? 1 : 0;
-  report.welded_vertices = report.input_vertex_count - distinct_inputs;
+  return static_cast<std::int64_t>(mesh.vertices.size()) - distinct_inputs;
+}
 
-  // degenerate faces: repeated vertices after welding, or (near) zero area. Unrepaired, they are
-  // kept out of the edge counts so that one bad face is reported once.
+// Degenerate faces (repeated vertices after welding, or (near) zero area) and duplicate faces:
+// counted in `report`, dropped when repairing, else marked in the returned flags so that the edge
+// counts leave them out and one bad face is reported once.
+std::vector<char> mark_bad_faces(TriangleMesh& mesh, const MeshLoadOptions& options, double diag, MeshReport& report) {
   std::vector<char> skip(mesh.triangles.size(), 0);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const auto& t = mesh.triangles[f];
@@ -207,8 +210,11 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     skip.assign(kept, 0);
     report.repaired = report.degenerate_faces + report.duplicate_faces > 0;
   }
+  return skip;
+}
 
-  // drop vertices no triangle uses and number the rest in order of first use
+// Drops the vertices no triangle uses and numbers the rest in order of first use.
+void compact_vertices(TriangleMesh& mesh) {
   std::vector<std::int32_t> compact(mesh.vertices.size(), -1);
   std::vector<Vec3> vertices;
   for (auto& t : mesh.triangles) {
@@ -222,14 +228,11 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     }
   }
   mesh.vertices = std::move(vertices);
-  report.triangle_count = static_cast<std::int64_t>(mesh.triangles.size());
-  report.vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
-  if (mesh.triangles.empty()) {
-    return Error{fmt::format("{}: mesh is empty after dropping {} degenerate and {} duplicate faces", name,
-                             report.degenerate_faces, report.duplicate_faces)};
-  }
+}
 
-  // edge use counts and directions, by sorting (deterministic, no hashing)
+// Edge use counts and directions, by sorting (deterministic, no hashing), into the report's
+// boundary, non-manifold and inconsistent edges and its connected components.
+void count_edges(const TriangleMesh& mesh, const std::vector<char>& skip, MeshReport& report) {
   struct EdgeUse {
     std::uint64_t key;
     std::int32_t face;
@@ -273,7 +276,11 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
     report.components +=
         (find_root(parent, static_cast<std::int32_t>(f)) == static_cast<std::int32_t>(f)) ? 1 : 0;
   }
+}
 
+// Refuses a mesh that is open (beyond what allow_open accepts), not 2-manifold, left with
+// unrepaired bad faces, or inconsistently oriented, saying which and the counts.
+Status check_topology(const std::string& name, const MeshReport& report, const MeshLoadOptions& options) {
   const bool open_ok = options.allow_open && report.boundary_edges <= options.max_open_boundary_edges;
   const bool unrepaired = !options.repair && report.degenerate_faces + report.duplicate_faces > 0;
   if ((report.boundary_edges > 0 && !open_ok) || report.non_manifold_edges > 0 || unrepaired) {
@@ -301,8 +308,31 @@ Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& opt
                     "same way (their normals disagree); fix the winding in a modelling tool",
                     name, report.inconsistent_edges)};
   }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<TriangleMesh> validate_mesh(TriangleMesh mesh, const MeshLoadOptions& options) {
+  const std::string& name = mesh.source_name;
+  MeshReport report{};
+  report.input_vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
+  if (auto checked = check_mesh_input(mesh); !checked) return checked.error();
+  const double diag = bbox_diagonal(mesh.vertices);
+  report.welded_vertices = weld_vertices(mesh, options.weld_tolerance * diag);
+  const std::vector<char> skip = mark_bad_faces(mesh, options, diag, report);
+  compact_vertices(mesh);
+  report.triangle_count = static_cast<std::int64_t>(mesh.triangles.size());
+  report.vertex_count = static_cast<std::int64_t>(mesh.vertices.size());
+  if (mesh.triangles.empty()) {
+    return Error{fmt::format("{}: mesh is empty after dropping {} degenerate and {} duplicate faces", name,
+                             report.degenerate_faces, report.duplicate_faces)};
+  }
+  count_edges(mesh, skip, report);
+  if (auto checked = check_topology(name, report, options); !checked) return checked.error();
   report.assumed_open = report.boundary_edges > 0;
 
+  // outward normals: a mesh wound inside out encloses a negative volume
   double volume = mesh_volume(mesh);
   if (volume < 0.0) {
     for (auto& t : mesh.triangles) std::swap(t[1], t[2]);

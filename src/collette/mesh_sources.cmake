@@ -4,6 +4,7 @@ list(APPEND UH_COLLETTE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/triangle_bvh.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_import.cpp
   ${CMAKE_CURRENT_LIST_DIR}/obj_stl_reader.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mesh_json.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_inside.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sphere_grid.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sphere_packing.cpp

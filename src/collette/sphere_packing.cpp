@@ -178,20 +178,18 @@ double measure_max_gap(const TriangleMesh& mesh, const std::vector<Sphere>& sphe
   return gap;
 }
 
-Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  Progress progress(options.progress);
-  progress.report(0.0);
+namespace {
+
+Status check_mesh_to_pack(const TriangleMesh& mesh) {
   const std::string& name = mesh.source_name;
   if (mesh.triangles.empty()) return Error{fmt::format("{}: cannot pack spheres into an empty mesh", name)};
   if (!mesh.report.closed_manifold() && !mesh.report.assumed_open) {
     return Error{fmt::format("{}: cannot pack spheres: the mesh is not closed and 2-manifold (validate it first)", name)};
   }
-  // open meshes are packed as if their holes were closed by flat fans
-  const TriangleMesh capped = mesh.report.assumed_open ? cap_holes(mesh) : TriangleMesh{};
-  const TriangleMesh& solid = mesh.report.assumed_open ? capped : mesh;
-  const double volume = mesh_volume(solid);
-  if (!(volume > 0.0)) return Error{fmt::format("{}: cannot pack spheres: the mesh encloses no volume ({})", name, volume)};
+  return Ok{};
+}
+
+Status check_packing_options(const std::string& name, const PackingOptions& options) {
   if (options.target_sphere_count < 0 || options.voxel_size < 0.0 || !std::isfinite(options.voxel_size)) {
     return Error{fmt::format("{}: invalid packing options (negative sphere count or voxel size)", name)};
   }
@@ -199,274 +197,371 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
     return Error{fmt::format("{}: invalid packing options (the largest sphere radius must be >= 0, got {})",
                              name, options.max_radius)};
   }
-  const std::int64_t target = options.target_sphere_count;
-  double h = options.voxel_size;
-  if (h == 0.0) {
-    const auto n = static_cast<double>(target > 0 ? target : kDefaultAutoCount);
-    h = std::cbrt(volume / n) * kAutoVoxelFactor;
-  }
-  const Aabb box = mesh_bounds(mesh);
-  const Vec3 origin = box.min - Vec3{h, h, h};
-  const Vec3 ext = box.max - box.min;
-  const std::int64_t nx = static_cast<std::int64_t>(std::ceil(ext.x / h)) + 2;
-  const std::int64_t ny = static_cast<std::int64_t>(std::ceil(ext.y / h)) + 2;
-  const std::int64_t nz = static_cast<std::int64_t>(std::ceil(ext.z / h)) + 2;
-  if (static_cast<double>(nx) * static_cast<double>(ny) * static_cast<double>(nz) > static_cast<double>(kMaxGridVoxels)) {
-    return Error{fmt::format("{}: voxel size {} needs a {}x{}x{} grid, more than {} voxels; use a larger voxel size",
-                             name, h, nx, ny, nz, kMaxGridVoxels)};
-  }
-  const std::int64_t grid_size = nx * ny * nz;
-  auto centre = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+  return Ok{};
+}
+
+// The voxel grid around the mesh, one voxel beyond its bounds on every side: cell (i, j, k) is
+// number i + nx (j + ny k), its centre origin + (i + 1/2, j + 1/2, k + 1/2) h.
+struct VoxelGrid {
+  Aabb bounds{};
+  Vec3 origin{};
+  double h = 0.0;
+  std::int64_t nx = 0, ny = 0, nz = 0;
+
+  std::int64_t size() const { return nx * ny * nz; }
+  std::int64_t cell(std::int64_t i, std::int64_t j, std::int64_t k) const { return i + nx * (j + ny * k); }
+  Vec3 centre(std::int64_t i, std::int64_t j, std::int64_t k) const {
     return Vec3{origin.x + (static_cast<double>(i) + 0.5) * h, origin.y + (static_cast<double>(j) + 0.5) * h,
                 origin.z + (static_cast<double>(k) + 0.5) * h};
-  };
+  }
+  Vec3 centre(std::int64_t g) const { return centre(g % nx, (g / nx) % ny, g / (nx * ny)); }
+  double diagonal() const { return norm(bounds.max - bounds.min); }
+};
 
-  const detail::TriangleBvh bvh(solid.vertices, solid.triangles);
+// The grid at the options' voxel size (automatic: from the volume per sphere), or why it is too large.
+Result<VoxelGrid> make_voxel_grid(const TriangleMesh& mesh, double volume, const PackingOptions& options) {
+  const std::int64_t target = options.target_sphere_count;
+  VoxelGrid grid;
+  grid.h = options.voxel_size;
+  if (grid.h == 0.0) {
+    const auto n = static_cast<double>(target > 0 ? target : kDefaultAutoCount);
+    grid.h = std::cbrt(volume / n) * kAutoVoxelFactor;
+  }
+  const double h = grid.h;
+  grid.bounds = mesh_bounds(mesh);
+  grid.origin = grid.bounds.min - Vec3{h, h, h};
+  const Vec3 ext = grid.bounds.max - grid.bounds.min;
+  grid.nx = static_cast<std::int64_t>(std::ceil(ext.x / h)) + 2;
+  grid.ny = static_cast<std::int64_t>(std::ceil(ext.y / h)) + 2;
+  grid.nz = static_cast<std::int64_t>(std::ceil(ext.z / h)) + 2;
+  if (static_cast<double>(grid.nx) * static_cast<double>(grid.ny) * static_cast<double>(grid.nz) >
+      static_cast<double>(kMaxGridVoxels)) {
+    return Error{fmt::format("{}: voxel size {} needs a {}x{}x{} grid, more than {} voxels; use a larger voxel size",
+                             mesh.source_name, h, grid.nx, grid.ny, grid.nz, kMaxGridVoxels)};
+  }
+  return grid;
+}
 
-  // 1. classify voxel centres row by row: one ray along +x per (j, k) row, crossings sorted;
-  // the winding number at a voxel is minus the sum of the crossing signs before it (the ray
-  // starts outside). Winding instead of parity keeps interpenetrating closed shells inside.
-  // Rows whose ray grazes an edge or vertex (signs not summing to zero, coincident crossings)
-  // fall back to a three-ray vote per voxel.
-  std::vector<std::int32_t> interior_of(static_cast<std::size_t>(grid_size), -1);
-  std::vector<std::int64_t> interior_cell;
+// The voxels whose centre is inside the mesh, numbered in grid order.
+struct Interior {
+  std::vector<std::int32_t> id_of_cell;  // -1 outside
+  std::vector<std::int64_t> cell_of_id;
+  std::int64_t count() const { return static_cast<std::int64_t>(cell_of_id.size()); }
+};
+
+// Classifies row (j, k) from one ray along +x whose crossings `hits` returned sorted: the winding
+// number at a voxel is minus the sum of the crossing signs before it (the ray starts outside).
+// Winding instead of parity keeps interpenetrating closed shells inside. A row whose ray grazes an
+// edge or vertex (signs not summing to zero, coincident crossings) falls back to a three-ray vote
+// per voxel.
+void classify_row(const VoxelGrid& grid, const detail::TriangleBvh& bvh, std::int64_t j, std::int64_t k,
+                  const std::vector<std::pair<double, int>>& hits, Interior& interior) {
+  int total = 0;
+  for (const auto& hit : hits) total += hit.second;
+  bool suspicious = total != 0;
+  const double coincident = 1e-9 * grid.diagonal();
+  for (std::size_t q = 1; q < hits.size() && !suspicious; ++q) {
+    suspicious = (hits[q].first - hits[q - 1].first) < coincident;
+  }
+  std::size_t next_hit = 0;
+  int winding = 0;
+  for (std::int64_t i = 0; i < grid.nx; ++i) {
+    const double t = (static_cast<double>(i) + 0.5) * grid.h + grid.h;
+    bool inside;
+    if (suspicious) {
+      inside = bvh.inside_vote(grid.centre(i, j, k));
+    } else {
+      while (next_hit < hits.size() && hits[next_hit].first < t) winding -= hits[next_hit++].second;
+      inside = winding > 0;
+    }
+    if (inside) {
+      const std::int64_t g = grid.cell(i, j, k);
+      interior.id_of_cell[static_cast<std::size_t>(g)] = static_cast<std::int32_t>(interior.cell_of_id.size());
+      interior.cell_of_id.push_back(g);
+    }
+  }
+}
+
+// Stage 1 (progress 0 to 0.1): the interior voxels, row by row.
+Interior classify_voxels(const VoxelGrid& grid, const detail::TriangleBvh& bvh, Progress& progress) {
+  Interior interior;
+  interior.id_of_cell.assign(static_cast<std::size_t>(grid.size()), -1);
   std::vector<std::pair<double, int>> hits;
-  const double diag = norm(ext);
-  for (std::int64_t k = 0; k < nz; ++k) {
-    for (std::int64_t j = 0; j < ny; ++j) {
-      const Vec3 o{origin.x - h, origin.y + (static_cast<double>(j) + 0.5) * h, origin.z + (static_cast<double>(k) + 0.5) * h};
+  for (std::int64_t k = 0; k < grid.nz; ++k) {
+    for (std::int64_t j = 0; j < grid.ny; ++j) {
+      const Vec3 o{grid.origin.x - grid.h, grid.origin.y + (static_cast<double>(j) + 0.5) * grid.h,
+                   grid.origin.z + (static_cast<double>(k) + 0.5) * grid.h};
       hits.clear();
       bvh.ray_hits(o, {1.0, 0.0, 0.0}, std::numeric_limits<double>::infinity(), hits);
       if (hits.empty()) continue;
       std::sort(hits.begin(), hits.end());
-      int total = 0;
-      for (const auto& hit : hits) total += hit.second;
-      bool suspicious = total != 0;
-      for (std::size_t q = 1; q < hits.size() && !suspicious; ++q) {
-        suspicious = (hits[q].first - hits[q - 1].first) < 1e-9 * diag;
-      }
-      std::size_t next_hit = 0;
-      int winding = 0;
-      for (std::int64_t i = 0; i < nx; ++i) {
-        const double t = (static_cast<double>(i) + 0.5) * h + h;
-        bool inside;
-        if (suspicious) {
-          inside = bvh.inside_vote(centre(i, j, k));
-        } else {
-          while (next_hit < hits.size() && hits[next_hit].first < t) winding -= hits[next_hit++].second;
-          inside = winding > 0;
-        }
-        if (inside) {
-          const std::int64_t g = i + nx * (j + ny * k);
-          interior_of[static_cast<std::size_t>(g)] = static_cast<std::int32_t>(interior_cell.size());
-          interior_cell.push_back(g);
+      classify_row(grid, bvh, j, k, hits, interior);
+    }
+    progress.report(0.1 * static_cast<double>(k + 1) / static_cast<double>(grid.nz));
+  }
+  return interior;
+}
+
+// Distances from the interior voxels to the surface, with the surface point each was measured to.
+struct SurfaceDistances {
+  std::vector<float> distance;
+  std::vector<Vec3> nearest;
+};
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Exact distances of the interior voxels around triangle `t` (those within its box and 1.5
+// voxels beyond), where nearer than what is known.
+void measure_near_triangle(const detail::Triangle& t, const VoxelGrid& grid, const Interior& interior,
+                           SurfaceDistances& out) {
+  const double h = grid.h;
+  const Vec3 lo{std::min({t.a.x, t.b.x, t.c.x}), std::min({t.a.y, t.b.y, t.c.y}), std::min({t.a.z, t.b.z, t.c.z})};
+  const Vec3 hi{std::max({t.a.x, t.b.x, t.c.x}), std::max({t.a.y, t.b.y, t.c.y}), std::max({t.a.z, t.b.z, t.c.z})};
+  auto cell_lo = [&](double v, double o) { return static_cast<std::int64_t>(std::floor((v - o) / h - 1.5)); };
+  auto cell_hi = [&](double v, double o) { return static_cast<std::int64_t>(std::ceil((v - o) / h + 0.5)); };
+  const std::int64_t i0 = std::max<std::int64_t>(0, cell_lo(lo.x, grid.origin.x)), i1 = std::min(grid.nx - 1, cell_hi(hi.x, grid.origin.x));
+  const std::int64_t j0 = std::max<std::int64_t>(0, cell_lo(lo.y, grid.origin.y)), j1 = std::min(grid.ny - 1, cell_hi(hi.y, grid.origin.y));
+  const std::int64_t k0 = std::max<std::int64_t>(0, cell_lo(lo.z, grid.origin.z)), k1 = std::min(grid.nz - 1, cell_hi(hi.z, grid.origin.z));
+  for (std::int64_t k = k0; k <= k1; ++k) {
+    for (std::int64_t j = j0; j <= j1; ++j) {
+      for (std::int64_t i = i0; i <= i1; ++i) {
+        const std::int32_t id = interior.id_of_cell[static_cast<std::size_t>(grid.cell(i, j, k))];
+        if (id < 0) continue;
+        const Vec3 p = grid.centre(i, j, k);
+        // the triangle is no nearer than its box: most visits after the first few triangles
+        // around a voxel end here, with the same result as the exact test below
+        const double bx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
+        const double by = std::max({lo.y - p.y, 0.0, p.y - hi.y});
+        const double bz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+        float& known = out.distance[static_cast<std::size_t>(id)];
+        if (bx * bx + by * by + bz * bz >= static_cast<double>(known) * static_cast<double>(known)) continue;
+        const Vec3 q = detail::closest_point_on_triangle(p, t);
+        const auto d = static_cast<float>(norm(q - p));
+        if (d < known) {
+          known = d;
+          out.nearest[static_cast<std::size_t>(id)] = q;
         }
       }
     }
-    progress.report(0.1 * static_cast<double>(k + 1) / static_cast<double>(nz));
   }
-  const auto n_interior = static_cast<std::int64_t>(interior_cell.size());
-  if (n_interior == 0) {
-    return Error{fmt::format("{}: no voxel centre lies inside the mesh at voxel size {}; use a smaller voxel size", name, h)};
-  }
+}
 
-  // 2. distance to the surface for interior voxels: exact near the surface (every triangle
-  // visits the voxels around it), then propagated inwards by passing nearest surface points
-  // between neighbours. Propagated values are distances to real surface points, so they are
-  // upper bounds; the packing loop replaces them with exact BVH distances before using them.
-  const float kInf = std::numeric_limits<float>::infinity();
-  std::vector<float> dsurf(static_cast<std::size_t>(n_interior), kInf);
-  std::vector<Vec3> nearest(static_cast<std::size_t>(n_interior));
+// Passes nearest surface points inwards between neighbours: two raster sweeps (forward over the 13
+// earlier neighbours, backward over the 13 later). Progress 0.15 to 0.2.
+void sweep_inwards(const VoxelGrid& grid, const Interior& interior, SurfaceDistances& out, Progress& progress) {
+  std::int64_t offsets[13];
+  int n_off = 0;
+  for (std::int64_t dk = -1; dk <= 0; ++dk) {
+    for (std::int64_t dj = -1; dj <= 1; ++dj) {
+      for (std::int64_t di = -1; di <= 1; ++di) {
+        const std::int64_t off = grid.cell(di, dj, dk);
+        if (off < 0) offsets[n_off++] = off;
+      }
+    }
+  }
+  const std::int64_t n_interior = interior.count();
+  for (int pass = 0; pass < kSweepPasses; ++pass) {
+    const bool forward = pass % 2 == 0;
+    for (std::int64_t q = 0; q < n_interior; ++q) {
+      const std::int64_t idx = forward ? q : n_interior - 1 - q;
+      const std::int64_t g = interior.cell_of_id[static_cast<std::size_t>(idx)];
+      const Vec3 p = grid.centre(g);
+      float& d = out.distance[static_cast<std::size_t>(idx)];
+      for (int o = 0; o < n_off; ++o) {
+        const std::int64_t gn = g + (forward ? offsets[o] : -offsets[o]);
+        if (gn < 0 || gn >= grid.size()) continue;
+        const std::int32_t nb = interior.id_of_cell[static_cast<std::size_t>(gn)];
+        if (nb < 0 || out.distance[static_cast<std::size_t>(nb)] == kInf) continue;
+        const Vec3& cand = out.nearest[static_cast<std::size_t>(nb)];
+        const auto dc = static_cast<float>(norm(cand - p));
+        if (dc < d) {
+          d = dc;
+          out.nearest[static_cast<std::size_t>(idx)] = cand;
+        }
+      }
+    }
+    progress.report(0.15 + 0.05 * (pass + 1) / kSweepPasses);
+  }
+}
+
+// Stage 2 (progress 0.1 to 0.2): distance to the surface for interior voxels: exact near the
+// surface (every triangle visits the voxels around it), then propagated inwards. Propagated values
+// are distances to real surface points, so they are upper bounds; the packing replaces them with
+// exact BVH distances before using them.
+std::vector<float> surface_distances(const TriangleMesh& solid, const VoxelGrid& grid, const Interior& interior,
+                                     Progress& progress) {
+  SurfaceDistances out{std::vector<float>(static_cast<std::size_t>(interior.count()), kInf),
+                       std::vector<Vec3>(static_cast<std::size_t>(interior.count()))};
   for (const auto& tri : solid.triangles) {
     const detail::Triangle t{solid.vertices[static_cast<std::size_t>(tri[0])], solid.vertices[static_cast<std::size_t>(tri[1])],
                              solid.vertices[static_cast<std::size_t>(tri[2])]};
-    const Vec3 lo{std::min({t.a.x, t.b.x, t.c.x}), std::min({t.a.y, t.b.y, t.c.y}), std::min({t.a.z, t.b.z, t.c.z})};
-    const Vec3 hi{std::max({t.a.x, t.b.x, t.c.x}), std::max({t.a.y, t.b.y, t.c.y}), std::max({t.a.z, t.b.z, t.c.z})};
-    auto cell_lo = [&](double v, double o) { return static_cast<std::int64_t>(std::floor((v - o) / h - 1.5)); };
-    auto cell_hi = [&](double v, double o) { return static_cast<std::int64_t>(std::ceil((v - o) / h + 0.5)); };
-    const std::int64_t i0 = std::max<std::int64_t>(0, cell_lo(lo.x, origin.x)), i1 = std::min(nx - 1, cell_hi(hi.x, origin.x));
-    const std::int64_t j0 = std::max<std::int64_t>(0, cell_lo(lo.y, origin.y)), j1 = std::min(ny - 1, cell_hi(hi.y, origin.y));
-    const std::int64_t k0 = std::max<std::int64_t>(0, cell_lo(lo.z, origin.z)), k1 = std::min(nz - 1, cell_hi(hi.z, origin.z));
-    for (std::int64_t k = k0; k <= k1; ++k) {
-      for (std::int64_t j = j0; j <= j1; ++j) {
-        for (std::int64_t i = i0; i <= i1; ++i) {
-          const std::int32_t id = interior_of[static_cast<std::size_t>(i + nx * (j + ny * k))];
-          if (id < 0) continue;
-          const Vec3 p = centre(i, j, k);
-          // the triangle is no nearer than its box: most visits after the first few triangles
-          // around a voxel end here, with the same result as the exact test below
-          const double bx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
-          const double by = std::max({lo.y - p.y, 0.0, p.y - hi.y});
-          const double bz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
-          const auto known = static_cast<double>(dsurf[static_cast<std::size_t>(id)]);
-          if (bx * bx + by * by + bz * bz >= known * known) continue;
-          const Vec3 q = detail::closest_point_on_triangle(p, t);
-          const auto d = static_cast<float>(norm(q - p));
-          if (d < dsurf[static_cast<std::size_t>(id)]) {
-            dsurf[static_cast<std::size_t>(id)] = d;
-            nearest[static_cast<std::size_t>(id)] = q;
-          }
-        }
-      }
-    }
+    measure_near_triangle(t, grid, interior, out);
   }
   progress.report(0.15);
-  {
-    // two raster sweeps (forward over the 13 earlier neighbours, backward over the 13 later)
-    std::int64_t offsets[13];
-    int n_off = 0;
-    for (std::int64_t dk = -1; dk <= 0; ++dk) {
-      for (std::int64_t dj = -1; dj <= 1; ++dj) {
-        for (std::int64_t di = -1; di <= 1; ++di) {
-          const std::int64_t off = di + nx * (dj + ny * dk);
-          if (off < 0) offsets[n_off++] = off;
-        }
-      }
-    }
-    for (int pass = 0; pass < kSweepPasses; ++pass) {
-      const bool forward = pass % 2 == 0;
-      for (std::int64_t q = 0; q < n_interior; ++q) {
-        const std::int64_t idx = forward ? q : n_interior - 1 - q;
-        const std::int64_t g = interior_cell[static_cast<std::size_t>(idx)];
-        const std::int64_t i = g % nx, j = (g / nx) % ny, k = g / (nx * ny);
-        const Vec3 p = centre(i, j, k);
-        float& d = dsurf[static_cast<std::size_t>(idx)];
-        for (int o = 0; o < n_off; ++o) {
-          const std::int64_t gn = g + (forward ? offsets[o] : -offsets[o]);
-          if (gn < 0 || gn >= grid_size) continue;
-          const std::int32_t nb = interior_of[static_cast<std::size_t>(gn)];
-          if (nb < 0 || dsurf[static_cast<std::size_t>(nb)] == kInf) continue;
-          const Vec3& cand = nearest[static_cast<std::size_t>(nb)];
-          const auto dc = static_cast<float>(norm(cand - p));
-          if (dc < d) {
-            d = dc;
-            nearest[static_cast<std::size_t>(idx)] = cand;
-          }
-        }
-      }
-      progress.report(0.15 + 0.05 * (pass + 1) / kSweepPasses);
-    }
+  sweep_inwards(grid, interior, out, progress);
+  for (float& d : out.distance) {
+    if (d == kInf) d = static_cast<float>(grid.diagonal());  // unreachable in practice; still an upper bound
   }
-  for (float& d : dsurf) {
-    if (d == kInf) d = static_cast<float>(diag);  // unreachable in practice; still an upper bound
-  }
-  std::vector<Vec3>().swap(nearest);
+  return std::move(out.distance);
+}
 
-  // 3. greedy largest-free-sphere placement. Heap entries are upper bounds of the current free
-  // radius (it only decreases); a popped entry that turns out smaller is pushed back.
-  std::vector<float> fsph(static_cast<std::size_t>(n_interior), kInf);
-  std::vector<char> exact(static_cast<std::size_t>(n_interior), 0);
-  std::vector<char> removed(static_cast<std::size_t>(n_interior), 0);
-  BucketQueue queue(kBucketsPerVoxel / h);
-  const double min_radius = kMinRadiusInVoxels * h;
-  const double margin = options.safety_margin * h;
+// Stage 3 (progress 0.2 to 0.95): greedy largest-free-sphere placement. Queue entries are upper
+// bounds of a voxel's current free radius (it only decreases); a popped entry that turns out
+// smaller is pushed back.
+class GreedyPacker {
+ public:
+  GreedyPacker(const VoxelGrid& grid, const detail::TriangleBvh& bvh, const Interior& interior,
+               std::vector<float> surface_distance, const PackingOptions& options, Progress& progress)
+      : grid_(grid),
+        bvh_(bvh),
+        interior_(interior),
+        options_(options),
+        progress_(progress),
+        dsurf_(std::move(surface_distance)),
+        fsph_(dsurf_.size(), kInf),
+        exact_(dsurf_.size(), 0),
+        removed_(dsurf_.size(), 0),
+        queue_(kBucketsPerVoxel / grid.h),
+        min_radius_(kMinRadiusInVoxels * grid.h),
+        margin_(options.safety_margin * grid.h),
+        max_radius_(options.max_radius > 0.0 ? options.max_radius : std::numeric_limits<double>::infinity()),
+        sgrid_(grid.bounds.min, grid.bounds.max, 2.0 * grid.h) {
+    for (std::int64_t q = 0; q < interior_.count(); ++q)
+      queue_.push(radius_bound_f(dsurf_[static_cast<std::size_t>(q)]), static_cast<std::int32_t>(q));
+  }
+
+  std::vector<Sphere> run() {
+    const std::int64_t target = options_.target_sphere_count;
+    std::int32_t id = -1;
+    std::int64_t bucket = 0;
+    while ((target == 0 || static_cast<std::int64_t>(spheres_.size()) < target) && queue_.pop(id, bucket)) {
+      if (!ready_to_place(id, bucket)) continue;
+      // every live voxel's free radius is below the top of this bucket
+      const auto key = static_cast<float>(queue_.upper_bound(bucket));
+      if (!place_at(static_cast<std::size_t>(id), key)) continue;
+      if (target > 0) {
+        progress_.report(0.2 + 0.75 * static_cast<double>(spheres_.size()) / static_cast<double>(target));
+      } else {
+        progress_.report(0.2 + 0.75 * static_cast<double>(removed_count_) /
+                                   static_cast<double>(interior_.count()));
+      }
+    }
+    return std::move(spheres_);
+  }
+
+ private:
   // The largest radius a sphere centred `d` from the surface may have. Monotone in d, so an upper
   // bound of d still gives an upper bound of the radius (the queue's invariant).
-  const double max_radius =
-      options.max_radius > 0.0 ? options.max_radius : std::numeric_limits<double>::infinity();
-  auto radius_bound = [&](double d) { return std::min(d, max_radius); };
-  auto radius_bound_f = [&](float d) { return static_cast<float>(radius_bound(static_cast<double>(d))); };
-  for (std::int64_t q = 0; q < n_interior; ++q)
-    queue.push(radius_bound_f(dsurf[static_cast<std::size_t>(q)]), static_cast<std::int32_t>(q));
-  detail::SphereGrid sgrid(box.min, box.max, 2.0 * h);
-  std::vector<Sphere> spheres;
-  std::int64_t removed_count = 0;
+  double radius_bound(double d) const { return std::min(d, max_radius_); }
+  float radius_bound_f(float d) const { return static_cast<float>(radius_bound(static_cast<double>(d))); }
 
-  // free radius at p: exact distance to the surface and to the placed spheres within `reach`
-  // (never more than the largest radius allowed)
-  auto free_at = [&](const Vec3& p, double reach, Vec3* away) {
+  void remove(std::size_t uid) {
+    removed_[uid] = 1;
+    ++removed_count_;
+  }
+
+  // Whether popped voxel `id` is still live and its free radius still in `bucket`; a voxel too
+  // small is removed, one whose radius fell is pushed back where it belongs. Its surface distance
+  // is made exact the first time it gets here.
+  bool ready_to_place(std::int32_t id, std::int64_t bucket) {
+    const auto uid = static_cast<std::size_t>(id);
+    if (removed_[uid] != 0) return false;
+    const float current = std::min(radius_bound_f(dsurf_[uid]), fsph_[uid]);
+    if (static_cast<double>(current) <= min_radius_) {
+      remove(uid);
+      return false;
+    }
+    if (queue_.bucket_of(current) < bucket) {
+      queue_.push(current, id);
+      return false;
+    }
+    if (exact_[uid] != 0) return true;
+    exact_[uid] = 1;
+    const auto d = static_cast<float>(std::sqrt(bvh_.closest(grid_.centre(interior_.cell_of_id[uid]))));
+    if (d < dsurf_[uid]) {
+      dsurf_[uid] = d;
+      const float bound = std::min(radius_bound_f(d), fsph_[uid]);
+      if (queue_.bucket_of(bound) < bucket) {
+        queue_.push(bound, id);
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // Free radius at p: exact distance to the surface and to the placed spheres within `reach`
+  // (never more than the largest radius allowed); `away`, if given, the direction away from the
+  // nearest of them.
+  double free_at(const Vec3& p, double reach, Vec3* away) const {
     Vec3 qs{};
-    const double ds = radius_bound(std::sqrt(bvh.closest(p, &qs, reach * reach)));
+    const double ds = radius_bound(std::sqrt(bvh_.closest(p, &qs, reach * reach)));
     std::int32_t nid = -1;
-    const double dsp = sgrid.free_radius(p, std::min(ds, reach), &nid);
+    const double dsp = sgrid_.free_radius(p, std::min(ds, reach), &nid);
     if (away != nullptr) {
       if (nid >= 0 && dsp < ds) {
-        *away = normalized(p - to_vec(spheres[static_cast<std::size_t>(nid)]));
+        *away = normalized(p - to_vec(spheres_[static_cast<std::size_t>(nid)]));
       } else {
         *away = ds < reach ? normalized(p - qs) : Vec3{};
       }
     }
     return std::min(ds, dsp);
-  };
+  }
 
-  std::int32_t id = -1;
-  std::int64_t bucket = 0;
-  while ((target == 0 || static_cast<std::int64_t>(spheres.size()) < target) && queue.pop(id, bucket)) {
-    // every live voxel's free radius is below the top of this bucket
-    const auto key = static_cast<float>(queue.upper_bound(bucket));
-    const auto uid = static_cast<std::size_t>(id);
-    if (removed[uid] != 0) continue;
-    const float current = std::min(radius_bound_f(dsurf[uid]), fsph[uid]);
-    if (static_cast<double>(current) <= min_radius) {
-      removed[uid] = 1;
-      ++removed_count;
-      continue;
-    }
-    if (queue.bucket_of(current) < bucket) {
-      queue.push(current, id);
-      continue;
-    }
-    const std::int64_t g = interior_cell[uid];
-    const Vec3 v = centre(g % nx, (g / nx) % ny, g / (nx * ny));
-    if (exact[uid] == 0) {
-      exact[uid] = 1;
-      const auto d = static_cast<float>(std::sqrt(bvh.closest(v)));
-      if (d < dsurf[uid]) {
-        dsurf[uid] = d;
-        const float bound = std::min(radius_bound_f(d), fsph[uid]);
-        if (queue.bucket_of(bound) < bucket) {
-          queue.push(bound, id);
-          continue;
-        }
+  // ProtoSphere-style refinement: step away from the nearest obstacle while the free radius grows,
+  // halving the step when it does not; stay within `leash` of the voxel centre `v` so the centre
+  // cannot leave the mesh. The free radius is 1-Lipschitz, so every evaluation is bounded by the
+  // best value so far plus the step: searching further would only cost time.
+  void refine_centre(const Vec3& v, double leash, double slack, Vec3& p, Vec3& away, double& best) const {
+    double step = kFirstStep * grid_.h;
+    for (int iter = 0; iter < kRefineIterations && step > 0.02 * grid_.h; ++iter) {
+      const Vec3 cand = p + away * step;
+      if (squared_norm(away) == 0.0 || norm(cand - v) > leash) {
+        step *= 0.5;
+        continue;
+      }
+      Vec3 cand_away{};
+      const double f = free_at(cand, best + step + slack, &cand_away);
+      if (f > best) {
+        best = f;
+        p = cand;
+        away = cand_away;
+      } else {
+        step *= 0.5;
       }
     }
-    // refine: walk away from the nearest obstacle while the free radius grows; stay within
-    // half the voxel's surface distance so the centre cannot leave the mesh
+  }
+
+  // Places the largest free sphere near voxel `uid` (its free radius below `key`); false, and the
+  // voxel removed, when none fits.
+  bool place_at(std::size_t uid, float key) {
+    const Vec3 v = grid_.centre(interior_.cell_of_id[uid]);
     Vec3 p = v;
-    const double leash = kLeash * static_cast<double>(dsurf[uid]);
-    // the free radius is 1-Lipschitz, so every evaluation below is bounded by the best value so
-    // far plus the step: searching further would only cost time
-    const double slack = 0.1 * h;
+    const double slack = 0.1 * grid_.h;
     Vec3 away{};
     double best = free_at(p, static_cast<double>(key) * 1.001 + slack, &away);
-    if (options.refine_centres) {
-      // ProtoSphere-style: step away from the nearest obstacle while the free radius grows,
-      // halving the step when it does not
-      double step = kFirstStep * h;
-      for (int iter = 0; iter < kRefineIterations && step > 0.02 * h; ++iter) {
-        const Vec3 cand = p + away * step;
-        if (squared_norm(away) == 0.0 || norm(cand - v) > leash) {
-          step *= 0.5;
-          continue;
-        }
-        Vec3 cand_away{};
-        const double f = free_at(cand, best + step + slack, &cand_away);
-        if (f > best) {
-          best = f;
-          p = cand;
-          away = cand_away;
-        } else {
-          step *= 0.5;
-        }
-      }
-    }
+    if (options_.refine_centres) refine_centre(v, kLeash * static_cast<double>(dsurf_[uid]), slack, p, away, best);
     // final radius from the float centre actually stored
     Sphere s{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), 0.f};
     const Vec3 pf = to_vec(s);
-    const double r = free_at(pf, best + slack, nullptr) - margin;
-    if (!(r > min_radius) || !bvh.inside_vote(pf)) {
-      removed[uid] = 1;
-      ++removed_count;
-      continue;
+    const double r = free_at(pf, best + slack, nullptr) - margin_;
+    if (!(r > min_radius_) || !bvh_.inside_vote(pf)) {
+      remove(uid);
+      return false;
     }
     s.radius = static_cast<float>(r);
     if (static_cast<double>(s.radius) > r) s.radius = std::nextafter(s.radius, 0.f);
-    const auto sid = static_cast<std::int32_t>(spheres.size());
-    spheres.push_back(s);
-    sgrid.insert(s, sid);
+    const auto sid = static_cast<std::int32_t>(spheres_.size());
+    spheres_.push_back(s);
+    sgrid_.insert(s, sid);
+    lower_free_radii(pf, static_cast<double>(s.radius), key);
+    return true;
+  }
 
-    // lower the free radius of voxels within reach; voxels whose centre is covered are removed
-    const double rs = static_cast<double>(s.radius);
+  // Lowers the free radius of the voxels within reach of a new sphere (centre pf, radius rs);
+  // voxels whose centre it covers are removed.
+  void lower_free_radii(const Vec3& pf, double rs, float key) {
+    const double h = grid_.h;
+    const Vec3& origin = grid_.origin;
     const double affect = rs + static_cast<double>(key) + h;
     auto lo_cell = [&](double c, double o, std::int64_t n) {
       return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((c - affect - o) / h)), 0, n - 1);
@@ -474,9 +569,9 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
     auto hi_cell = [&](double c, double o, std::int64_t n) {
       return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::ceil((c + affect - o) / h)), 0, n - 1);
     };
-    const std::int64_t i0 = lo_cell(pf.x, origin.x, nx), i1 = hi_cell(pf.x, origin.x, nx);
-    const std::int64_t j0 = lo_cell(pf.y, origin.y, ny), j1 = hi_cell(pf.y, origin.y, ny);
-    const std::int64_t k0 = lo_cell(pf.z, origin.z, nz), k1 = hi_cell(pf.z, origin.z, nz);
+    const std::int64_t i0 = lo_cell(pf.x, origin.x, grid_.nx), i1 = hi_cell(pf.x, origin.x, grid_.nx);
+    const std::int64_t j0 = lo_cell(pf.y, origin.y, grid_.ny), j1 = hi_cell(pf.y, origin.y, grid_.ny);
+    const std::int64_t k0 = lo_cell(pf.z, origin.z, grid_.nz), k1 = hi_cell(pf.z, origin.z, grid_.nz);
     for (std::int64_t k = k0; k <= k1; ++k) {
       const double dz = origin.z + (static_cast<double>(k) + 0.5) * h - pf.z;
       for (std::int64_t j = j0; j <= j1; ++j) {
@@ -487,33 +582,47 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
         const double chord = std::sqrt(chord2);
         const std::int64_t ia = std::max(i0, static_cast<std::int64_t>(std::floor((pf.x - chord - origin.x) / h - 0.5)));
         const std::int64_t ib = std::min(i1, static_cast<std::int64_t>(std::ceil((pf.x + chord - origin.x) / h - 0.5)));
-        for (std::int64_t i = ia; i <= ib; ++i) {
-          const std::int32_t w = interior_of[static_cast<std::size_t>(i + nx * (j + ny * k))];
-          if (w < 0 || removed[static_cast<std::size_t>(w)] != 0) continue;
-          const double dd = norm(centre(i, j, k) - pf) - rs;
-          if (dd < static_cast<double>(fsph[static_cast<std::size_t>(w)])) {
-            fsph[static_cast<std::size_t>(w)] = static_cast<float>(dd);
-            if (dd <= min_radius) {
-              removed[static_cast<std::size_t>(w)] = 1;
-              ++removed_count;
-            }
-          }
-        }
+        for (std::int64_t i = ia; i <= ib; ++i) lower_free_radius(grid_.cell(i, j, k), grid_.centre(i, j, k), pf, rs);
       }
     }
-    if (target > 0) {
-      progress.report(0.2 + 0.75 * static_cast<double>(spheres.size()) / static_cast<double>(target));
-    } else {
-      progress.report(0.2 + 0.75 * static_cast<double>(removed_count) / static_cast<double>(n_interior));
+  }
+
+  void lower_free_radius(std::int64_t cell, const Vec3& centre, const Vec3& pf, double rs) {
+    const std::int32_t w = interior_.id_of_cell[static_cast<std::size_t>(cell)];
+    if (w < 0 || removed_[static_cast<std::size_t>(w)] != 0) return;
+    const double dd = norm(centre - pf) - rs;
+    if (dd < static_cast<double>(fsph_[static_cast<std::size_t>(w)])) {
+      fsph_[static_cast<std::size_t>(w)] = static_cast<float>(dd);
+      if (dd <= min_radius_) remove(static_cast<std::size_t>(w));
     }
   }
-  progress.report(0.95);
 
+  const VoxelGrid& grid_;
+  const detail::TriangleBvh& bvh_;
+  const Interior& interior_;
+  const PackingOptions& options_;
+  Progress& progress_;
+  std::vector<float> dsurf_;  // upper bounds of the surface distance, exact once exact_ is set
+  std::vector<float> fsph_;   // free radius left by the placed spheres
+  std::vector<char> exact_;
+  std::vector<char> removed_;
+  std::int64_t removed_count_ = 0;
+  BucketQueue queue_;
+  double min_radius_;
+  double margin_;
+  double max_radius_;
+  detail::SphereGrid sgrid_;
+  std::vector<Sphere> spheres_;
+};
+
+// Stage 4 (progress 0.95 to 1): the packing's figures.
+SpherePacking make_packing(const TriangleMesh& mesh, double volume, const VoxelGrid& grid, std::int64_t voxel_count,
+                           std::vector<Sphere> spheres, const PackingOptions& options) {
   SpherePacking out;
   out.report.sphere_count = static_cast<std::int64_t>(spheres.size());
   out.report.mesh_volume = volume;
-  out.report.voxel_size = h;
-  out.report.voxel_count = n_interior;
+  out.report.voxel_size = grid.h;
+  out.report.voxel_count = voxel_count;
   double sv = 0.0;
   double rmin = std::numeric_limits<double>::infinity();
   double rmax = 0.0;
@@ -529,6 +638,37 @@ Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOption
   out.report.max_radius = rmax;
   out.report.max_gap = measure_max_gap(mesh, spheres, options.gap_samples_per_triangle);
   out.spheres = std::move(spheres);
+  return out;
+}
+
+}  // namespace
+
+Result<SpherePacking> pack_spheres(const TriangleMesh& mesh, const PackingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress(options.progress);
+  progress.report(0.0);
+  if (auto checked = check_mesh_to_pack(mesh); !checked) return checked.error();
+  // open meshes are packed as if their holes were closed by flat fans
+  const TriangleMesh capped = mesh.report.assumed_open ? cap_holes(mesh) : TriangleMesh{};
+  const TriangleMesh& solid = mesh.report.assumed_open ? capped : mesh;
+  const double volume = mesh_volume(solid);
+  if (!(volume > 0.0))
+    return Error{fmt::format("{}: cannot pack spheres: the mesh encloses no volume ({})", mesh.source_name, volume)};
+  if (auto checked = check_packing_options(mesh.source_name, options); !checked) return checked.error();
+  const Result<VoxelGrid> grid = make_voxel_grid(mesh, volume, options);
+  if (!grid) return grid.error();
+
+  const detail::TriangleBvh bvh(solid.vertices, solid.triangles);
+  const Interior interior = classify_voxels(*grid, bvh, progress);
+  if (interior.count() == 0) {
+    return Error{fmt::format("{}: no voxel centre lies inside the mesh at voxel size {}; use a smaller voxel size",
+                             mesh.source_name, grid->h)};
+  }
+  std::vector<float> distances = surface_distances(solid, *grid, interior, progress);
+  std::vector<Sphere> spheres = GreedyPacker(*grid, bvh, interior, std::move(distances), options, progress).run();
+  progress.report(0.95);
+
+  SpherePacking out = make_packing(mesh, volume, *grid, interior.count(), std::move(spheres), options);
   out.report.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.report(1.0);
   return out;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,82 @@ SphereTree::SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> le
   }
 }
 
+namespace {
+
+// One node's own fields: finite, positive radius and volume, a child count in range.
+Status check_node_fields(int i, const SphereTreeNode& node) {
+  if (!finite_node(node)) return node_error(i, "non-finite centre, radius or volume");
+  if (!(node.radius > 0.f)) return node_error(i, "radius " + std::to_string(node.radius) + " is not positive");
+  if (!(node.volume > 0.f)) return node_error(i, "volume " + std::to_string(node.volume) + " is not positive");
+  if (node.count < 0 || node.count > kMaxSphereTreeArity)
+    return node_error(i, "child count " + std::to_string(node.count) + " outside 0.." + std::to_string(kMaxSphereTreeArity));
+  return Ok{};
+}
+
+// A leaf node: its leaf sphere exists, is used once, and the node copies it with its volume.
+Status check_leaf_node(int i, const SphereTreeNode& node, std::span<const Sphere> leaves, std::vector<char>& leaf_used) {
+  const int leaf_total = static_cast<int>(leaves.size());
+  if (node.first < 0 || node.first >= leaf_total)
+    return node_error(i, "leaf index " + std::to_string(node.first) + " outside 0.." + std::to_string(leaf_total - 1));
+  char& used = leaf_used[static_cast<std::size_t>(node.first)];
+  if (used) return node_error(i, "leaf index " + std::to_string(node.first) + " used twice");
+  used = 1;
+  const Sphere& s = leaves[static_cast<std::size_t>(node.first)];
+  if (s.x != node.x || s.y != node.y || s.z != node.z || s.radius != node.radius)
+    return node_error(i, "leaf node differs from leaf sphere " + std::to_string(node.first));
+  const double expected = sphere_volume(static_cast<double>(node.radius));
+  if (std::abs(static_cast<double>(node.volume) - expected) > 1e-4 * expected)
+    return node_error(i, "leaf volume " + std::to_string(node.volume) + " is not the sphere volume " + std::to_string(expected));
+  return Ok{};
+}
+
+// An inner node at depth d: its children lie in the array, link back to it, are reached only
+// from it (queued at depth d + 1), and their volumes sum to its own.
+Status check_children(int i, const SphereTreeNode& node, std::span<const SphereTreeNode> nodes, std::vector<int>& depth_of,
+                      std::vector<int>& queue) {
+  const int n = static_cast<int>(nodes.size());
+  const int d = depth_of[static_cast<std::size_t>(i)];
+  if (node.first < 1 || node.first > n - node.count)
+    return node_error(i, "children " + std::to_string(node.first) + "+" + std::to_string(node.count) +
+                             " outside the node array 1.." + std::to_string(n - 1));
+  double child_volume = 0.0;
+  for (int c = node.first; c < node.first + node.count; ++c) {
+    const SphereTreeNode& child = nodes[static_cast<std::size_t>(c)];
+    if (child.parent != i)
+      return node_error(c, "parent link " + std::to_string(child.parent) + " but it is a child of node " + std::to_string(i));
+    if (depth_of[static_cast<std::size_t>(c)] != 0) return node_error(c, "reached twice (cycle or shared child)");
+    depth_of[static_cast<std::size_t>(c)] = d + 1;
+    child_volume += static_cast<double>(child.volume);
+    queue.push_back(c);
+  }
+  if (std::abs(child_volume - static_cast<double>(node.volume)) > 1e-4 * child_volume)
+    return node_error(i, "volume " + std::to_string(node.volume) + " is not the sum of its children's " + std::to_string(child_volume));
+  return Ok{};
+}
+
+// Every ancestor encloses every leaf below it (parent chains are known to be acyclic).
+Status check_enclosure(std::span<const SphereTreeNode> nodes) {
+  const int n = static_cast<int>(nodes.size());
+  const double tol = 1e-5 * static_cast<double>(nodes[0].radius);
+  for (int i = 0; i < n; ++i) {
+    const SphereTreeNode& leaf = nodes[static_cast<std::size_t>(i)];
+    if (!leaf.is_leaf()) continue;
+    for (int p = leaf.parent; p >= 0; p = nodes[static_cast<std::size_t>(p)].parent) {
+      const SphereTreeNode& a = nodes[static_cast<std::size_t>(p)];
+      const double dx = static_cast<double>(leaf.x) - static_cast<double>(a.x);
+      const double dy = static_cast<double>(leaf.y) - static_cast<double>(a.y);
+      const double dz = static_cast<double>(leaf.z) - static_cast<double>(a.z);
+      const double reach = std::sqrt(dx * dx + dy * dy + dz * dz) + static_cast<double>(leaf.radius);
+      if (reach > static_cast<double>(a.radius) + tol)
+        return node_error(p, "does not enclose leaf node " + std::to_string(i) + " (reach " + std::to_string(reach) +
+                                 " > radius " + std::to_string(a.radius) + ")");
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace
+
 Status validate(const SphereTree& tree) {
   const auto nodes = tree.nodes();
   const auto leaves = tree.leaves();
@@ -105,43 +182,14 @@ Status validate(const SphereTree& tree) {
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const int i = queue[head];
     const SphereTreeNode& node = nodes[static_cast<std::size_t>(i)];
-    const int d = depth_of[static_cast<std::size_t>(i)];
-    if (d > max_depth) max_depth = d;
-    if (!finite_node(node)) return node_error(i, "non-finite centre, radius or volume");
-    if (!(node.radius > 0.f)) return node_error(i, "radius " + std::to_string(node.radius) + " is not positive");
-    if (!(node.volume > 0.f)) return node_error(i, "volume " + std::to_string(node.volume) + " is not positive");
-    if (node.count < 0 || node.count > kMaxSphereTreeArity)
-      return node_error(i, "child count " + std::to_string(node.count) + " outside 0.." + std::to_string(kMaxSphereTreeArity));
+    max_depth = std::max(max_depth, depth_of[static_cast<std::size_t>(i)]);
+    if (auto checked = check_node_fields(i, node); !checked) return checked;
     if (node.is_leaf()) {
       ++leaf_nodes;
-      if (node.first < 0 || node.first >= leaf_total)
-        return node_error(i, "leaf index " + std::to_string(node.first) + " outside 0.." + std::to_string(leaf_total - 1));
-      char& used = leaf_used[static_cast<std::size_t>(node.first)];
-      if (used) return node_error(i, "leaf index " + std::to_string(node.first) + " used twice");
-      used = 1;
-      const Sphere& s = leaves[static_cast<std::size_t>(node.first)];
-      if (s.x != node.x || s.y != node.y || s.z != node.z || s.radius != node.radius)
-        return node_error(i, "leaf node differs from leaf sphere " + std::to_string(node.first));
-      const double expected = sphere_volume(static_cast<double>(node.radius));
-      if (std::abs(static_cast<double>(node.volume) - expected) > 1e-4 * expected)
-        return node_error(i, "leaf volume " + std::to_string(node.volume) + " is not the sphere volume " + std::to_string(expected));
-      continue;
+      if (auto checked = check_leaf_node(i, node, leaves, leaf_used); !checked) return checked;
+    } else if (auto checked = check_children(i, node, nodes, depth_of, queue); !checked) {
+      return checked;
     }
-    if (node.first < 1 || node.first > n - node.count)
-      return node_error(i, "children " + std::to_string(node.first) + "+" + std::to_string(node.count) +
-                               " outside the node array 1.." + std::to_string(n - 1));
-    double child_volume = 0.0;
-    for (int c = node.first; c < node.first + node.count; ++c) {
-      const SphereTreeNode& child = nodes[static_cast<std::size_t>(c)];
-      if (child.parent != i)
-        return node_error(c, "parent link " + std::to_string(child.parent) + " but it is a child of node " + std::to_string(i));
-      if (depth_of[static_cast<std::size_t>(c)] != 0) return node_error(c, "reached twice (cycle or shared child)");
-      depth_of[static_cast<std::size_t>(c)] = d + 1;
-      child_volume += static_cast<double>(child.volume);
-      queue.push_back(c);
-    }
-    if (std::abs(child_volume - static_cast<double>(node.volume)) > 1e-4 * child_volume)
-      return node_error(i, "volume " + std::to_string(node.volume) + " is not the sum of its children's " + std::to_string(child_volume));
   }
   if (static_cast<int>(queue.size()) != n)
     return Error{"sphere tree: " + std::to_string(n - static_cast<int>(queue.size())) + " of " + std::to_string(n) +
@@ -150,24 +198,7 @@ Status validate(const SphereTree& tree) {
     return Error{"sphere tree: " + std::to_string(leaf_nodes) + " leaf nodes for " + std::to_string(leaf_total) + " leaf spheres"};
   if (max_depth != tree.depth())
     return Error{"sphere tree: stored depth " + std::to_string(tree.depth()) + " but the longest path has " + std::to_string(max_depth) + " levels"};
-
-  // every ancestor encloses every leaf below it; parent chains are known to be acyclic now
-  const double tol = 1e-5 * static_cast<double>(nodes[0].radius);
-  for (int i = 0; i < n; ++i) {
-    const SphereTreeNode& leaf = nodes[static_cast<std::size_t>(i)];
-    if (!leaf.is_leaf()) continue;
-    for (int p = leaf.parent; p >= 0; p = nodes[static_cast<std::size_t>(p)].parent) {
-      const SphereTreeNode& a = nodes[static_cast<std::size_t>(p)];
-      const double dx = static_cast<double>(leaf.x) - static_cast<double>(a.x);
-      const double dy = static_cast<double>(leaf.y) - static_cast<double>(a.y);
-      const double dz = static_cast<double>(leaf.z) - static_cast<double>(a.z);
-      const double reach = std::sqrt(dx * dx + dy * dy + dz * dz) + static_cast<double>(leaf.radius);
-      if (reach > static_cast<double>(a.radius) + tol)
-        return node_error(p, "does not enclose leaf node " + std::to_string(i) + " (reach " + std::to_string(reach) +
-                                 " > radius " + std::to_string(a.radius) + ")");
-    }
-  }
-  return Ok{};
+  return check_enclosure(nodes);
 }
 
 }  // namespace uh::collette

@@ -90,11 +90,8 @@ SphereTreeNode enclose(std::span<const Sphere> leaves, std::span<const int> idx,
   return node;
 }
 
-// Splits idx into at most k clusters by volume-weighted k-means on the centres; returns the
-// cluster sizes after reordering idx so that clusters are contiguous. Deterministic.
-std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k, int iterations) {
-  const std::size_t m = idx.size();
-  // seed: volume quantiles along the longest axis of the centres' box
+// The axis (0 x, 1 y, 2 z) along which the leaves' centres spread the most.
+int longest_axis(std::span<const Sphere> leaves, std::span<const int> idx) {
   Vec3d lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
   Vec3d hi{-lo.x, -lo.y, -lo.z};
   for (int i : idx) {
@@ -103,64 +100,74 @@ std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k
     hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
   }
   const double ex = hi.x - lo.x, ey = hi.y - lo.y, ez = hi.z - lo.z;
-  const int axis = (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
-  auto coord = [&](int i) {
-    const Sphere& s = leaves[static_cast<std::size_t>(i)];
-    return axis == 0 ? s.x : (axis == 1 ? s.y : s.z);
-  };
-  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
-  double total = 0.0;
-  for (int i : idx) total += sphere_volume(leaves[static_cast<std::size_t>(i)]);
+  return (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
+}
 
-  std::vector<int> label(m, 0);
-  {
-    double acc = 0.0;
-    for (std::size_t j = 0; j < m; ++j) {
-      const double v = sphere_volume(leaves[static_cast<std::size_t>(idx[j])]);
-      label[j] = std::min(k - 1, static_cast<int>((acc + 0.5 * v) / total * k));
-      acc += v;
+// Volume-weighted k-means over the leaves idx[j], from their first labels; the centres and
+// weights are the clusters' (a cluster that lost every leaf keeps weight 0 and takes none).
+class KMeans {
+ public:
+  KMeans(std::span<const Sphere> leaves, std::span<const int> idx, std::vector<int> label, int k)
+      : leaves_(leaves), idx_(idx), label_(std::move(label)), centre_(static_cast<std::size_t>(k)),
+        weight_(static_cast<std::size_t>(k)) {}
+
+  std::vector<int> run(int iterations) {
+    update_centres();
+    for (int it = 0; it < iterations; ++it) {
+      if (!reassign()) break;
+      update_centres();
     }
+    return std::move(label_);
   }
-  std::vector<Vec3d> centre(static_cast<std::size_t>(k));
-  std::vector<double> weight(static_cast<std::size_t>(k));
-  auto update_centres = [&]() {
-    std::fill(centre.begin(), centre.end(), Vec3d{0, 0, 0});
-    std::fill(weight.begin(), weight.end(), 0.0);
-    for (std::size_t j = 0; j < m; ++j) {
-      const Sphere& s = leaves[static_cast<std::size_t>(idx[j])];
+
+ private:
+  void update_centres() {
+    std::fill(centre_.begin(), centre_.end(), Vec3d{0, 0, 0});
+    std::fill(weight_.begin(), weight_.end(), 0.0);
+    for (std::size_t j = 0; j < idx_.size(); ++j) {
+      const Sphere& s = leaves_[static_cast<std::size_t>(idx_[j])];
       const double v = sphere_volume(s);
-      Vec3d& c = centre[static_cast<std::size_t>(label[j])];
+      Vec3d& c = centre_[static_cast<std::size_t>(label_[j])];
       c = {c.x + v * static_cast<double>(s.x), c.y + v * static_cast<double>(s.y), c.z + v * static_cast<double>(s.z)};
-      weight[static_cast<std::size_t>(label[j])] += v;
+      weight_[static_cast<std::size_t>(label_[j])] += v;
     }
-    for (std::size_t c = 0; c < centre.size(); ++c)
-      if (weight[c] > 0.0) centre[c] = {centre[c].x / weight[c], centre[c].y / weight[c], centre[c].z / weight[c]};
-  };
-  update_centres();
-  for (int it = 0; it < iterations; ++it) {
+    for (std::size_t c = 0; c < centre_.size(); ++c)
+      if (weight_[c] > 0.0) centre_[c] = {centre_[c].x / weight_[c], centre_[c].y / weight_[c], centre_[c].z / weight_[c]};
+  }
+
+  // moves every leaf to its nearest centre; whether any moved
+  bool reassign() {
     bool changed = false;
-    for (std::size_t j = 0; j < m; ++j) {
-      const Vec3d p = centre_of(leaves[static_cast<std::size_t>(idx[j])]);
-      int best = label[j];
+    for (std::size_t j = 0; j < idx_.size(); ++j) {
+      const Vec3d p = centre_of(leaves_[static_cast<std::size_t>(idx_[j])]);
+      int best = label_[j];
       double best_d = std::numeric_limits<double>::max();
-      for (int c = 0; c < k; ++c) {
-        if (weight[static_cast<std::size_t>(c)] <= 0.0) continue;
-        const double d = dist(p, centre[static_cast<std::size_t>(c)]);
+      for (std::size_t c = 0; c < centre_.size(); ++c) {
+        if (weight_[c] <= 0.0) continue;
+        const double d = dist(p, centre_[c]);
         if (d < best_d) {
           best_d = d;
-          best = c;
+          best = static_cast<int>(c);
         }
       }
-      if (best != label[j]) {
-        label[j] = best;
+      if (best != label_[j]) {
+        label_[j] = best;
         changed = true;
       }
     }
-    if (!changed) break;
-    update_centres();
+    return changed;
   }
 
-  // reorder idx by label (stable, so the result is deterministic)
+  std::span<const Sphere> leaves_;
+  std::span<const int> idx_;
+  std::vector<int> label_;
+  std::vector<Vec3d> centre_;
+  std::vector<double> weight_;
+};
+
+// Reorders idx by label (stable, so the result is deterministic); returns the non-empty clusters' sizes.
+std::vector<int> group_by_label(std::span<int> idx, const std::vector<int>& label, int k) {
+  const std::size_t m = idx.size();
   std::vector<int> order(m);
   for (std::size_t j = 0; j < m; ++j) order[j] = static_cast<int>(j);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
@@ -174,6 +181,32 @@ std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k
   }
   std::copy(sorted.begin(), sorted.end(), idx.begin());
   std::erase(sizes, 0);
+  return sizes;
+}
+
+// Splits idx into at most k clusters by volume-weighted k-means on the centres; returns the
+// cluster sizes after reordering idx so that clusters are contiguous. Deterministic.
+std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k, int iterations) {
+  const std::size_t m = idx.size();
+  // seed: volume quantiles along the longest axis of the centres' box
+  const int axis = longest_axis(leaves, idx);
+  auto coord = [&](int i) {
+    const Sphere& s = leaves[static_cast<std::size_t>(i)];
+    return axis == 0 ? s.x : (axis == 1 ? s.y : s.z);
+  };
+  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
+  double total = 0.0;
+  for (int i : idx) total += sphere_volume(leaves[static_cast<std::size_t>(i)]);
+  std::vector<int> label(m, 0);
+  double acc = 0.0;
+  for (std::size_t j = 0; j < m; ++j) {
+    const double v = sphere_volume(leaves[static_cast<std::size_t>(idx[j])]);
+    label[j] = std::min(k - 1, static_cast<int>((acc + 0.5 * v) / total * k));
+    acc += v;
+  }
+
+  label = KMeans(leaves, idx, std::move(label), k).run(iterations);
+  std::vector<int> sizes = group_by_label(idx, label, k);
   if (sizes.size() < 2) {
     // all centres coincide (or k-means collapsed): split evenly in the axis order instead
     std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return coord(a) < coord(b); });
@@ -189,24 +222,12 @@ std::vector<int> split(std::span<const Sphere> leaves, std::span<int> idx, int k
 constexpr int kCutEnclosingIterations = 16;
 constexpr int kCutRefinements = 3;
 
-// Orders idx so that consecutive runs of sizes[0], sizes[1], ... leaves are compact groups: sorts
-// along a direction (below: the principal axis of the centres, from power iteration on their
-// covariance started at the longest axis of their box, or a fixed direction if that cuts better,
-// then refined by balanced 2-means), cuts at the size of the first half of the groups and recurses
-// into both halves. Deterministic.
-void bisect(std::span<const Sphere> leaves, std::span<int> idx, std::span<const int> sizes) {
-  if (sizes.size() < 2) return;
-  const std::size_t half = sizes.size() / 2;
-  std::size_t cut = 0;
-  for (std::size_t i = 0; i < half; ++i) cut += static_cast<std::size_t>(sizes[i]);
-  Vec3d lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
-           std::numeric_limits<double>::max()};
-  Vec3d hi{-lo.x, -lo.y, -lo.z};
+// The principal axis of the leaves' centres: power iteration on their covariance, started at the
+// longest axis of their box.
+Vec3d principal_axis(std::span<const Sphere> leaves, std::span<const int> idx) {
   Vec3d mean{0.0, 0.0, 0.0};
   for (int i : idx) {
     const Vec3d c = centre_of(leaves[static_cast<std::size_t>(i)]);
-    lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
-    hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
     mean = {mean.x + c.x, mean.y + c.y, mean.z + c.z};
   }
   const double inv_n = 1.0 / static_cast<double>(idx.size());
@@ -222,8 +243,7 @@ void bisect(std::span<const Sphere> leaves, std::span<int> idx, std::span<const 
     cyz += y * z;
     czz += z * z;
   }
-  const double ex = hi.x - lo.x, ey = hi.y - lo.y, ez = hi.z - lo.z;
-  const int longest = (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
+  const int longest = longest_axis(leaves, idx);
   Vec3d axis{longest == 0 ? 1.0 : 0.0, longest == 1 ? 1.0 : 0.0, longest == 2 ? 1.0 : 0.0};
   for (int it = 0; it < 32; ++it) {
     const Vec3d next{cxx * axis.x + cxy * axis.y + cxz * axis.z, cxy * axis.x + cyy * axis.y + cyz * axis.z,
@@ -232,50 +252,82 @@ void bisect(std::span<const Sphere> leaves, std::span<int> idx, std::span<const 
     if (!(len > 0.0) || !std::isfinite(len)) break;
     axis = {next.x / len, next.y / len, next.z / len};
   }
-  // The cut: along the principal axis or one of the 13 directions through a cube's faces, edges
-  // and corners, whichever gives the two halves the smallest sum of cubed enclosing-sphere radii
-  // (the volume of the two node spheres, which decides how many node pairs a query visits), then
-  // refined by balanced 2-means: sorted along the line between the halves' centroids (the order of
-  // the difference of squared distances to the two) and cut at the same size, while that lowers
-  // the cost. On the benchmark's deep random poses: 4,388 node pairs per query, against 4,620 with
-  // the cubed box diagonals as the cost and no refinement, 4,817 with the principal axis alone.
-  const double e = std::sqrt(0.5), c = std::sqrt(1.0 / 3.0);
-  const Vec3d directions[] = {axis,       {1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {e, e, 0},
-                              {e, -e, 0}, {e, 0, e},  {e, 0, -e}, {0, e, e}, {0, e, -e},
-                              {c, c, c},  {c, c, -c}, {c, -c, c}, {-c, c, c}};
-  const auto cubed_radius = [&](std::span<const int> part) {
-    const double r = static_cast<double>(enclose(leaves, part, kCutEnclosingIterations).radius);
+  return axis;
+}
+
+// Orders idx for the cut after its first `cut` leaves: along the principal axis or one of the 13
+// directions through a cube's faces, edges and corners, whichever gives the two halves the smallest
+// sum of cubed enclosing-sphere radii (the volume of the two node spheres, which decides how many
+// node pairs a query visits), then refined by balanced 2-means: sorted along the line between the
+// halves' centroids (the order of the difference of squared distances to the two) and cut at the
+// same size, while that lowers the cost. On the benchmark's deep random poses: 4,388 node pairs per
+// query, against 4,620 with the cubed box diagonals as the cost and no refinement, 4,817 with the
+// principal axis alone.
+class CutSearch {
+ public:
+  CutSearch(std::span<const Sphere> leaves, std::span<int> idx, std::size_t cut)
+      : leaves_(leaves), idx_(idx), cut_(cut), trial_(idx.begin(), idx.end()) {}
+
+  void run() {
+    const double e = std::sqrt(0.5), c = std::sqrt(1.0 / 3.0);
+    const Vec3d directions[] = {principal_axis(leaves_, idx_),
+                                {1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {e, e, 0},
+                                {e, -e, 0}, {e, 0, e},  {e, 0, -e}, {0, e, e}, {0, e, -e},
+                                {c, c, c},  {c, c, -c}, {c, -c, c}, {-c, c, c}};
+    for (const Vec3d& d : directions) try_direction(d);
+    for (int step = 0; step < kCutRefinements; ++step) {
+      Vec3d first{0.0, 0.0, 0.0}, second{0.0, 0.0, 0.0};
+      for (std::size_t j = 0; j < idx_.size(); ++j) {
+        const Vec3d p = centre_of(leaves_[static_cast<std::size_t>(idx_[j])]);
+        Vec3d& sum = j < cut_ ? first : second;
+        sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
+      }
+      const double n1 = static_cast<double>(cut_), n2 = static_cast<double>(idx_.size() - cut_);
+      std::copy(idx_.begin(), idx_.end(), trial_.begin());
+      if (!try_direction({second.x / n2 - first.x / n1, second.y / n2 - first.y / n1, second.z / n2 - first.z / n1}))
+        break;
+    }
+  }
+
+ private:
+  double cubed_radius(std::span<const int> part) const {
+    const double r = static_cast<double>(enclose(leaves_, part, kCutEnclosingIterations).radius);
     return r * r * r;
-  };
-  std::vector<int> trial(idx.begin(), idx.end());
-  double best = std::numeric_limits<double>::infinity();
-  // sorts `trial` along d; keeps it in idx when its cut costs less than the best so far
-  const auto try_direction = [&](const Vec3d& d) {
+  }
+
+  // sorts the trial order along d; keeps it in idx when its cut costs less than the best so far
+  bool try_direction(const Vec3d& d) {
     const auto along = [&](int i) {
-      const Sphere& s = leaves[static_cast<std::size_t>(i)];
+      const Sphere& s = leaves_[static_cast<std::size_t>(i)];
       return d.x * static_cast<double>(s.x) + d.y * static_cast<double>(s.y) + d.z * static_cast<double>(s.z);
     };
-    std::stable_sort(trial.begin(), trial.end(), [&](int a, int b) { return along(a) < along(b); });
-    const std::span<const int> sorted(trial);
-    const double cost = cubed_radius(sorted.subspan(0, cut)) + cubed_radius(sorted.subspan(cut));
-    if (!(cost < best)) return false;
-    best = cost;
-    std::copy(trial.begin(), trial.end(), idx.begin());
+    std::stable_sort(trial_.begin(), trial_.end(), [&](int a, int b) { return along(a) < along(b); });
+    const std::span<const int> sorted(trial_);
+    const double cost = cubed_radius(sorted.subspan(0, cut_)) + cubed_radius(sorted.subspan(cut_));
+    if (!(cost < best_)) return false;
+    best_ = cost;
+    std::copy(trial_.begin(), trial_.end(), idx_.begin());
     return true;
-  };
-  for (const Vec3d& d : directions) try_direction(d);
-  for (int step = 0; step < kCutRefinements; ++step) {
-    Vec3d first{0.0, 0.0, 0.0}, second{0.0, 0.0, 0.0};
-    for (std::size_t j = 0; j < idx.size(); ++j) {
-      const Vec3d p = centre_of(leaves[static_cast<std::size_t>(idx[j])]);
-      Vec3d& sum = j < cut ? first : second;
-      sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
-    }
-    const double n1 = static_cast<double>(cut), n2 = static_cast<double>(idx.size() - cut);
-    std::copy(idx.begin(), idx.end(), trial.begin());
-    if (!try_direction({second.x / n2 - first.x / n1, second.y / n2 - first.y / n1, second.z / n2 - first.z / n1}))
-      break;
   }
+
+  std::span<const Sphere> leaves_;
+  std::span<int> idx_;
+  std::size_t cut_;
+  std::vector<int> trial_;
+  double best_ = std::numeric_limits<double>::infinity();
+};
+
+// Orders idx so that consecutive runs of sizes[0], sizes[1], ... leaves are compact groups: sorts
+// along a direction (below: the principal axis of the centres, from power iteration on their
+// covariance started at the longest axis of their box, or a fixed direction if that cuts better,
+// then refined by balanced 2-means), cuts at the size of the first half of the groups and recurses
+// into both halves. Deterministic.
+void bisect(std::span<const Sphere> leaves, std::span<int> idx, std::span<const int> sizes) {
+  if (sizes.size() < 2) return;
+  const std::size_t half = sizes.size() / 2;
+  std::size_t cut = 0;
+  for (std::size_t i = 0; i < half; ++i) cut += static_cast<std::size_t>(sizes[i]);
+  CutSearch(leaves, idx, cut).run();
   bisect(leaves, idx.subspan(0, cut), sizes.subspan(0, half));
   bisect(leaves, idx.subspan(cut), sizes.subspan(half));
 }

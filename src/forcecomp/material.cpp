@@ -7,14 +7,6 @@
 namespace uh::forcecomp {
 namespace {
 
-// a standard normal draw (Box-Muller) from the seeded generator (std::normal_distribution differs
-// between standard libraries, so a seed would not name one surface everywhere); the open uniform
-// is never 0, so the logarithm is finite
-double standard_normal(core::SplitMix64& random) {
-  const double r = std::sqrt(-2.0 * std::log(random.uniform_open()));
-  return r * std::cos(2.0 * kPi * random.uniform_open());
-}
-
 double combined_in_series(double a, double b) { return a + b > 0.0 ? a * b / (a + b) : 0.0; }
 
 }  // namespace
@@ -65,7 +57,7 @@ Texture make_random_texture(double roughness_m, double correlation_length_m, std
   for (Texture::Wave& w : t.waves) {
     // k ~ N(0, I / l^2): the mean of cos(k . r) is then exp(-|r|^2 / (2 l^2))
     w.wave_vector =
-        Vec3{standard_normal(random), standard_normal(random), standard_normal(random)} / correlation_length_m;
+        Vec3{random.normal(), random.normal(), random.normal()} / correlation_length_m;
     w.phase = 2.0 * kPi * random.uniform_open();
   }
   return t;

@@ -300,6 +300,63 @@ TEST_F(CliTest, IstBuildRepairsDegenerateAndDuplicateFacesAndSaysWhat) {
       << human.out;
 }
 
+// A unit cube as the mesh JSON, its last `drop` triangles left out (an open box).
+std::string cube_json(int drop = 0) {
+  nlohmann::json vertices = nlohmann::json::array(), triangles = nlohmann::json::array();
+  for (int i = 0; i < 8; ++i)
+    for (int axis = 0; axis < 3; ++axis) vertices.push_back(static_cast<double>((i >> axis) & 1));
+  const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                            {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (int f = 0; f < 12 - drop; ++f)
+    for (const int c : faces[f]) triangles.push_back(c);
+  return nlohmann::json{{"vertices", vertices}, {"triangles", triangles}}.dump();
+}
+
+TEST_F(CliTest, MeshConvertWritesTheCheckedMeshAsObjAndJson) {
+  std::ofstream(dir_ / "cube.json") << cube_json();
+  const fs::path obj = dir_ / "cube.obj";
+  CommandRun r = uh(fmt::format("mesh convert '{}' -o '{}' --comment 'a unit cube'", (dir_ / "cube.json").string(),
+                                obj.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("8 vertices, 12 triangles"), std::string::npos) << r.out;
+  const std::string text = read_text(obj);
+  EXPECT_EQ(text.rfind("# a unit cube\nv ", 0), 0u) << text;
+  // the OBJ reads back as the same mesh: through the JSON again, and packed like any mesh
+  const fs::path back = dir_ / "cube_back.json";
+  r = uh(fmt::format("mesh convert '{}' -o '{}'", obj.string(), back.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_text(back));
+  EXPECT_EQ(j["vertices"].size(), 24u);
+  EXPECT_EQ(j["triangles"].size(), 36u);
+  r = uh(fmt::format("ist build '{}' -o '{}' --spheres 30 --json", obj.string(), (dir_ / "cube.ist").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NEAR(json_of(r)["mesh_volume"].get<double>(), 1.0, 1e-12);
+}
+
+TEST_F(CliTest, MeshConvertRefusesAnOpenOrBrokenMeshNamingTheFileAndKeepsTheOutput) {
+  const fs::path out = dir_ / "kept.obj";
+  std::ofstream(out) << "an earlier file that must survive";
+  std::ofstream(dir_ / "open_box.json") << cube_json(1);
+  CommandRun r = uh(fmt::format("mesh convert '{}' -o '{}'", (dir_ / "open_box.json").string(), out.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("open_box.json: mesh is not closed"), std::string::npos) << r.err;
+  std::ofstream(dir_ / "bad_index.json") << R"({"vertices": [0, 0, 0, 1, 0, 0, 0, 1, 0], "triangles": [0, 1, 3]})";
+  r = uh(fmt::format("mesh convert '{}' -o '{}'", (dir_ / "bad_index.json").string(), out.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad_index.json: 'triangles[2]' is 3, not the index of one of the 3 vertices"),
+            std::string::npos)
+      << r.err;
+  std::ofstream(dir_ / "ragged.json") << R"({"vertices": [0, 0, 0, 1], "triangles": []})";
+  r = uh(fmt::format("mesh convert '{}' -o '{}'", (dir_ / "ragged.json").string(), out.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("ragged.json: 'vertices' has 4 numbers, not x, y, z per vertex"), std::string::npos) << r.err;
+  std::ofstream(dir_ / "cube.json") << cube_json();
+  r = uh(fmt::format("mesh convert '{}' -o '{}'", (dir_ / "cube.json").string(), (dir_ / "cube.stl").string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("written as .obj or .json"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text(out), "an earlier file that must survive");
+}
+
 TEST_F(CliTest, IstBuildRefusesAMeshStillOpenAfterRepairNamingAllowOpen) {
   const fs::path mesh = write_cube(dir_ / "holey.obj", true, "f 1 1 2\nf 1 3 2\n");
   const fs::path out = dir_ / "holey.ist";

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "mesh_test_support.hpp"
 #include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
@@ -201,6 +203,27 @@ TEST(ObjText, ReadsBackExactly) {
   ASSERT_TRUE(read) << read.error().message;
   EXPECT_EQ(read->vertices.size(), 3u);
   EXPECT_EQ(read->triangles, mesh.triangles);
+}
+
+// The mesh JSON: exact by default and read back as written; scaled and rounded for pictures.
+TEST(MeshJson, ReadsBackExactlyAndRoundsWhenAsked) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0.1, -2.0 / 3.0, 1e-7}, {1.0 / 7.0, 12345.678901234567, -0.0}, {3.0, 0.3, -1e300}};
+  mesh.triangles = {{0, 1, 2}, {2, 1, 0}};
+  const auto read = parse_mesh_json(mesh_json(mesh).dump(), "written.json");
+  ASSERT_TRUE(read) << read.error().message;
+  EXPECT_EQ(read->source_name, "written.json");
+  ASSERT_EQ(read->vertices.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(read->vertices[i].x, mesh.vertices[i].x);
+    EXPECT_EQ(read->vertices[i].y, mesh.vertices[i].y);
+    EXPECT_EQ(read->vertices[i].z, mesh.vertices[i].z);
+  }
+  EXPECT_EQ(read->triangles, mesh.triangles);
+
+  mesh.vertices = {{0.123456, -0.00004, 2.0 / 3.0}};
+  mesh.triangles = {};
+  EXPECT_EQ(mesh_json(mesh, 10.0, 4)["vertices"].dump(), "[1.2346,-0.0004,6.6667]");
 }
 
 }  // namespace

@@ -5,7 +5,6 @@
 
 #include <cstdlib>
 #include <new>
-#include <random>
 
 #include "tree_test_support.hpp"
 #include "uh/collette/distance_query.hpp"
@@ -57,7 +56,7 @@ TEST(VolumeQuery, SteadyStateDoesNotAllocate) {
   VolumeQuery coherent({.coherence_skin = 0.05f});  // traverses on each jump, reuses on each repeat
   TimeCriticalQuery tc;
   DistanceQuery dq;
-  std::mt19937 rng(1);
+  core::SplitMix64 rng{1};
   std::vector<Pose> poses;
   for (int k = 0; k < 30; ++k) poses.push_back(testing::random_pose(rng, 1.0));
   poses.push_back(Pose{{}, {5.0, 0.0, 0.0}});

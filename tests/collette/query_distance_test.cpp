@@ -27,7 +27,7 @@ TEST(DistanceQuery, MatchesBruteForceOverLeaves) {
   ASSERT_TRUE(ta && tb);
   DistanceQuery cold({.warm_start = false});
   DistanceQuery warm;
-  std::mt19937 rng(9);
+  core::SplitMix64 rng{9};
   int apart = 0, touching = 0;
   for (int k = 0; k < 60; ++k) {
     const Pose pose = testing::random_pose(rng, 2.2);

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <random>
 #include <set>
 #include <utility>
 
@@ -28,7 +27,7 @@ TEST(VolumeQueryMargin, StoresExactlyThePairsWithinTheMarginAndKeepsTheTotals) {
   constexpr double kMarginD = static_cast<double>(kMargin);
   VolumeQuery exact;
   VolumeQuery with_margin({.contact_margin = kMargin});
-  std::mt19937 rng(5);
+  core::SplitMix64 rng{5};
   int poses_with_near = 0;
   for (int trial = 0; trial < 12; ++trial) {
     const Pose b_in_a = testing::random_pose(rng, 1.6);

@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "tree_test_support.hpp"
@@ -21,7 +20,7 @@ TEST(TimeCriticalQuery, UnboundedEqualsVolumeQuery) {
   ASSERT_TRUE(ta && tb);
   VolumeQuery exact;
   TimeCriticalQuery tc;
-  std::mt19937 rng(5);
+  core::SplitMix64 rng{5};
   for (int k = 0; k < 20; ++k) {
     const Pose pose = testing::random_pose(rng, 1.0);
     const VolumeQueryResult e = exact.run(*ta, *tb, pose);

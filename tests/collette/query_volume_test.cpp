@@ -74,7 +74,7 @@ void expect_matches_brute_force(const std::vector<Sphere>& la, const std::vector
   const auto tb = build_sphere_tree(lb, {.arity = arity_b});
   ASSERT_TRUE(ta && tb);
   VolumeQuery query;
-  std::mt19937 rng(seed);
+  core::SplitMix64 rng{seed};
   int overlapping_poses = 0;
   for (int k = 0; k < poses; ++k) {
     const Pose pose = testing::random_pose(rng, 1.2);

@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <random>
 #include <vector>
 
 #include "lens_reference.hpp"
@@ -13,6 +12,7 @@
 #include "uh/collette/volume_query.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
+#include "uh/core/split_mix.hpp"
 
 namespace uh::collette::testing {
 
@@ -21,8 +21,8 @@ enum class Shape { kBall, kBox, kRod };
 /// Non-overlapping spheres on a jittered grid of spacing `h` inside a shape of size ~1 centred at
 /// `offset`; radii vary in [0.15 h, 0.5 h - jitter] so that the spheres never overlap.
 inline std::vector<Sphere> make_packing(double h, Shape shape, std::uint32_t seed, Vec3 offset = {}) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
+  core::SplitMix64 rng{seed};
+  const auto u = [](core::SplitMix64& g) { return g.uniform(); };
   const double jitter = 0.1 * h;
   std::vector<Sphere> out;
   const int n = static_cast<int>(std::ceil(1.0 / h));
@@ -44,11 +44,13 @@ inline std::vector<Sphere> make_packing(double h, Shape shape, std::uint32_t see
   return out;
 }
 
-inline Pose random_pose(std::mt19937& rng, double max_shift) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::uniform_real_distribution<double> u(-max_shift, max_shift);
-  const Quat q = normalized(Quat{g(rng), g(rng), g(rng), g(rng)});
-  return {q, {u(rng), u(rng), u(rng)}};
+/// A uniformly random rotation (a normalised Gaussian quaternion) and a shift in [-max_shift, max_shift)^3.
+inline Pose random_pose(core::SplitMix64& rng, double max_shift) {
+  const auto u = [&] { return max_shift * (2.0 * rng.uniform() - 1.0); };
+  const double w = rng.normal(), x = rng.normal(), y = rng.normal(), z = rng.normal();
+  const Quat q = normalized(Quat{w, x, y, z});
+  const double px = u(), py = u(), pz = u();
+  return {q, {px, py, pz}};
 }
 
 inline Vec3 centre(const Sphere& s) {
@@ -108,8 +110,8 @@ inline double brute_gap(const std::vector<Sphere>& a, const std::vector<Sphere>&
 // about half of it; the test packings are sparse). Bisection on the reference path's volume.
 inline std::vector<Pose> deep_poses(const SphereTree& ta, const SphereTree& tb, int count,
                                     std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
+  core::SplitMix64 rng{seed};
+  const auto g = [](core::SplitMix64& r) { return r.normal(); };
   VolumeQuery q({.collect_pairs = false, .reference_kernel = true});
   const Vec3 ca = centre({ta.root().x, ta.root().y, ta.root().z, 0.f});
   const Vec3 cb = centre({tb.root().x, tb.root().y, tb.root().z, 0.f});

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <string>
 
@@ -152,7 +151,7 @@ TEST(CsvReader, RandomEditsEitherParseOrNameTheFileAndLine) {
   // starts with "t.csv:" and, past the header, a line number within the text
   const std::string valid = "# c\nid,a,b\nx,1,2.5\ny,-3,4e2\n\nz,5,6\n";
   const std::string alphabet = "0123456789.,-+eE\n\r #abinf\t";
-  std::mt19937 rng(29);
+  core::SplitMix64 rng{29};
   int errors = 0;
   for (int trial = 0; trial < 3000; ++trial) {
     const std::string text = test::mutate_text(valid, alphabet, rng);

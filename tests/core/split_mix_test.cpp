@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace uh::core {
 namespace {
@@ -41,6 +42,25 @@ TEST(SplitMix64, BelowCoversEveryValueEvenly) {
   }
   // each face 10,000 expected, standard deviation about 91: 5 sigma
   for (int c : counts) EXPECT_NEAR(c, draws / 6, 460);
+}
+
+TEST(SplitMix64, NormalsHaveUnitSpreadAndGaussianTails) {
+  SplitMix64 g{7};
+  const int draws = 200000;
+  double sum = 0.0, sum_sq = 0.0;
+  int beyond_two_sigma = 0;
+  for (int i = 0; i < draws; ++i) {
+    const double x = g.normal();
+    ASSERT_TRUE(std::isfinite(x));
+    sum += x;
+    sum_sq += x * x;
+    if (std::abs(x) > 2.0) ++beyond_two_sigma;
+  }
+  const double mean = sum / draws;
+  EXPECT_NEAR(mean, 0.0, 0.012);                       // 5 standard errors (1 / sqrt(draws))
+  EXPECT_NEAR(sum_sq / draws - mean * mean, 1.0, 0.016);  // 5 standard errors (sqrt(2 / draws))
+  // P(|x| > 2) = 4.55 %, standard deviation of the count about 93: 5 sigma
+  EXPECT_NEAR(beyond_two_sigma, 0.0455 * draws, 470);
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <memory>
-#include <random>
 #include <set>
 #include <utility>
 #include <vector>
@@ -30,7 +29,7 @@ std::set<std::pair<int, int>> ids(const std::vector<SpherePairContact>& pairs) {
 }
 
 TEST(HeldContactSet, ReevaluationMatchesBruteForceAtNewPose) {
-  std::mt19937 rng(42);
+  core::SplitMix64 rng{42};
   const std::vector<Sphere> a = random_spheres(rng, 40);
   const std::vector<Sphere> b = random_spheres(rng, 40);
   const Pose world_from_a = pose_of({0.1, -0.2, 0.3}, {1, 2, 3}, 0.4);
@@ -91,7 +90,7 @@ TEST(HeldContactSet, ReevaluationMatchesBruteForceAtNewPose) {
 }
 
 TEST(HeldContactSet, ReevaluatedPairsMatchBruteForcePerPair) {
-  std::mt19937 rng(3);
+  core::SplitMix64 rng{3};
   const std::vector<Sphere> a = random_spheres(rng, 20);
   const std::vector<Sphere> b = random_spheres(rng, 20);
   const Pose wa = pose_of({0, 0, 0}, {0, 0, 1}, 0.2);
@@ -115,7 +114,7 @@ TEST(HeldContactSet, ReevaluatedPairsMatchBruteForcePerPair) {
 }
 
 TEST(HeldContactSet, FusedEvaluationMatchesReevaluateThenPenalty) {
-  std::mt19937 rng(11);
+  core::SplitMix64 rng{11};
   const std::vector<Sphere> a = random_spheres(rng, 30);
   const std::vector<Sphere> b = random_spheres(rng, 30);
   const Pose wa = pose_of({0.2, 0.1, -0.1}, {1, -1, 2}, 0.7);

@@ -3,12 +3,12 @@
 // overlap geometry, the way a collision query would, without any tree, with the independent lens
 // reference (tests/support/lens_reference.hpp) rather than the kernel under test.
 
-#include <random>
 #include <vector>
 
 #include "lens_reference.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/math.hpp"
+#include "uh/core/split_mix.hpp"
 
 namespace uh::forcecomp::test {
 
@@ -21,11 +21,12 @@ inline Sphere sphere(double x, double y, double z, double r) {
 }
 
 /// `count` spheres with centres in [-0.5, 0.5]^3 and radii in [0.08, 0.2]: packings that overlap deeply.
-inline std::vector<Sphere> random_spheres(std::mt19937& rng, int count) {
-  std::uniform_real_distribution<double> pos(-0.5, 0.5);
-  std::uniform_real_distribution<double> rad(0.08, 0.2);
+inline std::vector<Sphere> random_spheres(core::SplitMix64& rng, int count) {
   std::vector<Sphere> out;
-  for (int i = 0; i < count; ++i) out.push_back(sphere(pos(rng), pos(rng), pos(rng), rad(rng)));
+  for (int i = 0; i < count; ++i) {
+    const double x = rng.uniform() - 0.5, y = rng.uniform() - 0.5, z = rng.uniform() - 0.5;
+    out.push_back(sphere(x, y, z, 0.08 + 0.12 * rng.uniform()));
+  }
   return out;
 }
 

@@ -149,7 +149,7 @@ TEST(ServerMessages, AnyMutationOfAMessageParsesOrIsAnError) {
       write_message(GameEvent{{.type = museum::EventType::vive_caught, .guard = 1, .count = 2}}),
       write_message(welcome_of(level, state, Role::phantom)),
   };
-  std::mt19937 rng(14);
+  core::SplitMix64 rng{14};
   int refused = 0;
   for (const std::string& message : messages) {
     for (int i = 0; i < 400; ++i) {

@@ -59,6 +59,7 @@
 #include "uh/core/latest_value.hpp"
 #include "uh/core/math.hpp"
 #include "uh/core/result.hpp"
+#include "uh/core/slot_table.hpp"
 #include "uh/core/spsc_queue.hpp"
 
 namespace uh::collette {
@@ -208,8 +209,9 @@ class CollisionWorld {
  private:
   struct Object;
   struct Watcher;
-  // Ids to items: a fixed table of slots with generations, changed by the controlling thread and
-  // looked up lock-free by movers and readers (defined in the .cpp, the only user).
+  // Ids to items: core's slot table under this world's id type (slot in the low bits, generation
+  // above), changed by the controlling thread and looked up lock-free by movers and readers
+  // (defined in the .cpp, the only user).
   template <typename T>
   class SlotTable {
    public:
@@ -219,24 +221,14 @@ class CollisionWorld {
     void release(std::int32_t id);   // the id and its copies are stale from now on
     T* find(std::int32_t id) const;  // null for a stale or unknown id
     T* at_slot(std::int32_t slot) const {
-      return slots_[static_cast<std::size_t>(slot)].item.load(std::memory_order_acquire);
+      return slots_.item(static_cast<std::uint32_t>(slot)).load(std::memory_order_acquire);
     }
-    std::int32_t slots_used() const { return used_; }
-    std::uint32_t generation(std::int32_t slot) const {
-      return slots_[static_cast<std::size_t>(slot)].generation.load(std::memory_order_relaxed);
-    }
-    int count() const { return count_; }
+    std::int32_t slots_used() const { return static_cast<std::int32_t>(slots_.slots_used()); }
+    std::uint32_t generation(std::int32_t slot) const { return slots_.generation(static_cast<std::uint32_t>(slot)); }
+    int count() const { return slots_.count(); }
 
    private:
-    struct Slot {
-      std::atomic<std::uint32_t> generation{0};
-      std::atomic<T*> item{nullptr};
-    };
-    std::unique_ptr<Slot[]> slots_;
-    int capacity_;
-    std::vector<std::int32_t> free_;
-    std::int32_t used_ = 0;  // slots ever occupied
-    int count_ = 0;
+    core::SlotTable<std::atomic<T*>> slots_;
   };
   // a change for the collision thread, and what it hands back to be freed
   struct Change {

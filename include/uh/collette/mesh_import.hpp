@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "uh/collette/triangle_mesh.hpp"
 #include "uh/core/result.hpp"
 
@@ -60,6 +62,16 @@ Result<TriangleMesh> parse_obj_or_stl(std::string_view bytes, const std::string&
 /// comment is not empty: the one OBJ writer, for meshes the project generates or receives and
 /// hands on as files. Coordinates are written so they read back exactly.
 std::string obj_text(const TriangleMesh& mesh, std::string_view comment);
+
+/// The mesh as JSON, {"vertices": [x, y, z, ...], "triangles": [i, j, k, ...]} (flat arrays,
+/// corners from 0): the one mesh-to-JSON writer (the museum page's pictures, the service's meshes).
+/// Coordinates are multiplied by `scale`; with decimals >= 0 they are rounded to that many places
+/// (a picture needs no more), else written so they read back exactly.
+nlohmann::json mesh_json(const TriangleMesh& mesh, double scale = 1.0, int decimals = -1);
+
+/// Reads that JSON (other fields are ignored): every coordinate a finite number, every corner an
+/// index of a vertex. `name` names the mesh in messages. No welding, no validation (validate_mesh()).
+Result<TriangleMesh> parse_mesh_json(std::string_view text, const std::string& name);
 
 /// Welds, repairs, validates and orients an in-memory mesh the same way load_mesh() does (used by
 /// load_mesh() and by code that builds meshes itself). `mesh.source_name` names it in messages.

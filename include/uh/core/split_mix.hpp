@@ -5,7 +5,9 @@
 /// unlike the std:: distributions, so a seed names one dealt round, one textured surface or one
 /// exploration everywhere. Not for cryptography.
 
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 
 namespace uh::core {
 
@@ -25,6 +27,12 @@ struct SplitMix64 {
   double uniform_open() { return (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53; }
   /// An integer in [0, n), n > 0 (the modulo's bias is below n / 2^64).
   int below(int n) { return static_cast<int>(next() % static_cast<std::uint64_t>(n)); }
+  /// A standard normal draw (Box-Muller over two open uniforms, so the logarithm is finite), in
+  /// place of std::normal_distribution, whose numbers differ between standard libraries.
+  double normal() {
+    const double r = std::sqrt(-2.0 * std::log(uniform_open()));
+    return r * std::cos(2.0 * std::numbers::pi * uniform_open());
+  }
 };
 
 }  // namespace uh::core
