@@ -242,16 +242,9 @@ Result<json> scene_mesh(const controllers::Scene& scene, const std::string& name
     return Error{fmt::format("'{}' was given as a .ist file, which holds no mesh", name)};
   auto mesh = collette::load_mesh(shape->mesh);
   if (!mesh) return mesh.error();
-  json vertices = json::array(), triangles = json::array();
-  const double s = shape->meters_per_unit;
-  for (const Vec3& v : mesh->vertices) {
-    vertices.push_back(v.x * s);
-    vertices.push_back(v.y * s);
-    vertices.push_back(v.z * s);
-  }
-  for (const auto& t : mesh->triangles)
-    for (const std::int32_t i : t) triangles.push_back(i);
-  return json{{"object", name}, {"vertices", std::move(vertices)}, {"triangles", std::move(triangles)}};
+  json out = collette::mesh_json(*mesh, shape->meters_per_unit);
+  out["object"] = name;
+  return out;
 }
 
 }  // namespace uh::service
