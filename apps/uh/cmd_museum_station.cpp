@@ -82,6 +82,43 @@ constexpr const char* kKeysHelp =
     "      h  guide the stylus home    c  next sound channel    + / -  its volume\n"
     "      q  quit\n";
 
+// A key of the station's keyboard pressed (kKeysHelp); false for 'q' (quit)
+bool press_key(museum_station::Station& station, char key) {
+  switch (key) {
+    case 'w':
+    case ' ':
+      station.press(StationKey::where_am_i);
+      break;
+    case 'r':
+      station.press(StationKey::repeat);
+      break;
+    case 'g':
+      station.press(StationKey::genuine);
+      break;
+    case 'f':
+      station.press(StationKey::forgery);
+      break;
+    case 'h':
+      station.press(StationKey::guide_home);
+      break;
+    case 'c':
+      station.press(StationKey::next_channel);
+      break;
+    case '+':
+    case '=':
+      station.press(StationKey::volume_up);
+      break;
+    case '-':
+      station.press(StationKey::volume_down);
+      break;
+    case 'q':
+      return false;
+    default:
+      break;
+  }
+  return true;
+}
+
 int museum_station_run(const StationArgs& args) {
   // a bad address or device is said before anything connects (the device is opened once and
   // closed: a selector naming no device fails now, not when the first piece comes)
@@ -131,41 +168,8 @@ int museum_station_run(const StationArgs& args) {
       }
       while ((*link)->poll(note)) (*station)->handle(note);
       bool quit = false;
-      while (auto key = next_key(input_open)) {
-        switch (*key) {
-          case 'w':
-          case ' ':
-            (*station)->press(StationKey::where_am_i);
-            break;
-          case 'r':
-            (*station)->press(StationKey::repeat);
-            break;
-          case 'g':
-            (*station)->press(StationKey::genuine);
-            break;
-          case 'f':
-            (*station)->press(StationKey::forgery);
-            break;
-          case 'h':
-            (*station)->press(StationKey::guide_home);
-            break;
-          case 'c':
-            (*station)->press(StationKey::next_channel);
-            break;
-          case '+':
-          case '=':
-            (*station)->press(StationKey::volume_up);
-            break;
-          case '-':
-            (*station)->press(StationKey::volume_down);
-            break;
-          case 'q':
-            quit = true;
-            break;
-          default:
-            break;
-        }
-      }
+      while (auto key = next_key(input_open))
+        if (!press_key(**station, *key)) quit = true;
       if (quit) break;
       const auto now = std::chrono::steady_clock::now();
       (*station)->frame(std::chrono::duration<double>(now - last).count());

@@ -138,24 +138,49 @@ void print_summary(const controllers::SessionReport& r) {
     print_tool_summary(t, r.stepped, r.tools.size() > 1 ? fmt::format("tool '{}': ", t.tool) : std::string());
 }
 
+// The scene to run: the file's (or the default one) with --device's driver and selection on its tool
+Result<controllers::Scene> scene_of(const RunArgs& args, const std::filesystem::path& cache) {
+  auto scene = args.scene.empty() ? controllers::default_scene(cache) : controllers::load_scene(args.scene);
+  if (!scene || args.device.empty()) return scene;
+  auto choice = devices::parse_device_choice(args.device, devices::all_drivers());
+  if (!choice) return choice.error();
+  // another driver does not share the scene's settings; the same one keeps them, with the selection on top
+  if (scene->tools.size() > 1)
+    return Error{fmt::format("{}: --device replaces the device of a one-tool scene; this scene has {} tools "
+                             "(set each one's device in its tools[i].device)",
+                             scene->source, scene->tools.size())};
+  controllers::SceneDevice& device = scene->tool().device;
+  if (choice->driver != device.driver) device.config = {};
+  device.driver = choice->driver;
+  for (const auto& [key, value] : choice->selection.values()) device.config.set(key, value);
+  return scene;
+}
+
+// What the run prints and writes once the session has stopped; the program's exit status
+int finish_run(const RunArgs& args, const controllers::SessionReport& report) {
+  if (!args.plot.empty())
+    if (auto plotted = write_session_plot(report, args.plot); !plotted) return fail(plotted.error().message);
+  if (args.json) {
+    std::printf("%s\n", controllers::session_report_json(report).c_str());
+  } else {
+    print_summary(report);
+    if (!args.trace.empty()) std::printf("  trace -> %s\n", args.trace.c_str());
+    if (!args.plot.empty()) std::printf("  plot  -> %s\n", args.plot.c_str());
+  }
+  if (g_stop_signal != 0) {
+    const int signal_number = g_stop_signal;
+    std::fflush(stdout);
+    std::fprintf(stderr, "uh: stopped by %s after %.2f s; the device was sent zero force\n",
+                 signal_name(signal_number).c_str(), report.seconds);
+    return 128 + signal_number;
+  }
+  return 0;
+}
+
 int run_session(const RunArgs& args) {
   const std::filesystem::path cache = controllers::default_cache_dir();
-  auto scene = args.scene.empty() ? controllers::default_scene(cache) : controllers::load_scene(args.scene);
+  auto scene = scene_of(args, cache);
   if (!scene) return fail(scene.error().message);
-  if (!args.device.empty()) {
-    auto choice = devices::parse_device_choice(args.device, devices::all_drivers());
-    if (!choice) return fail(choice.error().message);
-    // another driver does not share the scene's settings; the same one keeps them, with the selection on top
-    if (scene->tools.size() > 1)
-      return fail(
-          fmt::format("{}: --device replaces the device of a one-tool scene; this scene has {} tools "
-                      "(set each one's device in its tools[i].device)",
-                      scene->source, scene->tools.size()));
-    controllers::SceneDevice& device = scene->tool().device;
-    if (choice->driver != device.driver) device.config = {};
-    device.driver = choice->driver;
-    for (const auto& [key, value] : choice->selection.values()) device.config.set(key, value);
-  }
 
   controllers::SessionOptions options;
   if (args.haptic_hz > 0.0) options.haptic_hz = args.haptic_hz;
@@ -215,24 +240,7 @@ int run_session(const RunArgs& args) {
   const Status traced = trace_file ? trace_file->commit() : Status{Ok{}};
   if (!ran) return fail(ran.error().message);
   if (!traced) return fail(traced.error().message);
-  const auto& report = (*session)->report();
-  if (!args.plot.empty())
-    if (auto plotted = write_session_plot(report, args.plot); !plotted) return fail(plotted.error().message);
-  if (args.json) {
-    std::printf("%s\n", controllers::session_report_json(report).c_str());
-  } else {
-    print_summary(report);
-    if (!args.trace.empty()) std::printf("  trace -> %s\n", args.trace.c_str());
-    if (!args.plot.empty()) std::printf("  plot  -> %s\n", args.plot.c_str());
-  }
-  if (g_stop_signal != 0) {
-    const int signal_number = g_stop_signal;
-    std::fflush(stdout);
-    std::fprintf(stderr, "uh: stopped by %s after %.2f s; the device was sent zero force\n",
-                 signal_name(signal_number).c_str(), report.seconds);
-    return 128 + signal_number;
-  }
-  return 0;
+  return finish_run(args, (*session)->report());
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -105,118 +107,167 @@ std::string parse_mesh_binary(const Fields& f, AddObject& a) {
   return {};
 }
 
-// Parses the body of a request whose type is known; returns an error text or fills `body`.
-std::string parse_body(const std::string& type, const Fields& f, std::optional<RequestBody>& body) {
-  std::string e;
-  if (type == "hello") {
-    if (e = f.check_known({"protocol", "token"}); !e.empty()) return e;
-    const json* p = f.find("protocol");
-    if (p == nullptr) return "field 'protocol' is missing (expected the protocol version, 1)";
-    if (!p->is_number_integer())
-      return fmt::format("field 'protocol': expected a whole number, got {}", p->type_name());
-    Hello h;
-    const auto v = p->get<std::int64_t>();
-    h.protocol = v < 0 || v > 1'000'000 ? -1 : static_cast<int>(v);
-    if (e = f.string("token", h.token, false); !e.empty()) return e;
-    body = h;
-  } else if (type == "open") {
-    if (e = f.check_known({"scene"}); !e.empty()) return e;
-    Open o;
-    std::string scene;
-    if (e = f.string("scene", scene, false); !e.empty()) return e;
-    if (!scene.empty()) o.scene = scene;
-    body = o;
-  } else if (type == "start") {
-    if (e = f.check_known({"seconds"}); !e.empty()) return e;
-    Start s;
-    double seconds = -1.0;
-    if (e = f.number("seconds", seconds, 1e-3, 86400.0); !e.empty()) return e;
-    if (seconds > 0.0) s.seconds = seconds;
-    body = s;
-  } else if (type == "stop" || type == "ping" || type == "close" || type == "unsubscribe" ||
-             type == "get_scene") {
-    if (e = f.check_known({}); !e.empty()) return e;
-    if (type == "stop")
-      body = Stop{};
-    else if (type == "ping")
-      body = Ping{};
-    else if (type == "close")
-      body = Close{};
-    else if (type == "unsubscribe")
-      body = Unsubscribe{};
-    else
-      body = GetScene{};
-  } else if (type == "subscribe") {
-    if (e = f.check_known({"rate_hz"}); !e.empty()) return e;
-    Subscribe s;
-    if (e = f.number("rate_hz", s.rate_hz, kMinStateRateHz, kMaxStateRateHz); !e.empty()) return e;
-    body = s;
-  } else if (type == "get_mesh") {
-    if (e = f.check_known({"object"}); !e.empty()) return e;
-    GetMesh g;
-    if (e = f.string("object", g.object, true); !e.empty()) return e;
-    body = g;
-  } else if (type == "add_object") {
-    if (e = f.check_known({"object", "mesh_binary"}); !e.empty()) return e;
-    AddObject a;
-    if (e = f.object("object", a.object); !e.empty()) return e;
-    if (f.find("mesh_binary") != nullptr) {
-      if (e = parse_mesh_binary(f, a); !e.empty()) return e;
-    }
-    body = a;
-  } else if (type == "remove_object") {
-    if (e = f.check_known({"name"}); !e.empty()) return e;
-    RemoveObject r;
-    if (e = f.string("name", r.name, true); !e.empty()) return e;
-    body = r;
-  } else if (type == "set_pose") {
-    if (e = f.check_known({"object", "pose"}); !e.empty()) return e;
-    SetPose s;
-    if (e = f.string("object", s.object, true); !e.empty()) return e;
-    if (e = f.object("pose", s.pose); !e.empty()) return e;
-    body = s;
-  } else if (type == "set_watch") {
-    if (e = f.check_known({"objects"}); !e.empty()) return e;
-    const json* list = f.find("objects");
-    if (list == nullptr || !list->is_array()) return "field 'objects': expected a list of object names";
-    SetWatch s;
-    for (std::size_t i = 0; i < list->size(); ++i) {
-      const json& name = (*list)[i];
-      if (!name.is_string() || name.get_ref<const std::string&>().empty())
-        return fmt::format("field 'objects[{}]': expected an object name, got {}", i, name.type_name());
-      s.objects.push_back(name.get<std::string>());
-    }
-    body = s;
-  } else if (type == "set_device") {
-    if (e = f.check_known({"device"}); !e.empty()) return e;
-    SetDevice s;
-    if (e = f.object("device", s.device); !e.empty()) return e;
-    body = s;
-  } else if (type == "set_tool") {
-    if (e = f.check_known({"tool"}); !e.empty()) return e;
-    SetTool s;
-    if (e = f.object("tool", s.tool); !e.empty()) return e;
-    body = s;
-  } else if (type == "set_rates") {
-    if (e = f.check_known({"haptic_hz", "collision_hz"}); !e.empty()) return e;
-    SetRates s;
-    // the scene parser checks the ranges and names the scene field
-    double hz = -1.0;
-    if (e = f.number("haptic_hz", hz, 0.0, 1e9); !e.empty()) return e;
-    if (hz >= 0.0) s.haptic_hz = hz;
-    hz = -1.0;
-    if (e = f.number("collision_hz", hz, 0.0, 1e9); !e.empty()) return e;
-    if (hz >= 0.0) s.collision_hz = hz;
-    if (!s.haptic_hz && !s.collision_hz) return "set_rates needs 'haptic_hz' or 'collision_hz'";
-    body = s;
-  } else {
-    return fmt::format(
-        "unknown message type '{}' (known: hello, open, start, stop, ping, close, subscribe, unsubscribe, "
-        "get_scene, get_mesh, add_object, remove_object, set_pose, set_watch, set_device, set_tool, "
-        "set_rates)",
-        type);
-  }
+// One parser per request type: an error text, or `body` filled.
+using BodyParser = std::string (*)(const Fields& f, std::optional<RequestBody>& body);
+
+std::string parse_hello(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"protocol", "token"}); !e.empty()) return e;
+  const json* p = f.find("protocol");
+  if (p == nullptr) return "field 'protocol' is missing (expected the protocol version, 1)";
+  if (!p->is_number_integer()) return fmt::format("field 'protocol': expected a whole number, got {}", p->type_name());
+  Hello h;
+  const auto v = p->get<std::int64_t>();
+  h.protocol = v < 0 || v > 1'000'000 ? -1 : static_cast<int>(v);
+  if (auto e = f.string("token", h.token, false); !e.empty()) return e;
+  body = h;
   return {};
+}
+
+std::string parse_open(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"scene"}); !e.empty()) return e;
+  Open o;
+  std::string scene;
+  if (auto e = f.string("scene", scene, false); !e.empty()) return e;
+  if (!scene.empty()) o.scene = scene;
+  body = o;
+  return {};
+}
+
+std::string parse_start(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"seconds"}); !e.empty()) return e;
+  Start s;
+  double seconds = -1.0;
+  if (auto e = f.number("seconds", seconds, 1e-3, 86400.0); !e.empty()) return e;
+  if (seconds > 0.0) s.seconds = seconds;
+  body = s;
+  return {};
+}
+
+// a request without fields
+template <typename Message>
+std::string parse_bare(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({}); !e.empty()) return e;
+  body = Message{};
+  return {};
+}
+
+std::string parse_subscribe(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"rate_hz"}); !e.empty()) return e;
+  Subscribe s;
+  if (auto e = f.number("rate_hz", s.rate_hz, kMinStateRateHz, kMaxStateRateHz); !e.empty()) return e;
+  body = s;
+  return {};
+}
+
+std::string parse_get_mesh(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"object"}); !e.empty()) return e;
+  GetMesh g;
+  if (auto e = f.string("object", g.object, true); !e.empty()) return e;
+  body = g;
+  return {};
+}
+
+std::string parse_add_object(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"object", "mesh_binary"}); !e.empty()) return e;
+  AddObject a;
+  if (auto e = f.object("object", a.object); !e.empty()) return e;
+  if (f.find("mesh_binary") != nullptr)
+    if (auto e = parse_mesh_binary(f, a); !e.empty()) return e;
+  body = a;
+  return {};
+}
+
+std::string parse_remove_object(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"name"}); !e.empty()) return e;
+  RemoveObject r;
+  if (auto e = f.string("name", r.name, true); !e.empty()) return e;
+  body = r;
+  return {};
+}
+
+std::string parse_set_pose(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"object", "pose"}); !e.empty()) return e;
+  SetPose s;
+  if (auto e = f.string("object", s.object, true); !e.empty()) return e;
+  if (auto e = f.object("pose", s.pose); !e.empty()) return e;
+  body = s;
+  return {};
+}
+
+std::string parse_set_watch(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"objects"}); !e.empty()) return e;
+  const json* list = f.find("objects");
+  if (list == nullptr || !list->is_array()) return "field 'objects': expected a list of object names";
+  SetWatch s;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const json& name = (*list)[i];
+    if (!name.is_string() || name.get_ref<const std::string&>().empty())
+      return fmt::format("field 'objects[{}]': expected an object name, got {}", i, name.type_name());
+    s.objects.push_back(name.get<std::string>());
+  }
+  body = s;
+  return {};
+}
+
+std::string parse_set_device(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"device"}); !e.empty()) return e;
+  SetDevice s;
+  if (auto e = f.object("device", s.device); !e.empty()) return e;
+  body = s;
+  return {};
+}
+
+std::string parse_set_tool(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"tool"}); !e.empty()) return e;
+  SetTool s;
+  if (auto e = f.object("tool", s.tool); !e.empty()) return e;
+  body = s;
+  return {};
+}
+
+std::string parse_set_rates(const Fields& f, std::optional<RequestBody>& body) {
+  if (auto e = f.check_known({"haptic_hz", "collision_hz"}); !e.empty()) return e;
+  SetRates s;
+  // the scene's validate() checks the ranges and names the scene field
+  double hz = -1.0;
+  if (auto e = f.number("haptic_hz", hz, 0.0, 1e9); !e.empty()) return e;
+  if (hz >= 0.0) s.haptic_hz = hz;
+  hz = -1.0;
+  if (auto e = f.number("collision_hz", hz, 0.0, 1e9); !e.empty()) return e;
+  if (hz >= 0.0) s.collision_hz = hz;
+  if (!s.haptic_hz && !s.collision_hz) return "set_rates needs 'haptic_hz' or 'collision_hz'";
+  body = s;
+  return {};
+}
+
+// every request type and its parser, in the order an unknown type's error lists them
+constexpr std::pair<std::string_view, BodyParser> kBodyParsers[] = {
+    {"hello", parse_hello},
+    {"open", parse_open},
+    {"start", parse_start},
+    {"stop", parse_bare<Stop>},
+    {"ping", parse_bare<Ping>},
+    {"close", parse_bare<Close>},
+    {"subscribe", parse_subscribe},
+    {"unsubscribe", parse_bare<Unsubscribe>},
+    {"get_scene", parse_bare<GetScene>},
+    {"get_mesh", parse_get_mesh},
+    {"add_object", parse_add_object},
+    {"remove_object", parse_remove_object},
+    {"set_pose", parse_set_pose},
+    {"set_watch", parse_set_watch},
+    {"set_device", parse_set_device},
+    {"set_tool", parse_set_tool},
+    {"set_rates", parse_set_rates},
+};
+
+// Parses the body of a request of `type`; returns an error text or fills `body`.
+std::string parse_body(const std::string& type, const Fields& f, std::optional<RequestBody>& body) {
+  for (const auto& [name, parser] : kBodyParsers)
+    if (type == name) return parser(f, body);
+  std::string known;
+  for (const auto& entry : kBodyParsers) known += fmt::format("{}{}", known.empty() ? "" : ", ", entry.first);
+  return fmt::format("unknown message type '{}' (known: {})", type, known);
 }
 
 std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
