@@ -111,6 +111,12 @@ Result<std::string> read_scene_file(const std::filesystem::path& path);
 /// Parses scene JSON text; `source` names it in messages, `base_dir` resolves relative paths.
 Result<Scene> parse_scene(std::string_view json_text, const std::string& source, const std::filesystem::path& base_dir);
 
+/// The scene as a scene file's text, which load_scene() reads back to the same scene: every field
+/// written (defaults too), materials inline, mesh and .ist paths as the scene holds them (absolute
+/// after load_scene()). Refuses a scene validate() refuses, and a shape whose tree is held only
+/// in memory (no file to name).
+Result<std::string> write_scene(const Scene& scene);
+
 /// Reads a device's settings from a JSON object (numbers, strings, booleans, [x, y, z]) as a
 /// scene's `tool.device.config` (or `tools[i].device.config`) is read; a relative `file` resolves against
 /// `base_dir`. Errors name `source` and the key.
