@@ -613,61 +613,64 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   return device_error();
 }
 
+// One tool's part of the report: its device, its haptic loop, its force controller and proxy
+void HapticSession::collect_tool_report(ToolRig& rig, bool stepped) {
+  ToolReport& t = rig.report;
+  const haptico::HapticStats hs = rig.manager->stats();
+  t.haptic_target_hz = haptic_hz_;
+  t.haptic_ticks = hs.ticks;
+  const haptico::DeviceInfo& info = rig.manager->device_info();
+  t.device = {.driver = model_->scene.tools[static_cast<std::size_t>(rig.index)].device.driver,
+              .name = info.name,
+              .model = info.model,
+              .serial = info.serial,
+              .max_force_n = info.max_force_n};
+  if (const auto* fd = dynamic_cast<const devices::ForceDimensionDevice*>(&rig.manager->device()))
+    t.device.com_rate_hz = fd->com_rate_hz();
+  if (stepped) {
+    t.haptic_rate_hz = haptic_hz_;
+  } else {
+    t.haptic_rate_hz = hs.loop.achieved_rate_hz;
+    t.haptic_missed_deadlines = hs.loop.missed_deadlines;
+    t.jitter_p50_us = hs.loop.period_error.p50_ns * 1e-3;
+    t.jitter_p99_us = hs.loop.period_error.p99_ns * 1e-3;
+    t.jitter_p999_us = hs.loop.period_error.p999_ns * 1e-3;
+    t.jitter_max_us = hs.loop.period_error.max_ns * 1e-3;
+    t.tick_p50_us = hs.loop.callback_duration.p50_ns * 1e-3;
+    t.tick_p99_us = hs.loop.callback_duration.p99_ns * 1e-3;
+    t.tick_max_us = hs.loop.callback_duration.max_ns * 1e-3;
+    t.haptic_priority_raised = hs.loop.priority_raised;
+  }
+  const ForceController& fcon = *rig.force_controller;
+  const ForceControllerStats fc = fcon.stats();
+  t.force_max_raw_step_n = fc.max_force_step_n;
+  t.force_nonfinite = fc.safety.nonfinite + hs.nonfinite;
+  t.force_clamped = hs.force_clamped;
+  t.torque_clamped = hs.torque_clamped;
+  t.limits = hs.limits;
+  t.zeroed_ticks = hs.zeroed_ticks;
+  t.stale_ticks = fc.safety.stale_ticks;
+  t.contact_ticks = fc.contact_ticks;
+  t.multi_rate = fcon.options().multi_rate;
+  t.tick_force = fcon.options().tick_force == TickForce::kModel ? "model" : "exact";
+  t.model_clamped_ticks = fc.model_clamped_ticks;
+  t.model_held_ticks = fc.model_held_ticks;
+  t.model_checked_ticks = fc.model_checked_ticks;
+  t.model_error_rms_n = fc.model_error_rms_n;
+  t.model_error_max_n = fc.model_error_max_n;
+  t.coupling = fcon.options().use_coupling;
+  t.proxy = rig.proxy != nullptr;
+  if (rig.proxy) {
+    t.proxy_stats = rig.proxy->stats();
+    t.proxy_position = rig.proxy->pose().position;
+  }
+}
+
 void HapticSession::collect_report(double seconds, bool stepped) {
   SessionReport& r = report_;
   r.stepped = stepped;
   r.seconds = seconds;
-  for (auto& rig : rigs_) {
-    ToolReport& t = rig->report;
-    const haptico::HapticStats hs = rig->manager->stats();
-    t.haptic_target_hz = haptic_hz_;
-    t.haptic_ticks = hs.ticks;
-    const haptico::DeviceInfo& info = rig->manager->device_info();
-    t.device = {.driver = model_->scene.tools[static_cast<std::size_t>(rig->index)].device.driver,
-                .name = info.name,
-                .model = info.model,
-                .serial = info.serial,
-                .max_force_n = info.max_force_n};
-    if (const auto* fd = dynamic_cast<const devices::ForceDimensionDevice*>(&rig->manager->device()))
-      t.device.com_rate_hz = fd->com_rate_hz();
-    if (stepped) {
-      t.haptic_rate_hz = haptic_hz_;
-    } else {
-      t.haptic_rate_hz = hs.loop.achieved_rate_hz;
-      t.haptic_missed_deadlines = hs.loop.missed_deadlines;
-      t.jitter_p50_us = hs.loop.period_error.p50_ns * 1e-3;
-      t.jitter_p99_us = hs.loop.period_error.p99_ns * 1e-3;
-      t.jitter_p999_us = hs.loop.period_error.p999_ns * 1e-3;
-      t.jitter_max_us = hs.loop.period_error.max_ns * 1e-3;
-      t.tick_p50_us = hs.loop.callback_duration.p50_ns * 1e-3;
-      t.tick_p99_us = hs.loop.callback_duration.p99_ns * 1e-3;
-      t.tick_max_us = hs.loop.callback_duration.max_ns * 1e-3;
-      t.haptic_priority_raised = hs.loop.priority_raised;
-    }
-    const ForceController& fcon = *rig->force_controller;
-    const ForceControllerStats fc = fcon.stats();
-    t.force_max_raw_step_n = fc.max_force_step_n;
-    t.force_nonfinite = fc.safety.nonfinite + hs.nonfinite;
-    t.force_clamped = hs.force_clamped;
-    t.torque_clamped = hs.torque_clamped;
-    t.limits = hs.limits;
-    t.zeroed_ticks = hs.zeroed_ticks;
-    t.stale_ticks = fc.safety.stale_ticks;
-    t.contact_ticks = fc.contact_ticks;
-    t.multi_rate = fcon.options().multi_rate;
-    t.tick_force = fcon.options().tick_force == TickForce::kModel ? "model" : "exact";
-    t.model_clamped_ticks = fc.model_clamped_ticks;
-    t.model_held_ticks = fc.model_held_ticks;
-    t.model_checked_ticks = fc.model_checked_ticks;
-    t.model_error_rms_n = fc.model_error_rms_n;
-    t.model_error_max_n = fc.model_error_max_n;
-    t.coupling = fcon.options().use_coupling;
-    t.proxy = rig->proxy != nullptr;
-    if (rig->proxy) {
-      t.proxy_stats = rig->proxy->stats();
-      t.proxy_position = rig->proxy->pose().position;
-    }
-  }
+  for (auto& rig : rigs_) collect_tool_report(*rig, stepped);
   const collette::CollisionWorldStats ws = world_->stats();
   r.collision_target_hz = collision_hz_;
   r.collision_steps = ws.steps;

@@ -299,6 +299,7 @@ class HapticSession {
   Status begin_run();
   // the run's statistics into each tool's report (before the loops stop), then (after the last
   // trace is taken) the tools' reports into report_
+  void collect_tool_report(ToolRig& rig, bool stepped);
   void collect_report(double seconds, bool stepped);
   void publish_report();
   void take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
