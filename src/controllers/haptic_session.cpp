@@ -127,14 +127,25 @@ Result<std::unique_ptr<HapticSession>> HapticSession::create(const Scene& scene,
 Result<std::unique_ptr<HapticSession>> HapticSession::create(std::shared_ptr<const SessionModel> model,
                                                              const SessionRunOptions& options,
                                                              const haptico::DeviceRegistry& registry) {
+  return create(std::move(model), std::vector<std::unique_ptr<haptico::HapticDevice>>{}, options, registry);
+}
+
+Result<std::unique_ptr<HapticSession>> HapticSession::create(
+    std::shared_ptr<const SessionModel> model, std::vector<std::unique_ptr<haptico::HapticDevice>> devices,
+    const SessionRunOptions& options, const haptico::DeviceRegistry& registry) {
   assert(model != nullptr && "uh::controllers::HapticSession::create(): no model");
+  const std::size_t tools = model->scene.tools.size();
+  if (devices.size() > tools)
+    return Error{fmt::format("{}: {} devices given for {} tool(s)", model->scene.source, devices.size(), tools),
+                 ErrorKind::kInvalid};
+  devices.resize(tools);  // the rest open through the registry
   std::unique_ptr<HapticSession> session(new HapticSession());
   session->model_ = std::move(model);
   session->haptic_hz_ = session->model_->scene.haptic_hz;
   session->collision_hz_ = session->model_->scene.collision_hz;
   if (Status s = session->add_objects(options); !s) return s.error();
-  for (std::size_t t = 0; t < session->model_->scene.tools.size(); ++t)
-    if (Status s = session->add_tool(t, options, registry); !s) return s.error();
+  for (std::size_t t = 0; t < tools; ++t)
+    if (Status s = session->add_tool(t, std::move(devices[t]), options, registry); !s) return s.error();
   HapticSession& self = *session;
   self.collision_connection_ = self.world_->on_collision().connect<&HapticSession::on_collision>(self);
   self.step_connection_ = self.world_->on_step().connect<&HapticSession::on_step>(self);  // after the proxies'
@@ -163,8 +174,8 @@ Status HapticSession::add_objects(const SessionRunOptions& options) {
   return Ok{};
 }
 
-Status HapticSession::add_tool(std::size_t t, const SessionRunOptions& options,
-                               const haptico::DeviceRegistry& registry) {
+Status HapticSession::add_tool(std::size_t t, std::unique_ptr<haptico::HapticDevice> device,
+                               const SessionRunOptions& options, const haptico::DeviceRegistry& registry) {
   const Scene& scene = model_->scene;
   const SceneTool& tool = scene.tools[t];
   auto rig = std::make_unique<ToolRig>();
@@ -178,7 +189,7 @@ Status HapticSession::add_tool(std::size_t t, const SessionRunOptions& options,
                                      .name = tool.name});
   if (!tool_id) return tool_id.error();
   rig->tool_id = *tool_id;
-  if (Status s = open_device(*rig, options, registry); !s) return s;
+  if (Status s = open_device(*rig, std::move(device), options, registry); !s) return s;
   if (Status s = wire_controllers(*rig); !s) return s;
   ToolRig& r = *rig;
   r.sent_connection = r.manager->sent_on_haptic_tick().connect<&ToolRig::on_tick_sent>(r);
@@ -189,8 +200,9 @@ Status HapticSession::add_tool(std::size_t t, const SessionRunOptions& options,
   return Ok{};
 }
 
-Status HapticSession::open_device(ToolRig& rig, const SessionRunOptions& options,
-                                  const haptico::DeviceRegistry& registry) {
+// The tool's device through the registry, as its scene entry names it
+Result<std::unique_ptr<haptico::HapticDevice>> HapticSession::make_device(const ToolRig& rig,
+                                                                         const haptico::DeviceRegistry& registry) const {
   const Scene& scene = model_->scene;
   const SceneTool& tool = scene.tools[static_cast<std::size_t>(rig.index)];
   // a simulated device advances its own time by one period per tick: it runs at the haptic rate
@@ -202,9 +214,21 @@ Status HapticSession::open_device(ToolRig& rig, const SessionRunOptions& options
   if (!device)
     return Error{fmt::format("{}: {}.device: {}", scene.source, rig.path, device.error().message),
                  device.error().kind};
+  return device;
+}
+
+Status HapticSession::open_device(ToolRig& rig, std::unique_ptr<haptico::HapticDevice> given,
+                                  const SessionRunOptions& options, const haptico::DeviceRegistry& registry) {
+  const Scene& scene = model_->scene;
+  const SceneTool& tool = scene.tools[static_cast<std::size_t>(rig.index)];
+  if (!given) {
+    auto made = make_device(rig, registry);
+    if (!made) return made.error();
+    given = std::move(made).value();
+  }
   const std::size_t trace_capacity = static_cast<std::size_t>(std::max(1024.0, haptic_hz_ * 0.5));
   rig.manager = std::make_unique<haptico::HapticManager>(
-      std::move(device).value(),
+      std::move(given),
       haptico::HapticManagerOptions{.rate_hz = haptic_hz_,
                                     .raise_priority = options.raise_priority,
                                     .trace_capacity = trace_capacity,

@@ -10,7 +10,6 @@
 #include "plan.hpp"
 #include "uh/collette/ist_cache.hpp"
 #include "uh/controllers/session_model.hpp"
-#include "uh/haptico/device_registry.hpp"
 
 namespace uh::exploration {
 namespace {
@@ -44,24 +43,6 @@ Result<std::shared_ptr<const SessionModel>> compile_object_scene(const Scene& sc
   return std::shared_ptr<const SessionModel>(std::move(on_spheres));
 }
 
-// A session of `model` (compile_object_scene) whose device is `device`: handed over through a
-// registry whose "explorer" driver gives it to one session only
-Result<std::unique_ptr<HapticSession>> open_explorer_session(std::shared_ptr<const SessionModel> model,
-                                                              const SessionOptions& so,
-                                                              std::unique_ptr<ExplorerDevice> device) {
-  auto holder = std::make_shared<std::unique_ptr<haptico::HapticDevice>>(std::move(device));
-  haptico::DeviceRegistry registry;
-  if (auto r = registry.register_driver(
-          "explorer",
-          [holder](const haptico::DeviceConfig&) -> Result<std::unique_ptr<haptico::HapticDevice>> {
-            if (!*holder) return Error{"the exploration's hand is used by one session only"};
-            return std::move(*holder);
-          });
-      !r)
-    return r.error();
-  return HapticSession::create(std::move(model), {.raise_priority = so.raise_priority}, registry);
-}
-
 // The object of `model` explored: the plan, the hand, the session run in simulated time, the trace
 Result<ObjectExploration> explore_object(const Scene& scene, const std::shared_ptr<const SessionModel>& model,
                                          const ExploreOptions& options, const SessionOptions& so) {
@@ -81,7 +62,9 @@ Result<ObjectExploration> explore_object(const Scene& scene, const std::shared_p
                                                                            .workspace_half_extents = {10.0, 10.0, 10.0}},
                                                  options, *plan, press_stop_force_n(options, force_limit_n), capacity);
   ExplorerDevice* explorer = device.get();
-  auto session = open_explorer_session(model, so, std::move(device));
+  std::vector<std::unique_ptr<haptico::HapticDevice>> hands;
+  hands.push_back(std::move(device));
+  auto session = HapticSession::create(model, std::move(hands), {.raise_priority = so.raise_priority});
   if (!session) return session.error();
   explorer->set_session(session->get());
   if (auto ran = (*session)->run_stepped(options.max_seconds, options.ticks_per_collision_step); !ran)

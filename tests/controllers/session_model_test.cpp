@@ -7,6 +7,8 @@
 #include "scene_test_support.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/controllers/haptic_session.hpp"
+#include "uh/haptico/device_registry.hpp"
+#include "uh/haptico/sim_line_device.hpp"
 
 namespace uh::controllers {
 namespace {
@@ -57,6 +59,44 @@ TEST(SessionModel, OneModelServesTwoSessionsWithOneTree) {
   ASSERT_TRUE(again.has_value());
   EXPECT_EQ((*again)->objects[0].tree.get(), (*model)->objects[0].tree.get());
   EXPECT_EQ((*again)->tools[0].tree.get(), (*model)->tools[0].tree.get());
+}
+
+// A device the caller made drives its tool as the registry's would: the small scene's sim-line
+// built by hand gives the registry-made session's trace bit for bit, through a registry that knows
+// no driver at all (which alone cannot open the scene's); more devices than tools are refused.
+TEST(SessionModel, ADeviceTheCallerMadeDrivesItsTool) {
+  collette::IstCache cache(testing::fresh_cache("model-device"));
+  auto model = compile(small_scene(), cache);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  const haptico::DeviceRegistry none;
+  const auto hand = [] {
+    std::vector<std::unique_ptr<haptico::HapticDevice>> devices;
+    devices.push_back(std::make_unique<haptico::SimLineDevice>(haptico::SimLineOptions{
+        .device = {.rate_hz = 1000.0, .max_force_n = 6.0, .dof_actuated = 6},
+        .start = {0.0, 0.0, 0.10},
+        .end = {0.0, 0.0, 0.045},
+        .duration_s = 0.5,
+        .bounce = true}));
+    return devices;
+  };
+  auto given = HapticSession::create(*model, hand(), {}, none);
+  ASSERT_TRUE(given.has_value()) << given.error().message;
+  auto made = HapticSession::create(*model);
+  ASSERT_TRUE(made.has_value()) << made.error().message;
+  std::ostringstream trace_given, trace_made;
+  ASSERT_TRUE((*given)->run_stepped(0.5, 4, &trace_given).has_value());
+  ASSERT_TRUE((*made)->run_stepped(0.5, 4, &trace_made).has_value());
+  EXPECT_GT((*given)->report().contact_ticks, 0u);
+  EXPECT_EQ(trace_given.str(), trace_made.str());
+
+  const auto unknown = HapticSession::create(*model, {}, none);
+  ASSERT_FALSE(unknown.has_value()) << "the empty registry cannot open sim-line";
+  auto two = hand();
+  two.push_back(std::move(hand().front()));
+  const auto too_many = HapticSession::create(*model, std::move(two), {}, none);
+  ASSERT_FALSE(too_many.has_value());
+  EXPECT_NE(too_many.error().message.find("2 devices given for 1 tool(s)"), std::string::npos)
+      << too_many.error().message;
 }
 
 TEST(SessionModel, ATreeGivenForTheToolOrTheObjectKeepsTheObjectsMeshSurface) {

@@ -205,6 +205,13 @@ class HapticSession {
   static Result<std::unique_ptr<HapticSession>> create(
       std::shared_ptr<const SessionModel> model, const SessionRunOptions& options = {},
       const haptico::DeviceRegistry& registry = devices::all_drivers());
+  /// As above with devices the caller made: `devices[i]` drives the model's tools[i] (at most one
+  /// per tool; a missing or null entry opens that tool's device through the registry). For a
+  /// program that owns its device: a scripted hand (`uh explore`), a device opened elsewhere. The
+  /// session opens them and owns them from then on.
+  static Result<std::unique_ptr<HapticSession>> create(
+      std::shared_ptr<const SessionModel> model, std::vector<std::unique_ptr<haptico::HapticDevice>> devices,
+      const SessionRunOptions& options = {}, const haptico::DeviceRegistry& registry = devices::all_drivers());
   ~HapticSession();
   HapticSession(const HapticSession&) = delete;
   HapticSession& operator=(const HapticSession&) = delete;
@@ -293,8 +300,12 @@ class HapticSession {
   HapticSession();
   // create()'s stages: the world and the objects, then each tool (its device, its controllers)
   Status add_objects(const SessionRunOptions& options);
-  Status add_tool(std::size_t tool, const SessionRunOptions& options, const haptico::DeviceRegistry& registry);
-  Status open_device(ToolRig& rig, const SessionRunOptions& options, const haptico::DeviceRegistry& registry);
+  Status add_tool(std::size_t tool, std::unique_ptr<haptico::HapticDevice> device, const SessionRunOptions& options,
+                  const haptico::DeviceRegistry& registry);
+  Result<std::unique_ptr<haptico::HapticDevice>> make_device(const ToolRig& rig,
+                                                             const haptico::DeviceRegistry& registry) const;
+  Status open_device(ToolRig& rig, std::unique_ptr<haptico::HapticDevice> given, const SessionRunOptions& options,
+                     const haptico::DeviceRegistry& registry);
   Status wire_controllers(ToolRig& rig);
   Status begin_run();
   // the run's statistics into each tool's report (before the loops stop), then (after the last
