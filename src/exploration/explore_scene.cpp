@@ -35,8 +35,9 @@ Result<std::shared_ptr<const SessionModel>> compile_object_scene(const Scene& sc
   alone.tool().device = {.driver = "explorer", .config = {}};
   alone.tool().workspace = {};  // the device frame is the world frame
   collette::IstCache cache(so.cache_dir);
-  auto compiled =
-      controllers::compile(controllers::with_session_options(alone, so), cache, {.progress = so.build_progress});
+  // a tree the caller gives (the blind player, site after site) is not read again for its surface
+  auto compiled = controllers::compile(controllers::with_session_options(alone, so), cache,
+                                       {.surface_beside_given_tree = false, .progress = so.build_progress});
   if (!compiled) return compiled.error();
   auto on_spheres = std::make_shared<SessionModel>(**compiled);
   for (controllers::CompiledShape& shape : on_spheres->objects) shape.surface = nullptr;
