@@ -13,10 +13,10 @@ namespace {
 // One mesh's surface per (file, scale), shared by the objects that repeat it.
 class SurfaceLoader {
  public:
-  explicit SurfaceLoader(bool beside_given_tree) : beside_given_tree_(beside_given_tree) {}
+  SurfaceLoader(bool any, bool beside_given_tree) : any_(any), beside_given_tree_(beside_given_tree) {}
 
   Result<std::shared_ptr<const collette::MeshInside>> load(const SceneShape& shape) {
-    if (shape.mesh.empty() || (shape.tree && !beside_given_tree_)) return std::shared_ptr<const collette::MeshInside>{};
+    if (!any_ || shape.mesh.empty() || (shape.tree && !beside_given_tree_)) return std::shared_ptr<const collette::MeshInside>{};
     const auto key = std::make_pair(shape.mesh.string(), shape.meters_per_unit);
     if (const auto it = loaded_.find(key); it != loaded_.end()) return it->second;
     auto surface = load_shape_surface(shape);
@@ -25,6 +25,7 @@ class SurfaceLoader {
   }
 
  private:
+  bool any_;
   bool beside_given_tree_;
   std::map<std::pair<std::string, double>, std::shared_ptr<const collette::MeshInside>> loaded_;
 };
@@ -35,7 +36,7 @@ Error named(const Scene& scene, const std::string& part, const Error& error) {
 
 Status compile_objects(collette::IstCache& cache, const CompileOptions& options, SessionModel& model) {
   const Scene& scene = model.scene;
-  SurfaceLoader surfaces(options.surface_beside_given_tree);
+  SurfaceLoader surfaces(options.surfaces, options.surface_beside_given_tree);
   for (SceneObject& object : model.scene.objects) {
     const std::string part = fmt::format("object '{}'", object.name);
     auto tree = tree_of(object.shape, cache, options.progress);

@@ -35,13 +35,8 @@ Result<std::shared_ptr<const SessionModel>> compile_object_scene(const Scene& sc
   alone.tool().device = {.driver = "explorer", .config = {}};
   alone.tool().workspace = {};  // the device frame is the world frame
   collette::IstCache cache(so.cache_dir);
-  // a tree the caller gives (the blind player, site after site) is not read again for its surface
-  auto compiled = controllers::compile(controllers::with_session_options(alone, so), cache,
-                                       {.surface_beside_given_tree = false, .progress = so.build_progress});
-  if (!compiled) return compiled.error();
-  auto on_spheres = std::make_shared<SessionModel>(**compiled);
-  for (controllers::CompiledShape& shape : on_spheres->objects) shape.surface = nullptr;
-  return std::shared_ptr<const SessionModel>(std::move(on_spheres));
+  return controllers::compile(controllers::with_session_options(alone, so), cache,
+                              {.surfaces = false, .progress = so.build_progress});
 }
 
 // The object of `model` explored: the plan, the hand, the session run in simulated time, the trace

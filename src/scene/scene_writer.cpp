@@ -2,9 +2,6 @@
 // field is written, defaults too, so that a written file says all it means; materials are written
 // inline (the file's named table is a convenience of hand-written files).
 
-#include <charconv>
-#include <cstdlib>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -54,23 +51,10 @@ json material_json(const forcecomp::Material& m) {
   return j;
 }
 
-// device settings are text: [x, y, z] and numbers go back as JSON arrays and numbers
-json config_value(const std::string& text) {
-  double v[3];
-  std::size_t count = 0;
-  const char* p = text.data();
-  const char* end = p + text.size();
-  while (p < end && count < 3) {
-    const auto [next, ec] = std::from_chars(p, end, v[count]);
-    if (ec != std::errc{}) return text;
-    ++count;
-    p = next;
-    if (p < end && *p == ',') ++p;
-    else break;
-  }
-  if (p != end) return text;
-  if (count == 1) return v[0];
-  if (count == 3) return json::array({v[0], v[1], v[2]});
+// device settings are text: what the config reads as [x, y, z] or a number goes back as one
+json config_value(const haptico::DeviceConfig& config, const std::string& key, const std::string& text) {
+  if (const auto v = config.vec3(key, {}); v) return array_of(*v);
+  if (const auto n = config.number(key, 0.0); n) return *n;
   return text;
 }
 
@@ -98,7 +82,8 @@ Result<json> tool_json(const SceneTool& tool, const std::string& path) {
   t["force"] = force_params_json(tool);
   if (const json m = material_json(tool.material); !m.empty()) t["material"] = m;
   json config = json::object();
-  for (const auto& [key, value] : tool.device.config.values()) config[key] = config_value(value);
+  for (const auto& [key, value] : tool.device.config.values())
+    config[key] = config_value(tool.device.config, key, value);
   t["device"] = {{"driver", tool.device.driver}, {"config", config}};
   t["workspace"] = {{"scale", tool.workspace.scale},
                     {"offset", array_of(tool.workspace.world_from_device_base.position)},

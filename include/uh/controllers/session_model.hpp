@@ -45,6 +45,8 @@ struct CompileOptions {
   /// a preloading caller (`uh explore`) renders on the proxy today, the spheres (issue 24: it
   /// compiles its model next).
   bool surface_beside_given_tree = true;
+  /// Load meshed objects' surfaces at all (false: a caller whose proxy rests on the spheres).
+  bool surfaces = true;
   /// The packing's progress (what, fraction) while a mesh is packed on first use; calling thread.
   std::function<void(const std::string& what, double fraction)> progress{};
 };
