@@ -87,62 +87,72 @@ std::string approx(double v) {
 // cannot be stored that precisely, and it bounds the grid cell indices below
 constexpr double kMinRadiusPerCoordinate = 1e-9;
 
+// A leaf's place in one radius class's grid (see check_leaves_disjoint)
+struct GridEntry {
+  int level;
+  std::int64_t x, y, z;
+  std::int32_t id;
+  auto key() const { return std::tie(level, x, y, z); }
+};
+
+std::int64_t grid_cell(float c, int level) {
+  return static_cast<std::int64_t>(std::floor(static_cast<double>(c) / std::ldexp(4.0, level)));
+}
+
+// An error when leaves i and j overlap by more than `tol`
+Status check_leaf_pair(std::span<const Sphere> leaves, std::size_t i, std::size_t j, double tol) {
+  const Sphere& s = leaves[i];
+  const Sphere& t = leaves[j];
+  const double dx = static_cast<double>(s.x) - static_cast<double>(t.x);
+  const double dy = static_cast<double>(s.y) - static_cast<double>(t.y);
+  const double dz = static_cast<double>(s.z) - static_cast<double>(t.z);
+  const double depth =
+      static_cast<double>(s.radius) + static_cast<double>(t.radius) - std::sqrt(dx * dx + dy * dy + dz * dz);
+  if (depth > tol)
+    return Error{"invalid tree: leaf spheres " + std::to_string(std::min(i, j)) + " and " +
+                 std::to_string(std::max(i, j)) + " overlap by " + approx(depth) +
+                 " (the leaves of a packing are disjoint; tolerance " + approx(tol) + ")"};
+  return Ok{};
+}
+
 // The first two leaf spheres that overlap by more than `tol`. One uniform grid per power-of-two
 // radius class (radius in [2^e, 2^(e+1)), cells 2^(e+2) wide, so at least twice the class's
 // largest radius): a sphere can only overlap a sphere of its own or a larger class whose centre
 // lies in one of the 27 cells around its own centre in that class's grid. Spheres of a packing
 // are disjoint, so a cell holds a bounded number of them and the check is O(n log n) even for
-// a hostile file (a quadratic sweep would not be).
+// a hostile file (a quadratic sweep would not be). The entries are sorted with z last, so the
+// three cells of a column (dx, dy) are one run found by one binary search.
 Status check_leaves_disjoint(std::span<const Sphere> leaves, double tol) {
-  struct Entry {
-    int level;
-    std::int64_t x, y, z;
-    std::int32_t id;
-    auto key() const { return std::tie(level, x, y, z); }
-  };
-  auto cell_of = [](float c, int level) {
-    return static_cast<std::int64_t>(std::floor(static_cast<double>(c) / std::ldexp(4.0, level)));
-  };
-  std::vector<Entry> entries;
+  std::vector<GridEntry> entries;
   entries.reserve(leaves.size());
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     const Sphere& s = leaves[i];
     const int level = std::ilogb(s.radius);
-    entries.push_back(
-        {level, cell_of(s.x, level), cell_of(s.y, level), cell_of(s.z, level), static_cast<std::int32_t>(i)});
+    entries.push_back({level, grid_cell(s.x, level), grid_cell(s.y, level), grid_cell(s.z, level),
+                       static_cast<std::int32_t>(i)});
   }
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+  std::sort(entries.begin(), entries.end(), [](const GridEntry& a, const GridEntry& b) {
     return a.key() < b.key() || (a.key() == b.key() && a.id < b.id);
   });
   std::vector<int> levels;
-  for (const Entry& e : entries)
+  for (const GridEntry& e : entries)
     if (levels.empty() || levels.back() != e.level) levels.push_back(e.level);
+  const auto by_key = [](const GridEntry& a, const GridEntry& b) { return a.key() < b.key(); };
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     const Sphere& s = leaves[i];
-    const int own = std::ilogb(s.radius);
-    for (auto lv = std::lower_bound(levels.begin(), levels.end(), own); lv != levels.end(); ++lv) {
-      const std::int64_t cx = cell_of(s.x, *lv), cy = cell_of(s.y, *lv), cz = cell_of(s.z, *lv);
+    for (auto lv = std::lower_bound(levels.begin(), levels.end(), std::ilogb(s.radius)); lv != levels.end(); ++lv) {
+      const std::int64_t cx = grid_cell(s.x, *lv), cy = grid_cell(s.y, *lv), cz = grid_cell(s.z, *lv);
       for (std::int64_t dx = -1; dx <= 1; ++dx)
-        for (std::int64_t dy = -1; dy <= 1; ++dy)
-          for (std::int64_t dz = -1; dz <= 1; ++dz) {
-            const Entry probe{*lv, cx + dx, cy + dy, cz + dz, -1};
-            auto it = std::lower_bound(entries.begin(), entries.end(), probe,
-                                       [](const Entry& a, const Entry& b) { return a.key() < b.key(); });
-            for (; it != entries.end() && it->key() == probe.key(); ++it) {
-              const auto j = static_cast<std::size_t>(it->id);
-              if (j == i) continue;
-              const Sphere& t = leaves[j];
-              const double ddx = static_cast<double>(s.x) - static_cast<double>(t.x);
-              const double ddy = static_cast<double>(s.y) - static_cast<double>(t.y);
-              const double ddz = static_cast<double>(s.z) - static_cast<double>(t.z);
-              const double depth = static_cast<double>(s.radius) + static_cast<double>(t.radius) -
-                                   std::sqrt(ddx * ddx + ddy * ddy + ddz * ddz);
-              if (depth > tol)
-                return Error{"invalid tree: leaf spheres " + std::to_string(std::min(i, j)) + " and " +
-                             std::to_string(std::max(i, j)) + " overlap by " + approx(depth) +
-                             " (the leaves of a packing are disjoint; tolerance " + approx(tol) + ")"};
-            }
+        for (std::int64_t dy = -1; dy <= 1; ++dy) {
+          const GridEntry first{*lv, cx + dx, cy + dy, cz - 1, -1};
+          for (auto it = std::lower_bound(entries.begin(), entries.end(), first, by_key);
+               it != entries.end() && it->level == *lv && it->x == cx + dx && it->y == cy + dy && it->z <= cz + 1;
+               ++it) {
+            const auto j = static_cast<std::size_t>(it->id);
+            if (j == i) continue;
+            if (Status ok = check_leaf_pair(leaves, i, j, tol); !ok) return ok;
           }
+        }
     }
   }
   return Ok{};

@@ -27,16 +27,25 @@ struct Spectrum {
   std::vector<double> power;
 };
 
-// `grid` resampled residuals over a common length; adds the power at each frequency
+// Adds the power of one resampled residual at each frequency of `spectrum`. The window is applied
+// once, and each frequency's e^(i w j) advances by one complex multiplication per sample instead of
+// a sine and a cosine (the blind player's studies spent half their time in libm here); over the few
+// thousand samples of a stroke the rotation's rounding stays near 1e-12 of the power.
 void add_spectrum(const std::vector<double>& residual, double ds, Spectrum& spectrum) {
   const std::size_t n = residual.size();
+  std::vector<double> windowed(n);
+  for (std::size_t i = 0; i < n; ++i)
+    windowed[i] = residual[i] * (0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(i) / static_cast<double>(n - 1)));
   for (std::size_t k = 0; k < spectrum.frequency.size(); ++k) {
-    double re = 0.0, im = 0.0;
     const double w = 2.0 * kPi * spectrum.frequency[k] * ds;
+    const double step_re = std::cos(w), step_im = std::sin(w);
+    double re = 0.0, im = 0.0, phase_re = 1.0, phase_im = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      const double hann = 0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(i) / static_cast<double>(n - 1));
-      re += hann * residual[i] * std::cos(w * static_cast<double>(i));
-      im += hann * residual[i] * std::sin(w * static_cast<double>(i));
+      re += windowed[i] * phase_re;
+      im += windowed[i] * phase_im;
+      const double next_re = phase_re * step_re - phase_im * step_im;
+      phase_im = phase_re * step_im + phase_im * step_re;
+      phase_re = next_re;
     }
     spectrum.power[k] += re * re + im * im;
   }

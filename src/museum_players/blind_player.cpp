@@ -280,9 +280,10 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   scene.watch = {piece.name};
   scene.haptic_hz = options.haptic_hz;
   scene.collision_hz = options.haptic_hz;
-  // the piece compiled once; each site's exploration reuses its tree
+  // the piece's tree compiled once; each site's exploration reuses it (and leaves the mesh surface
+  // out, exploration::explore_scene)
   collette::IstCache cache(cache_dir);
-  auto model = controllers::compile(scene, cache);
+  auto model = controllers::compile(scene, cache, {.surfaces = false});
   if (!model) return Error{fmt::format("{}: {}", piece.name, model.error().message)};
   const controllers::CompiledShape& piece_shape = (*model)->objects[0];
   scene.objects[0].shape.tree = piece_shape.tree;
