@@ -30,7 +30,9 @@ run_ctest() {
   local name=$1 dir=$2; shift 2
   echo "== ctest ($name) =="
   local log="$uh_root/$dir/ctest.log"
-  (cd "$uh_root/$dir" && ctest --output-on-failure --timeout 900 "$@") 2>&1 | tee "$log"
+  # one test per core: most tests wait on threads, sockets and child processes as much as they
+  # compute (the slowest start first, the load tests run alone: tests/CMakeLists.txt)
+  (cd "$uh_root/$dir" && ctest --output-on-failure --timeout 900 --parallel "$uh_jobs" "$@") 2>&1 | tee "$log"
   local line
   line=$(grep -E "tests passed, [0-9]+ tests? failed out of" "$log" | tail -n 1)
   if [ -z "$line" ]; then echo "test: no ctest summary for $name"; status=1; return; fi
@@ -76,7 +78,17 @@ run_counted() {
   [ "$f" -eq 0 ] || status=1
 }
 
-echo "== build (Release) =="
+# "== NAME ==" and the time the previous stage took, so a run's log shows where its minutes go
+stage_name=""
+stage_start=$SECONDS
+stage() {
+  [ -n "$stage_name" ] && echo "time: $stage_name and its tests took $((SECONDS - stage_start)) s"
+  stage_name=$1
+  stage_start=$SECONDS
+  [ -n "$1" ] && echo "== $1 =="
+}
+
+stage "build (Release)"
 if uh_build build/release -- -DCMAKE_BUILD_TYPE=Release -DUH_BUILD_TESTS=ON -DUH_BUILD_BENCHMARKS=ON; then
   run_ctest release build/release
   run_pytest
@@ -94,7 +106,7 @@ fi
 sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
                  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DUH_BUILD_BENCHMARKS=OFF -DUH_BUILD_VIEW=OFF)
 
-echo "== build (AddressSanitizer + UndefinedBehaviorSanitizer) =="
+stage "build (AddressSanitizer + UndefinedBehaviorSanitizer)"
 if uh_build build/asan -- "${sanitizer_flags[@]}" -DUH_SANITIZE=address,undefined; then
   # fontconfig's process-long caches (cairo text in the PNG plots) are not ours to free
   LSAN_OPTIONS="suppressions=$uh_root/tests/support/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}" \
@@ -103,7 +115,7 @@ else
   echo "test: sanitizer build failed"; status=1; failed=$((failed + 1))
 fi
 
-echo "== build (ThreadSanitizer) =="
+stage "build (ThreadSanitizer)"
 # only what the tests labelled "threads" run (tests/CMakeLists.txt, uh_thread_tests)
 if uh_build build/tsan uh_thread_tests -- "${sanitizer_flags[@]}" -DUH_SANITIZE=thread; then
   run_ctest tsan build/tsan -L threads
@@ -111,7 +123,7 @@ else
   echo "test: ThreadSanitizer build failed"; status=1; failed=$((failed + 1))
 fi
 
-echo "== build (Windows x64, mingw-w64; the C API's tests under wine64) =="
+stage "build (Windows x64, mingw-w64; the C API's tests under wine64)"
 if uh_build build/windows uh_capi_test -- -DCMAKE_TOOLCHAIN_FILE="$uh_root/cmake/mingw-w64-x86_64.cmake" \
      -DCMAKE_BUILD_TYPE=Release; then
   run_ctest windows build/windows
@@ -121,7 +133,7 @@ else
   echo "test: Windows build failed"; status=1; failed=$((failed + 1))
 fi
 
-echo "== build (libFuzzer, clang) =="
+stage "build (libFuzzer, clang)"
 if command -v clang++ >/dev/null 2>&1; then
   if uh_build build/fuzz uh_ist_loader_fuzz uh_ist_seed_corpus uh_scene_parser_fuzz uh_csv_reader_fuzz uh_service_protocol_fuzz uh_service_mesh_binary_fuzz uh_mesh_reader_fuzz uh_museum_protocol_fuzz -- -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
        -DUH_BUILD_FUZZERS=ON -DUH_BUILD_APPS=OFF -DUH_BUILD_BENCHMARKS=OFF; then
@@ -133,5 +145,7 @@ else
   echo "test: clang++ not found (scripts/install-deps.sh installs it)"; status=1; failed=$((failed + 1))
 fi
 
+stage ""
+echo "time: the whole command took $SECONDS s"
 echo "tests: $passed passed, $failed failed"
 exit $status
