@@ -42,12 +42,31 @@ double wanted_step_of(const Pose& from, const Pose& target, double radius, doubl
   return length;
 }
 
+// Moves `t` out along the normal of each constraint it breaks (with the rotation `w`), a few
+// Gauss-Seidel sweeps over the rows: each correction meets its row exactly and is as short as it
+// can be, so a step that breaks rows by rounding or a slight tilt keeps its tangential part.
+void push_out(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& w, Vec3& t) {
+  for (int sweep = 0; sweep < 4; ++sweep) {
+    bool met = true;
+    for (const forcecomp::ProxyConstraint& c : rows) {
+      const double at_t = dot(c.normal, t) + dot(cross(c.lever, c.normal), w) + c.gap;
+      if (at_t >= -1e-12) continue;
+      t -= at_t * c.normal;
+      met = false;
+    }
+    if (met) return;
+  }
+}
+
 // Coulomb friction on the proxy's translation (the god-object's friction cone). `from` is where the
 // proxy was, `free` the translation the constraints allow towards the handle without friction, `n`
 // the surface's normal. The proxy keeps its place along the surface (it takes only the normal part
 // of the step) while the handle pulls it sideways by at most mu_s (mu_d once sliding) times how deep
 // the handle presses; beyond, it slides until the pull is mu_d times the depth. The result is moved
-// back towards `free` as far as a constraint needs (each is linear in it, and `free` meets them).
+// out along the normals of the constraints it breaks (the cone's normal is the contact's mean, so
+// on a face of many rows a tangential step breaks the slightly tilted ones by micrometres), and
+// what still breaks one after a few sweeps back towards `free` as far as a constraint needs (each
+// is linear in it, and `free` meets them).
 Vec3 friction_step(const Vec3& from, const Vec3& free, const Vec3& handle, const Vec3& n, double mu_s, double mu_d,
                    bool& sliding, std::span<const forcecomp::ProxyConstraint> rows, const Vec3& w) {
   const Vec3 normal_part = dot(free, n) * n;
@@ -67,6 +86,7 @@ Vec3 friction_step(const Vec3& from, const Vec3& free, const Vec3& handle, const
     if (norm(move) > cap) move = move * (cap / norm(move));
     t += move;
   }
+  push_out(rows, w, t);
   double back = 0.0;
   for (const forcecomp::ProxyConstraint& c : rows) {
     const double turn = dot(cross(c.lever, c.normal), w) + c.gap;
@@ -301,12 +321,22 @@ void ToolProxy::count_contacts(std::span<const forcecomp::ProxyConstraint> rows,
   }
 }
 
-// The mean normal of the pairs in contact (within a tenth of a millimetre of their allowed depth),
-// for the friction cone; `holding` when there are none.
-Vec3 ToolProxy::contact_normal(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& holding) const {
-  Vec3 sum{};
-  for (const forcecomp::ProxyConstraint& c : rows)
-    if (c.gap < 1e-4) sum += c.normal;
+// The friction cone's normal: the mean normal of the rows in contact (within a tenth of a
+// millimetre of their allowed depth), of the per-sphere rows (rows[first_per_sphere, end): the
+// smoothed or the mesh surface's) when any of them is in contact, since the raw sphere pairs' normals
+// scatter with the packing's grain by degrees, which tilts the cone from step to step, breaks a
+// slide into stick and slip and made a packed face's dynamic friction read 12-25 % low; `holding`
+// when none is in contact.
+Vec3 ToolProxy::contact_normal(std::span<const forcecomp::ProxyConstraint> rows, std::size_t first_per_sphere,
+                               const Vec3& holding) const {
+  const auto mean_in_contact = [](std::span<const forcecomp::ProxyConstraint> some) {
+    Vec3 sum{};
+    for (const forcecomp::ProxyConstraint& c : some)
+      if (c.gap < 1e-4) sum += c.normal;
+    return sum;
+  };
+  const Vec3 per_sphere = mean_in_contact(rows.subspan(std::min(first_per_sphere, rows.size())));
+  const Vec3 sum = norm(per_sphere) > 0.0 ? per_sphere : mean_in_contact(rows);
   return norm(sum) > 0.0 ? normalized(sum) : holding;
 }
 
@@ -330,10 +360,12 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
     deepest = std::max(deepest, -constraints_[static_cast<std::size_t>(k)].gap);
   raise_max(deepest_m_, deepest);
   const double moves = (deepest > 0.0 ? reach : std::sqrt(2.0) * std::min(length, limit)) + worst_arc;
-  std::int32_t kept = 0;
+  std::int32_t kept = 0, kept_pairs = 0;
   for (std::int32_t k = 0; k < constraint_count_; ++k)
-    if (constraints_[static_cast<std::size_t>(k)].gap < moves)
+    if (constraints_[static_cast<std::size_t>(k)].gap < moves) {
       constraints_[static_cast<std::size_t>(kept++)] = constraints_[static_cast<std::size_t>(k)];
+      if (k < pair_rows_) kept_pairs = kept;
+    }
   const std::span<forcecomp::ProxyConstraint> rows{constraints_.data(), static_cast<std::size_t>(kept)};
   forcecomp::ProxyStep step{.translation = t, .rotation = w};
   if (!rows.empty()) {
@@ -354,7 +386,8 @@ Pose ToolProxy::advance(const Pose& from, const Pose& target, ProxyState& out) {
   out.friction_static = held.friction_static;
   out.friction_dynamic = held.friction_dynamic;
   out.stiffness_n_m = held.stiffness_n_m;
-  if (held.friction_static > 0.0) held.normal = contact_normal(rows, held.normal);
+  if (held.friction_static > 0.0)
+    held.normal = contact_normal(rows, static_cast<std::size_t>(kept_pairs), held.normal);
   out.contact_normal = held.normal;
   if (step.active > 0 && held.friction_static > 0.0 && norm(held.normal) > 0.0)
     step.translation = friction_step(from.position, step.translation, target.position, held.normal,
@@ -443,6 +476,7 @@ void ToolProxy::on_step(double time_s) {
   } else {
     seated_ = true;
     const Pose from = have_query_ ? queried_ : proxy_;
+    pair_rows_ = constraint_count_;
     append_smooth(from);
     append_surface(from);
     proxy_ = advance(from, target, out);

@@ -366,7 +366,9 @@ TEST(ToolProxy, APegSlidesIntoAHoleWithoutSnagging) {
 
 // Friction as a cone on the proxy: a ball pressed into a packed face with about 2 N and pulled
 // sideways sticks until the sideways force is mu_s times the normal force, then slides at mu_d.
-// The reference is Coulomb's law on the spring force the device would feel.
+// The reference is Coulomb's law on the spring force the device would feel, at every tick of the
+// slide: a cone tilted by the packing's grain from step to step breaks a slide into stick and slip
+// (a sawtooth between 0 and mu_s N whose ticks in slip alone still read mu_d).
 class Friction : public ::testing::TestWithParam<bool> {};  // on the mesh, or on the spheres' union
 
 TEST_P(Friction, SticksUntilMuStaticThenSlidesAtMuDynamic) {
@@ -390,7 +392,7 @@ TEST_P(Friction, SticksUntilMuStaticThenSlidesAtMuDynamic) {
   double peak_ratio = 0.0;           // the largest sideways / normal force before the proxy first slid
   double break_ratio = 0.0;          // that ratio at the tick before it first slid
   bool slid = false;
-  std::vector<double> sliding_ratios;  // while it slides, after the breakaway
+  std::vector<double> sliding_ratios;  // every tick of the slide (the handle's second half)
   double last_ratio = 0.0;
   for (int i = 0; i < 4000; ++i) {
     // down onto the face, then the handle moves sideways at 1 cm/s
@@ -399,27 +401,31 @@ TEST_P(Friction, SticksUntilMuStaticThenSlidesAtMuDynamic) {
     proxy.set_target(handle);
     world.step(1e-3 * i);
     if (const ProxyState* st = proxy.take()) state = *st;
-    if (i < 1100) continue;
+    if (i < 1000) continue;  // pressed and settled (the handle stops at 3.5 mm from tick 330)
     const Vec3 f = stiffness * (proxy.slide(state, handle).position - handle.position);
     const double ratio = std::hypot(f.x, f.y) / f.z;
     if (!slid && state.sliding) break_ratio = peak_ratio > 0.0 ? last_ratio : ratio;
     slid |= state.sliding;
     if (!slid) peak_ratio = std::max(peak_ratio, ratio);
     last_ratio = ratio;
-    if (state.sliding && i > 2000) sliding_ratios.push_back(ratio);
+    if (i > 2000) sliding_ratios.push_back(ratio);
   }
   ASSERT_TRUE(slid) << "the handle moved 3 cm sideways: the proxy must have broken away";
-  // the breakaway: the pull reaches mu_s times the normal force about the contact's normal, which
-  // the packing's grain tilts by a few degrees from the face's (measured 0.71 for 0.6 on this slab,
-  // 18 % high; the sliding force is within 2 %)
-  EXPECT_NEAR(break_ratio, 0.6, 0.15);
-  EXPECT_LT(peak_ratio, 0.6 + 0.2);
-  ASSERT_GT(sliding_ratios.size(), 500u);
+  // the breakaway: the pull reaches mu_s times the normal force about the contact's normal: the
+  // mesh's (measured 0.555), or the smoothed union's, which the packing's grain tilts by a few
+  // degrees from the face's (measured 0.72, 20 % high)
+  const double breakaway_tolerance = GetParam() ? 0.1 : 0.15;
+  EXPECT_NEAR(break_ratio, 0.6, breakaway_tolerance);
+  EXPECT_LT(peak_ratio, 0.6 + breakaway_tolerance);
+  ASSERT_EQ(sliding_ratios.size(), 1999u);
   std::sort(sliding_ratios.begin(), sliding_ratios.end());
   const double median = sliding_ratios[sliding_ratios.size() / 2];
-  std::printf("friction on the proxy (%s): breakaway at %.3f (mu_s 0.6; largest before it %.3f), sliding median %.3f (mu_d 0.4)\n",
-              GetParam() ? "mesh" : "spheres", break_ratio, peak_ratio, median);
+  const double low = sliding_ratios[sliding_ratios.size() / 20];  // the 5th percentile
+  std::printf("friction on the proxy (%s): breakaway at %.3f (mu_s 0.6; largest before it %.3f), sliding median %.3f, "
+              "5th percentile %.3f (mu_d 0.4)\n",
+              GetParam() ? "mesh" : "spheres", break_ratio, peak_ratio, median, low);
   EXPECT_NEAR(median, 0.4, 0.04);
+  EXPECT_GT(low, 0.3) << "the slide sticks and slips";
 }
 INSTANTIATE_TEST_SUITE_P(OnTheMeshAndOnTheSpheres, Friction, ::testing::Values(true, false));
 

@@ -157,7 +157,8 @@ class ToolProxy {
     double friction_dynamic = 0.0;
     double stiffness_n_m = 0.0;
   };
-  Vec3 contact_normal(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& holding) const;
+  Vec3 contact_normal(std::span<const forcecomp::ProxyConstraint> rows, std::size_t first_per_sphere,
+                      const Vec3& holding) const;
   void count_contacts(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w);
   HoldingFriction holding_friction(std::span<const forcecomp::ProxyConstraint> rows, const std::int32_t* active,
                                    std::int32_t count) const;
@@ -222,6 +223,9 @@ class ToolProxy {
   std::vector<TextureContact> texture_contact_;
   std::vector<std::int32_t> contact_rows_;  // per watched object: rows in contact after the step
   std::int32_t constraint_count_ = 0;
+  // constraints_[0, pair_rows_) are this step's sphere pairs, the rest one row per tool sphere (the
+  // smoothed or the mesh surface's)
+  std::int32_t pair_rows_ = 0;
   double dropped_gap_m_ = std::numeric_limits<double>::infinity();  // smallest gap left out for capacity
   bool placed_ = false;
   bool seated_ = false;          // it has been out of every object: from then on it keeps its side
