@@ -242,6 +242,9 @@ static class SessionTests
             {
                 Name = "probe", MeshPath = Path.Combine(source, "assets/meshes/stylus.obj"), MetersPerUnit = 0.01,
                 Spheres = 300, MaxForceN = 2.5, DeviceDriver = "sim-raster",
+                // the default scene's sweep, which comes out of the bunny's flank and back in: the
+                // driver's default box lies inside the bunny, where the proxy leaves the tool free
+                DeviceConfigJson = "{\"min\": [-0.04, -0.025, 0.0], \"max\": [0.04, 0.025, 0.0965], \"depth\": 0.045}",
             });
             var refused = false;
             try { scene.SetTool(new ToolSettings { MeshPath = "/nonexistent/tool.obj" }); }
