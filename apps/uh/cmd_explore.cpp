@@ -35,6 +35,13 @@ std::string shown(const std::optional<double>& v, const char* format_unit) {
   return v ? fmt::format(fmt::runtime(format_unit), *v) : std::string("none");
 }
 
+// Whether the stiffness read is the proxy's passive limit rather than the material's (the presses
+// read a spring within a few per cent of it: the material is at least that stiff)
+bool at_rendered_limit(const exploration::ObjectExploration& o) {
+  const auto& k = o.estimate.stiffness_n_per_mm;
+  return o.rendered_stiffness_limit_n_per_m > 0.0 && k && *k * 1e3 >= 0.95 * o.rendered_stiffness_limit_n_per_m;
+}
+
 int explore(const ExploreArgs& args) {
   auto scene = controllers::load_scene(args.scene);
   if (!scene) return fail(scene.error().message);
@@ -61,6 +68,10 @@ int explore(const ExploreArgs& args) {
           {{"name", o.object},
            {"stiffness_n_per_mm", optional_number(e.stiffness_n_per_mm)},
            {"stiffness_per_press_n_per_mm", e.stiffness_per_press_n_per_mm},
+           {"rendered_stiffness_limit_n_per_mm", o.rendered_stiffness_limit_n_per_m > 0.0
+                                                     ? nlohmann::json(o.rendered_stiffness_limit_n_per_m * 1e-3)
+                                                     : nlohmann::json(nullptr)},
+           {"stiffness_is_rendered_limit", at_rendered_limit(o)},
            {"press_reach_m", optional_number(e.press_reach_m)},
            {"damping_n_s_per_m", optional_number(e.damping_n_s_per_m)},
            {"damping_per_press_n_s_per_m", e.damping_per_press_n_s_per_m},
@@ -91,6 +102,11 @@ int explore(const ExploreArgs& args) {
         shown(e.stiffness_n_per_mm, "{:.3f} N/mm").c_str(),
         shown(e.press_reach_m ? std::optional<double>(*e.press_reach_m * 1e3) : std::nullopt, "{:.2f} mm")
             .c_str());
+    if (at_rendered_limit(o))
+      std::printf(
+          "    (the rendered stiffness: through the proxy the device renders at most %.3f N/mm passively, and the "
+          "material is stiffer; --proxy off reads the material's)\n",
+          o.rendered_stiffness_limit_n_per_m * 1e-3);
     if (e.press_reach_m && options.press_depth_m && *e.press_reach_m < 0.95 * *options.press_depth_m)
       std::printf(
           "    (the force limit stopped the presses short of %.2f mm: a packed face reads low there)\n",

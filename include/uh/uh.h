@@ -329,8 +329,9 @@ typedef struct uh_session_def {
   int32_t raise_priority;  /* nonzero: ask for SCHED_FIFO for the haptic and collision threads */
   const char* cache_dir;   /* where packed meshes are cached (NULL: $UH_CACHE_DIR or ~/.cache/unrealhaptics) */
   /* --- added in API version 2's second layout --- */
-  int32_t proxy;           /* how contact is rendered: -1 the scene's (force.proxy), 0 the penalty path,
-                            * 1 the 6-DOF proxy, which never lets the tool through a surface */
+  int32_t proxy;           /* how contact is rendered: -1 the scene's (force.proxy, the 6-DOF proxy unless
+                            * the scene turns it off), 0 the penalty path, 1 the 6-DOF proxy, which never
+                            * lets the tool through a surface */
 } uh_session_def;
 
 UH_API uh_status uh_session_def_init(uh_session_def* def);
@@ -370,8 +371,10 @@ typedef struct uh_contact_event {
   uh_contact_kind kind;
   int32_t object;        /* index of the object in the scene */
   double time_s;         /* time of the collision step that saw it, since start [s] */
-  double volume;         /* overlap volume then [m^3] (0 for UH_CONTACT_END) */
-  int32_t pairs;         /* overlapping sphere pairs then (0 for UH_CONTACT_END) */
+  double volume;         /* overlap volume then [m^3] (0 for UH_CONTACT_END; 0 through the proxy, which
+                          * rests on the surface) */
+  int32_t pairs;         /* overlapping sphere pairs then (0 for UH_CONTACT_END; through the proxy, its
+                          * constraint rows in contact) */
   /* --- added in API version 2's second layout --- */
   int32_t tool;          /* index of the tool in the scene */
 } uh_contact_event;

@@ -32,7 +32,8 @@ def test_default_session_stepped_reads_contact_and_force():
     assert abs(np.linalg.norm(st.tool_orientation) - 1.0) < 1e-9
     assert np.linalg.norm(st.force) <= report["force"]["max_n"] + 1e-12
     begins = [e for e in events if e.kind == "begin"]
-    assert begins and all(e.object == 0 and e.volume > 0 and e.pairs > 0 for e in begins)
+    # through the proxy, the default, which rests on the surface: its rows in contact, no overlap volume
+    assert begins and all(e.object == 0 and e.volume == 0 and e.pairs > 0 for e in begins)
 
 
 def test_threaded_session_polls_state_and_stop_returns_the_report(scene):
@@ -164,8 +165,8 @@ def test_two_tools_each_with_its_state(tmp_path):
             s.state(2)
     assert [t["tool"] for t in report["tools"]] == ["left", "right"]
     assert all(t["contact"]["ticks"] > 0 for t in report["tools"])
-    assert right.haptic_ticks == 1000 and abs(right.tool_position[0] - 0.15) < 1e-9
-    assert first.haptic_ticks == left.haptic_ticks and abs(left.tool_position[0]) < 1e-9
+    assert right.haptic_ticks == 1000 and abs(right.handle_position[0] - 0.15) < 1e-9
+    assert first.haptic_ticks == left.haptic_ticks and abs(left.handle_position[0]) < 1e-9
 
 
 def test_tools_added_through_calls_each_name_their_contacts():

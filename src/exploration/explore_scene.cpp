@@ -10,6 +10,7 @@
 #include "plan.hpp"
 #include "uh/collette/ist_cache.hpp"
 #include "uh/controllers/session_model.hpp"
+#include "uh/forcecomp/virtual_coupling.hpp"
 
 namespace uh::exploration {
 namespace {
@@ -75,6 +76,8 @@ Result<ObjectExploration> explore_object(const Scene& scene, const std::shared_p
   result.trace.stroke_axes[0] = plan->axes[0];
   result.trace.stroke_axes[1] = plan->axes[1];
   result.trace.axis_point = plan->axis_point;
+  if (alone.force.proxy.enabled)
+    result.rendered_stiffness_limit_n_per_m = forcecomp::VirtualCoupling(alone.force.coupling).stiffness();
   result.work_on_hand_j = (*session)->report().work_on_hand_j;
   result.simulated_s = (*session)->report().seconds;
   result.haptic_ticks = (*session)->report().haptic_ticks;

@@ -516,7 +516,10 @@ std::string with_standin(const fs::path& dir) {
                      (dir / "cache").string(), UH_STANDIN_DHD, UH_STANDIN_HD);
 }
 
-// a small scene: the stylus on a simulated line through the bunny's middle
+// a small scene: the stylus on a simulated line through the bunny's middle. The tests that bind a
+// stand-in device to it (with --device) find its handle resting inside the bunny, which the proxy,
+// by design, leaves free until it comes out: they are about the device, so the scene renders on
+// the penalty path.
 fs::path write_small_device_scene(const fs::path& dir) {
   const fs::path meshes = fs::path(UH_TEST_DATA_DIR) / "meshes";
   std::ofstream(dir / "small.json") << fmt::format(R"({{
@@ -528,7 +531,8 @@ fs::path write_small_device_scene(const fs::path& dir) {
   "tool": {{ "name": "stylus", "mesh": "{}", "meters_per_unit": 0.01, "spheres": 150,
           "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "max_force_n": 6.0 }},
           "device": {{ "driver": "sim-line", "config": {{ "start": [0, 0, 0.1], "end": [0, 0, 0.045] }} }} }},
-  "watch": ["bunny"]
+  "watch": ["bunny"],
+  "force": {{ "proxy": {{ "enabled": false }} }}
 }})",
                                                    (meshes / "bunny_npm_3674.obj").string(),
                                                    (meshes / "stylus.obj").string());
@@ -672,7 +676,8 @@ TEST_F(CliTest, DevicesAndRunOnHaplysService) {
 
 // two devices of different drivers in one session, each on its stand-in: HD's Touch presses into
 // the bunny (its handle rests at the origin), the omega.3 into a ball 15 cm beside it (its
-// workspace moved there); HD's scheduler clocks one loop, the manager's own the other
+// workspace moved there); HD's scheduler clocks one loop, the manager's own the other. Each handle
+// rests inside its object, which the proxy leaves free until it comes out: the penalty path.
 TEST_F(CliTest, RunsTwoDevicesOfDifferentDriversInOneSession) {
   const fs::path meshes = fs::path(UH_TEST_DATA_DIR) / "meshes";
   const fs::path scene = dir_ / "hands.json";
@@ -689,7 +694,8 @@ TEST_F(CliTest, RunsTwoDevicesOfDifferentDriversInOneSession) {
             {{ "name": "right", "mesh": "{2}", "meters_per_unit": 0.01, "spheres": 150,
              "force": {{ "mode": "3dof", "stiffness": 1.6e4, "damping": 1.0, "max_force_n": 6.0 }},
              "device": {{ "driver": "forcedimension", "config": {{ "serial": 11001 }} }},
-             "workspace": {{ "offset": [0.15, 0, 0.03] }} }}]
+             "workspace": {{ "offset": [0.15, 0, 0.03] }} }}],
+  "force": {{ "proxy": {{ "enabled": false }} }}
 }})",
                                       (meshes / "bunny_npm_3674.obj").string(),
                                       (meshes / "ball.obj").string(), (meshes / "stylus.obj").string());
@@ -779,9 +785,24 @@ nlohmann::json explored(const nlohmann::json& out, const std::string& object) {
   return {};
 }
 
+// What `uh explore` reads through the proxy (the default) for a material whose spring is
+// `material_n_per_mm`: the material's, or, where the material is stiffer than the device renders
+// passively, that limit, and it says so. The scenes' coupling asks 1.5 kN/m, within the passive
+// bound for the device's damping at 1 kHz (0.9 x 2 b / T = 1.8 kN/m at b = 1 N s/m).
+void expect_rendered_stiffness(const nlohmann::json& e, double material_n_per_mm, const std::string& what) {
+  ASSERT_TRUE(e["rendered_stiffness_limit_n_per_mm"].is_number()) << what << ": explored through the proxy";
+  const double limit = e["rendered_stiffness_limit_n_per_mm"].get<double>();
+  EXPECT_NEAR(limit, 1.5, 1e-9) << what;
+  const double expected = std::min(material_n_per_mm, limit);
+  EXPECT_NEAR(e["stiffness_n_per_mm"].get<double>(), expected, 0.05 * expected) << what;
+  EXPECT_EQ(e["stiffness_is_rendered_limit"].get<bool>(), material_n_per_mm > limit) << what;
+}
+
+// On the penalty path, which renders each material as it is: its damping, its textures as the contact
+// point feels them and springs stiffer than the proxy's passive limit (expect_rendered_stiffness).
 TEST_F(CliTest, ExploreRecoversEveryMaterialOfTheMaterialsScene) {
   const MaterialsScene scene = materials_scene();
-  const CommandRun r = uh(fmt::format("explore '{}' --json", materials_scene_path().string()),
+  const CommandRun r = uh(fmt::format("explore '{}' --proxy off --json", materials_scene_path().string()),
                           fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json out = json_of(r);
@@ -873,7 +894,7 @@ TEST_F(CliTest, ExploreFindsTheTexturePeriodAtTenKilohertzToo) {
 // plane: 2 pi r k at first touch), friction within 10 % and the grating's period within 5 % on a
 // flat packed face as on the round ones, at 1 and 10 kHz; the packing's grain (its spheres' caps
 // under the face) reads as neither friction nor a period, nor does the random texture. One
-// packing, cached between the runs.
+// packing, cached between the runs. On the penalty path, as ExploreRecoversEveryMaterialOfTheMaterialsScene.
 TEST_F(CliTest, ExploreRecoversEveryMaterialOnAFlatPackedSlab) {
   const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_flat.json";
   std::ifstream in(path);
@@ -881,7 +902,7 @@ TEST_F(CliTest, ExploreRecoversEveryMaterialOnAFlatPackedSlab) {
   const double period = scene.material("ridged")["texture"]["period"].get<double>();
   for (const std::string run : {"sticky", "slippery", "plain", "stiff", "rough", "ridged",
                                 "ridged --haptic-hz 10000 --ticks-per-collision 10 --seed 2"}) {
-    const CommandRun r = uh(fmt::format("explore '{}' --object {} --json", path.string(), run),
+    const CommandRun r = uh(fmt::format("explore '{}' --proxy off --object {} --json", path.string(), run),
                             fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json e = json_of(r)["objects"][0];
@@ -952,7 +973,9 @@ TEST_F(CliTest, ExploreReadsFrictionThroughTheProxyOnAPackedBlock) {
   }
 }
 
-// A 2 cm block packed with spheres of bounded radius (unbounded, its face reads 9-33 % soft).
+// A 2 cm block packed with spheres of bounded radius (unbounded, its face reads 9-33 % soft): the
+// material's stiffness on the penalty path; through the proxy, the same below its passive limit,
+// the limit above it.
 TEST_F(CliTest, ExploreRecoversTheStiffnessOfAThickPackedBlock) {
   const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_block.json";
   std::ifstream in(path);
@@ -963,28 +986,39 @@ TEST_F(CliTest, ExploreRecoversTheStiffnessOfAThickPackedBlock) {
     const double k = object.contains("material") ? object["material"]["stiffness"].get<double>()
                                                  : scene["tool"]["force"]["stiffness"].get<double>();
     const std::string name = object["name"].get<std::string>();
-    const CommandRun r = uh(fmt::format("explore '{}' --object {} --json --seed 1", path.string(), name),
-                            fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    const nlohmann::json e = json_of(r)["objects"][0];
     const double reference = 2.0 * kPi * tool_radius * k * 1e-3;  // N/mm
-    EXPECT_NEAR(e["stiffness_n_per_mm"].get<double>(), reference, 0.05 * reference) << name;
-    EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << name << ": passive";
+    for (const std::string path_option : {"--proxy off", ""}) {
+      const CommandRun r =
+          uh(fmt::format("explore '{}' {} --object {} --json --seed 1", path.string(), path_option, name),
+             fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const nlohmann::json e = json_of(r)["objects"][0];
+      if (path_option.empty()) {
+        expect_rendered_stiffness(e, reference, name);
+      } else {
+        EXPECT_NEAR(e["stiffness_n_per_mm"].get<double>(), reference, 0.05 * reference) << name;
+        EXPECT_TRUE(e["rendered_stiffness_limit_n_per_mm"].is_null()) << name << ": the penalty path";
+      }
+      EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << name << " " << path_option << ": passive";
+    }
   }
 }
 
 // Surfaces as stiff as the museum's materials (k = 1.5e5 and 2.5e5 N/m^2), flat and curved: a press
 // to 2.5 mm asks up to 40 N of the 1 cm ball, which the scene's tool and safety limits allow; the
 // presses reach their depth (a press stopped short by the force reads a packed face low) and the
-// stiffness is recovered within 5 % at every seed.
+// stiffness is recovered within 5 % at every seed on the penalty path. Through the proxy (the
+// default) each reads the device's passive limit, and `uh explore` says that it is not the material's.
 TEST_F(CliTest, ExploreRecoversTheStiffnessOfStiffSurfaces) {
   const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_stiff.json";
   std::ifstream in(path);
   const MaterialsScene scene{nlohmann::json::parse(in)};
   const double r = scene.tool_radius();
-  for (const int seed : {1, 2, 3, 4}) {
-    const CommandRun run = uh(fmt::format("explore '{}' --json --seed {}", path.string(), seed),
-                              fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+  const std::string cache = fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string());
+  for (const int seed : {1, 2, 3, 4, 0}) {  // 0: seed 1 through the proxy
+    const std::string path_option = seed == 0 ? "" : "--proxy off";
+    const CommandRun run =
+        uh(fmt::format("explore '{}' {} --json --seed {}", path.string(), path_option, std::max(seed, 1)), cache);
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const nlohmann::json out = json_of(run);
     ASSERT_EQ(out["objects"].size(), scene.scene["objects"].size());
@@ -997,6 +1031,11 @@ TEST_F(CliTest, ExploreRecoversTheStiffnessOfStiffSurfaces) {
       const bool ball = object["mesh"].get<std::string>().ends_with("ball.obj");
       const double r_eff = ball ? r * scene.radius(name) / (r + scene.radius(name)) : r;
       const double reference = 2.0 * kPi * r_eff * k * 1e-3;  // N/mm
+      if (seed == 0) {
+        expect_rendered_stiffness(e, reference, name);
+        EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << name << ": passive";
+        continue;
+      }
       EXPECT_NEAR(e["stiffness_n_per_mm"].get<double>(), reference, 0.05 * reference)
           << name << " seed " << seed;
       EXPECT_GT(e["press_reach_m"].get<double>(), 0.0024)
@@ -1008,6 +1047,14 @@ TEST_F(CliTest, ExploreRecoversTheStiffnessOfStiffSurfaces) {
       EXPECT_LT(e["work_on_hand_j"].get<double>(), leak) << name << ": passive";
     }
   }
+  const std::string name = scene.scene["objects"][0]["name"].get<std::string>();
+  const CommandRun text = uh(fmt::format("explore '{}' --object {}", path.string(), name), cache);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("stiffness  1.500 N/mm"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("(the rendered stiffness: through the proxy the device renders at most 1.500 N/mm "
+                          "passively, and the material is stiffer; --proxy off reads the material's)"),
+            std::string::npos)
+      << text.out;
 }
 
 TEST_F(CliTest, MuseumJudgeReportsItsVerdictsAndTheirEvidence) {

@@ -37,6 +37,14 @@ struct SessionFixture : ::testing::Test {
 };
 std::filesystem::path* SessionFixture::cache_ = nullptr;
 
+// The penalty path, for the tests of its own mechanisms (held frames, the local model, the
+// damping's onset, the rate limit at a held frame's step): the proxy, the default, has none of them.
+SessionOptions penalty_path() {
+  SessionOptions options;
+  options.proxy = false;
+  return options;
+}
+
 TEST_F(SessionFixture, SteppedSessionPushesTheToolOutAndIsDeterministic) {
   auto first = make(small_scene_json());
   ASSERT_TRUE(first);
@@ -83,8 +91,8 @@ TEST_F(SessionFixture, ForceOnTheStylusPointsUpOutOfTheBunny) {
 
 TEST_F(SessionFixture, MultiRateReevaluationSmoothsTheForceOfASlowCollisionThread) {
   // collision every 8 ticks (125 Hz at a 1 kHz haptic rate): held forces step, re-evaluated ones follow
-  auto multi = make(small_scene_json(true));
-  auto held = make(small_scene_json(false));
+  auto multi = make(small_scene_json(true), penalty_path());
+  auto held = make(small_scene_json(false), penalty_path());
   ASSERT_TRUE(multi && held);
   ASSERT_TRUE(multi->run_stepped(1.0, 8).has_value());
   ASSERT_TRUE(held->run_stepped(1.0, 8).has_value());
@@ -95,9 +103,9 @@ TEST_F(SessionFixture, MultiRateReevaluationSmoothsTheForceOfASlowCollisionThrea
 
 TEST_F(SessionFixture, LocalModelFollowsTheExactReevaluationOfEveryPair) {
   // collision every 4 ticks: the model (default) rendered, the exact re-evaluation run beside it
-  SessionOptions check;
+  SessionOptions check = penalty_path();
   check.check_model = true;
-  SessionOptions reference;
+  SessionOptions reference = penalty_path();
   reference.tick_force = TickForce::kExact;
   auto checked = make(small_scene_json(), check);
   auto exact = make(small_scene_json(), reference);
@@ -123,10 +131,10 @@ TEST_F(SessionFixture, DampingFullVolumeRemovesTheKnockAtContactOnset) {
   // does, so no turn-around changes the velocity); collision every tick, so that every force step
   // comes from the force law. The paper's damping reading puts eps_d * v on at the first touch.
   const std::string scene = replaced(small_scene_json(), R"("bounce": true)", R"("bounce": false)");
-  auto with_paper =
-      make(replaced(scene, R"("damping": 1.0,)", R"("damping": 1.0, "damping_full_volume": 0,)"));
-  auto ramped = make(scene);  // the default: damping_full_volume 2e-8 m^3
-  auto undamped = make(replaced(scene, R"("damping": 1.0,)", R"("damping": 0.0,)"));
+  auto with_paper = make(replaced(scene, R"("damping": 1.0,)", R"("damping": 1.0, "damping_full_volume": 0,)"),
+                         penalty_path());
+  auto ramped = make(scene, penalty_path());  // the default: damping_full_volume 2e-8 m^3
+  auto undamped = make(replaced(scene, R"("damping": 1.0,)", R"("damping": 0.0,)"), penalty_path());
   ASSERT_TRUE(with_paper && ramped && undamped);
   for (auto* s : {with_paper.get(), ramped.get(), undamped.get()}) ASSERT_TRUE(s->run_stepped(0.45, 1).has_value());
   ASSERT_GT(undamped->report().contact_ticks, 50) << "the stylus must be in contact for a while";
@@ -175,16 +183,21 @@ TEST_F(SessionFixture, StateAfterASteppedRunIsTheZeroItEndedWith) {
   const std::vector<double>& last = table.rows[499];
   const auto at = [&](const char* name) { return last[static_cast<std::size_t>(table.column(name))]; };
   EXPECT_NEAR(tick.time_s, at("tick_time_s"), 1e-9);
-  // the scene's workspace mapping is the identity: the tool sits at the handle, forces are the device's
-  EXPECT_NEAR(tick.tool_position_world.x, at("x"), 1e-9);
-  EXPECT_NEAR(tick.tool_position_world.z, at("z"), 1e-9);
-  EXPECT_NEAR(tick.tool_orientation_world.w, at("qw"), 1e-9);
+  // the scene's workspace mapping is the identity: the handle is the device's pose, forces are the
+  // device's (the tool, the proxy, rests on the bunny above the handle)
+  EXPECT_NEAR(tick.handle_position_world.x, at("x"), 1e-9);
+  EXPECT_NEAR(tick.handle_position_world.z, at("z"), 1e-9);
+  EXPECT_GT(tick.tool_position_world.z, tick.handle_position_world.z) << "the proxy holds the tool out of the bunny";
+  // (the proxy's turn is its own, no longer the device's: a unit quaternion still)
+  const Quat& q = tick.tool_orientation_world;
+  EXPECT_NEAR(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z, 1.0, 1e-9);
   EXPECT_NEAR(tick.force_world.z, at("fz"), 1e-6);
   EXPECT_NEAR(tick.torque_world.x, at("tx"), 1e-6);
   EXPECT_GT(norm(tick.force_world), 0.1) << "at 0.5 s the stylus is at its deepest in the bunny";
   EXPECT_GT(tick.contact_pairs, 0);
   EXPECT_EQ(tick.missed_deadlines, 0u);
-  EXPECT_EQ(s.tool_position_world, tick.tool_position_world) << "the tool has not moved since";
+  EXPECT_EQ(s.handle_position_world, tick.handle_position_world) << "the handle has not moved since";
+  EXPECT_EQ(s.tool_position_world, tick.tool_position_world) << "nor the tool";
 }
 
 TEST_F(SessionFixture, StatesCarryTheDeviceButtons) {
@@ -322,7 +335,7 @@ TEST_F(SessionFixture, SmallestOfToolSafetyAndDeviceLimitBoundsEveryTick) {
 TEST_F(SessionFixture, RateLimitBoundsEveryTickToTickStep) {
   const std::string held = replaced(small_scene_with_limits(6.0, 10.0, 6.0, 100.0), R"("multi_rate": true)",
                                     R"("multi_rate": false)");
-  auto session = make(held);
+  auto session = make(held, penalty_path());
   ASSERT_TRUE(session);
   std::ostringstream trace;
   ASSERT_TRUE(session->run_stepped(1.0, 25, &trace).has_value());

@@ -34,7 +34,7 @@ namespace UnrealHaptics
         public int Object;        // the object's index in the scene
         public int Tool;          // the tool's index in the scene
         public double TimeS;      // of the collision step that saw it [s]
-        public double Volume;     // overlap volume then [m^3] (0 for End)
+        public double Volume;     // overlap volume then [m^3] (0 for End; 0 through the proxy)
         public int Pairs;         // overlapping sphere pairs then
     }
 

@@ -19,6 +19,10 @@ struct ObjectExploration {
   std::string object;
   MaterialEstimate estimate;
   ExploreTrace trace;
+  /// Through the proxy, the stiffest spring the device renders [N/m]: the coupling's stiffness
+  /// clamped to Colgate's passivity bound for the device's damping at the haptic period. A material
+  /// stiffer than it reads as it (the rendered stiffness, not the material's). 0 on the penalty path.
+  double rendered_stiffness_limit_n_per_m = 0.0;
   double work_on_hand_j = 0.0;  ///< energy the device put into the hand over the whole (closed) script [J]
   double simulated_s = 0.0;     ///< simulated time the script took [s]
   std::uint64_t haptic_ticks = 0;

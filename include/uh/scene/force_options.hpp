@@ -14,10 +14,9 @@ namespace uh::scene {
 
 /// Options of a ToolProxy (aggregate; scene field `force.proxy`, docs/scenes.md).
 struct ToolProxyOptions {
-  /// Render through the proxy, or the penalty path when false (the default until every shipped
-  /// scene's test passes on the proxy: docs/forcecomp.md, "Not yet"). A scene that enables
+  /// Render through the proxy (the default), or the penalty path when false. A scene that enables
   /// force.coupling gets the penalty path with the coupling unless it asks for the proxy too.
-  bool enabled = false;
+  bool enabled = true;
   /// Most any point of the tool moves in one collision step [m] (a hand faster than step_m times
   /// the collision rate drags the proxy behind it). The world's contact margin is raised to it.
   double step_m = 0.002;
