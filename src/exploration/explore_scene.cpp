@@ -23,10 +23,11 @@ using controllers::SessionOptions;
 
 // The scene the hand explores `object` in, compiled once: the object alone with the scene's first
 // tool on the explorer's device, in the device frame = world, with the session's overrides. The
-// model holds both shapes' trees (the planner reads them before the session exists). Not yet the
-// object's mesh surface: through the proxy resting on the mesh, the strokes read dynamic friction
-// 12-25 % low (0.353 for 0.4, 0.112 for 0.15 on materials_packed.json; 0.399 and 0.149 on the
-// spheres), a cause not found yet (docs/forcecomp.md, "Not yet"), so the proxy rests on the spheres.
+// model holds both shapes' trees (the planner reads them before the session exists). Not the
+// object's mesh surface: the proxy rests on the spheres. On a fine mesh the surface reads the same
+// friction (materials_packed.json: 0.601 / 0.400 for 0.6 / 0.4) and finds the flat slab's grating
+// the spheres alone miss, but on a coarse one its facets read as texture and stiffness (the 1 m
+// icospheres of materials.json); docs/forcecomp.md, "Not yet".
 Result<std::shared_ptr<const SessionModel>> compile_object_scene(const Scene& scene, const SceneObject& object,
                                                                  const SessionOptions& so) {
   Scene alone = scene;
