@@ -333,16 +333,60 @@ Status CorotationalFem::factorise_and_solve() {
                  ErrorKind::kInvalid};
   }
   ++factorisations_;
+  keep_preconditioner();
   increment_ = solver_->solve(rhs_);
   if (!increment_.allFinite()) return Error{"soft::CorotationalFem: the solve gave a non-finite step", ErrorKind::kInvalid};
   return Ok{};
+}
+
+void CorotationalFem::keep_preconditioner() {
+  const auto& lower = solver_->matrixL().nestedExpression();
+  const auto columns = static_cast<std::size_t>(lower.cols());
+  // the strictly lower part only (L's unit diagonal is implied)
+  factor_starts_.assign(1, 0);
+  factor_rows_.clear();
+  factor_values_.clear();
+  for (std::size_t j = 0; j < columns; ++j) {
+    for (auto k = lower.outerIndexPtr()[j]; k < lower.outerIndexPtr()[j + 1]; ++k) {
+      if (at(lower.innerIndexPtr()[k]) <= j) continue;
+      factor_rows_.push_back(lower.innerIndexPtr()[k]);
+      factor_values_.push_back(static_cast<float>(lower.valuePtr()[k]));
+    }
+    factor_starts_.push_back(static_cast<std::int32_t>(factor_rows_.size()));
+  }
+  const auto& order = solver_->permutationP().indices();
+  permutation_.assign(order.data(), order.data() + order.size());
+  diagonal_inverse_ = solver_->vectorD().cwiseInverse();
+  permuted_.resize(static_cast<Eigen::Index>(columns));
+}
+
+// result = P^T L^-T D^-1 L^-1 P residual, with the single-precision L
+void CorotationalFem::precondition(const Eigen::VectorXd& residual, Eigen::VectorXd& result) {
+  const auto n = static_cast<std::int32_t>(permutation_.size());
+  for (std::int32_t i = 0; i < n; ++i) permuted_[permutation_[at(i)]] = residual[i];
+  for (std::int32_t j = 0; j < n; ++j) {
+    const double value = permuted_[j];
+    for (std::int32_t k = factor_starts_[at(j)]; k < factor_starts_[at(j + 1)]; ++k) {
+      permuted_[factor_rows_[at(k)]] -= static_cast<double>(factor_values_[at(k)]) * value;
+    }
+  }
+  permuted_.array() *= diagonal_inverse_.array();
+  for (std::int32_t j = n - 1; j >= 0; --j) {
+    double value = permuted_[j];
+    for (std::int32_t k = factor_starts_[at(j)]; k < factor_starts_[at(j + 1)]; ++k) {
+      value -= static_cast<double>(factor_values_[at(k)]) * permuted_[factor_rows_[at(k)]];
+    }
+    permuted_[j] = value;
+  }
+  result.resize(n);
+  for (std::int32_t i = 0; i < n; ++i) result[i] = permuted_[permutation_[at(i)]];
 }
 
 bool CorotationalFem::conjugate_gradients() {
   const double target = solver_options_.relative_residual * rhs_.norm();
   multiply(increment_, product_);
   residual_ = rhs_ - product_;
-  preconditioned_ = solver_->solve(residual_);
+  precondition(residual_, preconditioned_);
   direction_ = preconditioned_;
   double rz = residual_.dot(preconditioned_);
   for (int iteration = 0; iteration < solver_options_.max_iterations; ++iteration) {
@@ -352,7 +396,7 @@ bool CorotationalFem::conjugate_gradients() {
     const double alpha = rz / direction_.dot(product_);
     increment_ += alpha * direction_;
     residual_ -= alpha * product_;
-    preconditioned_ = solver_->solve(residual_);
+    precondition(residual_, preconditioned_);
     const double rz_next = residual_.dot(preconditioned_);
     direction_ = preconditioned_ + (rz_next / rz) * direction_;
     rz = rz_next;
