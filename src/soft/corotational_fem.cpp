@@ -173,8 +173,31 @@ Result<CorotationalFem> CorotationalFem::create(TetMesh mesh, const ElasticMater
   fem.mesh_ = std::move(mesh);
   fem.rhs_.setZero(3 * free_count);
   fem.increment_.setZero(3 * free_count);
+  fem.order_free_nodes();
   fem.build_pattern();
   return fem;
+}
+
+// renumbers the free nodes by Eigen's approximate minimum degree ordering of the free node graph
+void CorotationalFem::order_free_nodes() {
+  const auto count = static_cast<Eigen::Index>(rhs_.size() / 3);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (const auto& element : elements_) {
+    for (const std::int32_t a : element.nodes) {
+      for (const std::int32_t b : element.nodes) {
+        if (free_index_[at(a)] >= 0 && free_index_[at(b)] >= 0) entries.emplace_back(free_index_[at(a)], free_index_[at(b)], 1.0);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> graph(count, count);
+  graph.setFromTriplets(entries.begin(), entries.end());
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> elimination;
+  Eigen::AMDOrdering<int>()(graph, elimination);  // the k-th node eliminated is elimination.indices()[k]
+  std::vector<std::int32_t> position(static_cast<std::size_t>(count));
+  for (Eigen::Index k = 0; k < count; ++k) position[at(elimination.indices()[k])] = static_cast<std::int32_t>(k);
+  for (auto& index : free_index_) {
+    if (index >= 0) index = position[at(index)];
+  }
 }
 
 // The system is symmetric: only its lower triangle is stored (the factorisation reads no more, and
@@ -219,7 +242,7 @@ void CorotationalFem::build_pattern() {
   }
   diagonal_slots_.resize(at(static_cast<std::int32_t>(dofs)));
   for (Eigen::Index d = 0; d < dofs; ++d) diagonal_slots_[static_cast<std::size_t>(d)] = slot(d, d);
-  solver_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
+  solver_ = std::make_unique<Factorisation>();
   solver_->analyzePattern(system_);
 }
 
@@ -341,45 +364,71 @@ Status CorotationalFem::factorise_and_solve() {
 
 void CorotationalFem::keep_preconditioner() {
   const auto& lower = solver_->matrixL().nestedExpression();
-  const auto columns = static_cast<std::size_t>(lower.cols());
-  // the strictly lower part only (L's unit diagonal is implied)
+  const auto nodes = static_cast<std::int32_t>(lower.cols() / 3);
   factor_starts_.assign(1, 0);
   factor_rows_.clear();
-  factor_values_.clear();
-  for (std::size_t j = 0; j < columns; ++j) {
-    for (auto k = lower.outerIndexPtr()[j]; k < lower.outerIndexPtr()[j + 1]; ++k) {
-      if (at(lower.innerIndexPtr()[k]) <= j) continue;
-      factor_rows_.push_back(lower.innerIndexPtr()[k]);
-      factor_values_.push_back(static_cast<float>(lower.valuePtr()[k]));
+  factor_blocks_.clear();
+  factor_diagonal_.assign(at(nodes), {0.0F, 0.0F, 0.0F});
+  std::vector<std::int32_t> block_of_node(at(nodes), -1);  // the block of node row I in this column
+  for (std::int32_t column_node = 0; column_node < nodes; ++column_node) {
+    for (int c = 0; c < 3; ++c) {
+      const std::int32_t column = 3 * column_node + c;
+      for (auto k = lower.outerIndexPtr()[column]; k < lower.outerIndexPtr()[column + 1]; ++k) {
+        const std::int32_t row = lower.innerIndexPtr()[k];
+        const auto value = static_cast<float>(lower.valuePtr()[k]);
+        if (row <= column) continue;
+        const std::int32_t row_node = row / 3;
+        if (row_node == column_node) {
+          factor_diagonal_[at(column_node)][at(c + row % 3 - 1)] = value;  // (1,0) -> 0, (2,0) -> 1, (2,1) -> 2
+          continue;
+        }
+        std::int32_t& block = block_of_node[at(row_node)];
+        if (block < 0) {
+          block = static_cast<std::int32_t>(factor_rows_.size());
+          factor_rows_.push_back(row_node);
+          factor_blocks_.resize(factor_blocks_.size() + 9, 0.0F);
+        }
+        factor_blocks_[at(9 * block + 3 * c + row % 3)] = value;
+      }
     }
+    for (auto b = at(factor_starts_.back()); b < factor_rows_.size(); ++b) block_of_node[at(factor_rows_[b])] = -1;
     factor_starts_.push_back(static_cast<std::int32_t>(factor_rows_.size()));
   }
-  const auto& order = solver_->permutationP().indices();
-  permutation_.assign(order.data(), order.data() + order.size());
   diagonal_inverse_ = solver_->vectorD().cwiseInverse();
-  permuted_.resize(static_cast<Eigen::Index>(columns));
 }
 
-// result = P^T L^-T D^-1 L^-1 P residual, with the single-precision L
+// result = L^-T D^-1 L^-1 residual with the single-precision blocks of L
 void CorotationalFem::precondition(const Eigen::VectorXd& residual, Eigen::VectorXd& result) {
-  const auto n = static_cast<std::int32_t>(permutation_.size());
-  for (std::int32_t i = 0; i < n; ++i) permuted_[permutation_[at(i)]] = residual[i];
-  for (std::int32_t j = 0; j < n; ++j) {
-    const double value = permuted_[j];
-    for (std::int32_t k = factor_starts_[at(j)]; k < factor_starts_[at(j + 1)]; ++k) {
-      permuted_[factor_rows_[at(k)]] -= static_cast<double>(factor_values_[at(k)]) * value;
+  const auto nodes = static_cast<std::int32_t>(factor_diagonal_.size());
+  result = residual;
+  double* y = result.data();
+  for (std::int32_t j = 0; j < nodes; ++j) {
+    const auto& d = factor_diagonal_[at(j)];
+    double* yj = y + 3 * j;
+    yj[1] -= static_cast<double>(d[0]) * yj[0];
+    yj[2] -= static_cast<double>(d[1]) * yj[0] + static_cast<double>(d[2]) * yj[1];
+    for (std::int32_t b = factor_starts_[at(j)]; b < factor_starts_[at(j + 1)]; ++b) {
+      const float* l = &factor_blocks_[at(9 * b)];
+      double* yi = y + 3 * factor_rows_[at(b)];
+      for (int c = 0; c < 3; ++c) {
+        for (int r = 0; r < 3; ++r) yi[r] -= static_cast<double>(l[3 * c + r]) * yj[c];
+      }
     }
   }
-  permuted_.array() *= diagonal_inverse_.array();
-  for (std::int32_t j = n - 1; j >= 0; --j) {
-    double value = permuted_[j];
-    for (std::int32_t k = factor_starts_[at(j)]; k < factor_starts_[at(j + 1)]; ++k) {
-      value -= static_cast<double>(factor_values_[at(k)]) * permuted_[factor_rows_[at(k)]];
+  result.array() *= diagonal_inverse_.array();
+  for (std::int32_t j = nodes - 1; j >= 0; --j) {
+    double* yj = y + 3 * j;
+    for (std::int32_t b = factor_starts_[at(j)]; b < factor_starts_[at(j + 1)]; ++b) {
+      const float* l = &factor_blocks_[at(9 * b)];
+      const double* yi = y + 3 * factor_rows_[at(b)];
+      for (int c = 0; c < 3; ++c) {
+        for (int r = 0; r < 3; ++r) yj[c] -= static_cast<double>(l[3 * c + r]) * yi[r];
+      }
     }
-    permuted_[j] = value;
+    const auto& d = factor_diagonal_[at(j)];
+    yj[1] -= static_cast<double>(d[2]) * yj[2];
+    yj[0] -= static_cast<double>(d[0]) * yj[1] + static_cast<double>(d[1]) * yj[2];
   }
-  result.resize(n);
-  for (std::int32_t i = 0; i < n; ++i) result[i] = permuted_[permutation_[at(i)]];
 }
 
 bool CorotationalFem::conjugate_gradients() {
