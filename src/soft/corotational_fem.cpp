@@ -11,12 +11,12 @@ namespace uh::soft {
 namespace {
 
 // the rotation of F = R S for det F > 0, by Newton's iteration X <- (g X + X^-T / g) / 2 with
-// Higham's scaling g: quadratic, a handful of iterations, orthogonal to rounding
+// Higham's scaling g: quadratic, a handful of iterations, orthogonal to 1e-12
 bool polar_newton(const Eigen::Matrix3d& deformation, Eigen::Matrix3d& rotation) {
   constexpr int kMaxIterations = 20;
   // the iteration converges quadratically: once a change is below this, one more leaves an error
-  // of its square, below rounding
-  constexpr double kLastButOne = 1e-7;
+  // of about half its square (5e-13), far below what the forces notice
+  constexpr double kLastButOne = 1e-6;
   // Higham's scaling speeds up the first iterations of a strongly stretched element; near the
   // rotation it is 1 and its square roots are saved
   constexpr double kScaledAbove = 1e-2;
