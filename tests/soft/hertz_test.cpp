@@ -9,11 +9,12 @@
 //
 // What this reaches: the force is 4 to 27 % above Hertz on the default lattice (4,374 tets, cells of
 // 0.19 R) and 17 to 20 % above on 16,464 tets (0.12 R); the slope of log F against log d is 1.5 to
-// within 0.1. Two errors make the FEM stiffer: linear tetrahedra on cells several times coarser
-// than the contact (about +15 % at cells of 0.24 R, +8 % less at half that) and the finite block
-// held at its base (+8 % for a 5 cm block over a 10 cm one at equal cells). Hertz's 15 % on the
-// default lattice and 5 % refined need several times finer cells near the contact than this
-// lattice affords in a test; the bounds below hold what is reached, so a regression fails them.
+// within 0.1. Two errors make the FEM stiffer: at cells of 0.24 R the force is 22-30 % above
+// Hertz on this block and 13-20 % above on one twice as large, so the finite block held at its
+// base accounts for 3-10 %, linear tetrahedra on cells coarser than the contact for the rest.
+// Hertz's 15 % on the default lattice and 5 % refined need several times finer cells near the
+// contact than this lattice affords in a test; the bounds below hold what is reached, so a
+// regression fails them.
 
 #include <gtest/gtest.h>
 
