@@ -44,8 +44,8 @@ struct NodeContact {
   Eigen::Matrix3d stiffness = Eigen::Matrix3d::Zero();
 };
 
-/// An obstacle's contacts at the node positions [m]: fills `contacts` (given empty), one entry per
-/// pressed node (a node at most once).
+/// An obstacle's contacts at the node positions [m]: appends to `contacts` (given empty) an entry
+/// per pressed node; entries naming the same node add up (several obstacles may press one node).
 using ContactModel =
     std::function<void(const std::vector<Eigen::Vector3d>& positions, std::vector<NodeContact>& contacts)>;
 
@@ -56,15 +56,17 @@ std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3
 /// the polar decomposition of its deformation gradient, its forces are the linear ones in that
 /// rotated frame. Lumped mass from the density. Steps are implicit (backward Euler), linearised
 /// with the rotations of the step's start, and solved by conjugate gradients preconditioned with a
-/// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once), which is
-/// refactored only when the iterations do not converge quickly. Fixed nodes are eliminated: they
+/// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once, kept as a
+/// single-precision copy in 3 x 3 node blocks), which is refactored only when the iterations do
+/// not converge quickly (SolverOptions). Fixed nodes are eliminated: they
 /// stay at their held position (the rest position unless moved with `hold`).
 /// Not thread-safe: one simulation thread owns it. Not real-time: the assembly writes into fixed
 /// slots, but Eigen's products, solves and factorisations may allocate.
 class CorotationalFem {
  public:
   /// A model of `mesh` (positively oriented tetrahedra of nonzero volume) with `fixed` nodes held.
-  /// Fails (kInvalid) on a bad material or node index, (kMesh) on an empty or degenerate mesh.
+  /// Fails (kInvalid) on a bad material, solver option or node index, (kMesh) on an empty or
+  /// degenerate mesh.
   static Result<CorotationalFem> create(TetMesh mesh, const ElasticMaterial& material,
                                         const std::vector<std::int32_t>& fixed, const SolverOptions& solver = {});
 
