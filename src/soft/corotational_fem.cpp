@@ -4,24 +4,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace uh::soft {
 namespace {
 
 // the rotation of F = R S for det F > 0, by Newton's iteration X <- (g X + X^-T / g) / 2 with
-// Higham's scaling g: quadratic, a handful of iterations, orthogonal to rounding
+// Higham's scaling g: quadratic, a handful of iterations, orthogonal to 1e-12
 bool polar_newton(const Eigen::Matrix3d& deformation, Eigen::Matrix3d& rotation) {
   constexpr int kMaxIterations = 20;
-  constexpr double kConverged = 1e-13;
+  // the iteration converges quadratically: once a change is below this, one more leaves an error
+  // of about half its square (5e-13), far below what the forces notice
+  constexpr double kLastButOne = 1e-6;
+  // Higham's scaling speeds up the first iterations of a strongly stretched element; near the
+  // rotation it is 1 and its square roots are saved
+  constexpr double kScaledAbove = 1e-2;
   Eigen::Matrix3d x = deformation;
+  double change = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
-    const Eigen::Matrix3d inverse_transpose = x.inverse().transpose();
-    const double scale = std::sqrt(inverse_transpose.norm() / x.norm());
+    const bool last = change < kLastButOne;
+    // X^-T from the cofactors, the cross products of X's columns
+    Eigen::Matrix3d inverse_transpose;
+    inverse_transpose.col(0) = x.col(1).cross(x.col(2));
+    inverse_transpose.col(1) = x.col(2).cross(x.col(0));
+    inverse_transpose.col(2) = x.col(0).cross(x.col(1));
+    const double determinant = x.col(0).dot(inverse_transpose.col(0));
+    if (!(determinant > 0.0)) return false;
+    inverse_transpose /= determinant;
+    const double scale =
+        change > kScaledAbove ? std::sqrt(std::sqrt(inverse_transpose.squaredNorm() / x.squaredNorm())) : 1.0;
     const Eigen::Matrix3d next = 0.5 * (scale * x + inverse_transpose / scale);
-    const double change = (next - x).norm();
+    change = (next - x).norm();
     x = next;
-    if (change < kConverged) {
+    if (last) {
       rotation = x;
       return true;
     }
@@ -82,6 +98,14 @@ bool all_finite(const std::vector<Eigen::Vector3d>& vectors) {
   return std::all_of(vectors.begin(), vectors.end(), [](const Eigen::Vector3d& v) { return v.allFinite(); });
 }
 
+Status check_solver(const SolverOptions& o) {
+  if (!(o.relative_residual > 0.0 && o.relative_residual < 1.0)) {
+    return Error{"soft::CorotationalFem: solver relative_residual must be in (0, 1)", ErrorKind::kInvalid};
+  }
+  if (o.max_iterations < 1) return Error{"soft::CorotationalFem: solver max_iterations must be >= 1", ErrorKind::kInvalid};
+  return Ok{};
+}
+
 }  // namespace
 
 std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
@@ -96,8 +120,9 @@ std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3
 }
 
 Result<CorotationalFem> CorotationalFem::create(TetMesh mesh, const ElasticMaterial& material,
-                                                const std::vector<std::int32_t>& fixed) {
+                                                const std::vector<std::int32_t>& fixed, const SolverOptions& solver) {
   if (auto valid = check_material(material); !valid) return valid.error();
+  if (auto valid = check_solver(solver); !valid) return valid.error();
   if (mesh.tets.empty()) return Error{"soft::CorotationalFem: the mesh has no tetrahedra", ErrorKind::kMesh};
   const auto node_count = static_cast<std::int32_t>(mesh.nodes.size());
   CorotationalFem fem;
@@ -109,9 +134,9 @@ Result<CorotationalFem> CorotationalFem::create(TetMesh mesh, const ElasticMater
     }
     fem.free_index_[at(node)] = -1;
   }
-  const double lambda = material.young_modulus_pa * material.poisson_ratio /
-                        ((1.0 + material.poisson_ratio) * (1.0 - 2.0 * material.poisson_ratio));
-  const double mu = material.young_modulus_pa / (2.0 * (1.0 + material.poisson_ratio));
+  fem.lambda_ = material.young_modulus_pa * material.poisson_ratio /
+                ((1.0 + material.poisson_ratio) * (1.0 - 2.0 * material.poisson_ratio));
+  fem.mu_ = material.young_modulus_pa / (2.0 * (1.0 + material.poisson_ratio));
   fem.masses_.assign(mesh.nodes.size(), 0.0);
   fem.elements_.reserve(mesh.tets.size());
   for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
@@ -128,44 +153,66 @@ Result<CorotationalFem> CorotationalFem::create(TetMesh mesh, const ElasticMater
     }
     Element element;
     element.nodes = t;
-    element.rest_inverse = edges.inverse();
+    element.volume = volume;
     // gradients of the shape functions: rows of the inverse edge matrix, and minus their sum
-    std::array<Eigen::Vector3d, 4> g;
-    for (int i = 0; i < 3; ++i) g[at(i + 1)] = element.rest_inverse.row(i).transpose();
-    g[0] = -(g[1] + g[2] + g[3]);
-    // the Hessian of the linear strain energy V (mu eps:eps + lambda/2 tr(eps)^2)
-    for (std::size_t a = 0; a < 4; ++a) {
-      for (std::size_t b = 0; b < 4; ++b) {
-        element.stiffness[a * 4 + b] =
-            volume * (lambda * g[a] * g[b].transpose() + mu * g[b] * g[a].transpose() +
-                      mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity());
-      }
-    }
+    const Eigen::Matrix3d rest_inverse = edges.inverse();
+    for (int i = 0; i < 3; ++i) element.gradients[at(i + 1)] = rest_inverse.row(i).transpose();
+    element.gradients[0] = -(element.gradients[1] + element.gradients[2] + element.gradients[3]);
     for (const std::int32_t n : t) fem.masses_[at(n)] += material.density_kg_m3 * volume / 4.0;
     fem.elements_.push_back(element);
   }
   std::int32_t free_count = 0;
   for (auto& index : fem.free_index_) index = index < 0 ? -1 : free_count++;
   fem.material_ = material;
+  fem.solver_options_ = solver;
   fem.positions_ = mesh.nodes;
   fem.held_ = mesh.nodes;
   fem.velocities_.assign(mesh.nodes.size(), Eigen::Vector3d::Zero());
+  fem.previous_velocities_ = fem.velocities_;
   fem.forces_.assign(mesh.nodes.size(), Eigen::Vector3d::Zero());
   fem.mesh_ = std::move(mesh);
   fem.rhs_.setZero(3 * free_count);
   fem.increment_.setZero(3 * free_count);
+  fem.order_free_nodes();
   fem.build_pattern();
   return fem;
 }
 
+// renumbers the free nodes by Eigen's approximate minimum degree ordering of the free node graph
+void CorotationalFem::order_free_nodes() {
+  const auto count = static_cast<Eigen::Index>(rhs_.size() / 3);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (const auto& element : elements_) {
+    for (const std::int32_t a : element.nodes) {
+      for (const std::int32_t b : element.nodes) {
+        if (free_index_[at(a)] >= 0 && free_index_[at(b)] >= 0) entries.emplace_back(free_index_[at(a)], free_index_[at(b)], 1.0);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> graph(count, count);
+  graph.setFromTriplets(entries.begin(), entries.end());
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> elimination;
+  Eigen::AMDOrdering<int>()(graph, elimination);  // the k-th node eliminated is elimination.indices()[k]
+  std::vector<std::int32_t> position(static_cast<std::size_t>(count));
+  for (Eigen::Index k = 0; k < count; ++k) position[at(elimination.indices()[k])] = static_cast<std::int32_t>(k);
+  for (auto& index : free_index_) {
+    if (index >= 0) index = position[at(index)];
+  }
+}
+
+// The system is symmetric: only its lower triangle is stored (the factorisation reads no more, and
+// the products use it as a self-adjoint view), so a node pair's block is written once, in the rows
+// of the node with the larger free index.
 void CorotationalFem::build_pattern() {
   std::vector<Eigen::Triplet<double>> entries;
   for (const auto& element : elements_) {
     for (const std::int32_t a : element.nodes) {
       for (const std::int32_t b : element.nodes) {
-        if (free_index_[at(a)] < 0 || free_index_[at(b)] < 0) continue;
-        for (int r = 0; r < 3; ++r) {
-          for (int c = 0; c < 3; ++c) entries.emplace_back(3 * free_index_[at(b)] + r, 3 * free_index_[at(a)] + c, 0.0);
+        const std::int32_t fa = free_index_[at(a)];
+        const std::int32_t fb = free_index_[at(b)];
+        if (fa < 0 || fb < 0 || fa < fb) continue;
+        for (int c = 0; c < 3; ++c) {
+          for (int r = fa == fb ? c : 0; r < 3; ++r) entries.emplace_back(3 * fa + r, 3 * fb + c, 0.0);
         }
       }
     }
@@ -185,53 +232,82 @@ void CorotationalFem::build_pattern() {
       for (std::size_t b = 0; b < 4; ++b) {
         const std::int32_t fa = free_index_[at(elements_[e].nodes[a])];
         const std::int32_t fb = free_index_[at(elements_[e].nodes[b])];
-        if (fa < 0 || fb < 0) continue;
-        for (int c = 0; c < 3; ++c) block_slots_[(e * 16 + a * 4 + b) * 3 + at(c)] = slot(3 * fb, 3 * fa + c);
+        if (fa < 0 || fb < 0 || fa < fb) continue;
+        // column c of the block starts at its first stored row: row 0, or row c on the diagonal
+        for (int c = 0; c < 3; ++c) {
+          block_slots_[(e * 16 + a * 4 + b) * 3 + at(c)] = slot(3 * fa + (fa == fb ? c : 0), 3 * fb + c);
+        }
       }
     }
   }
   diagonal_slots_.resize(at(static_cast<std::int32_t>(dofs)));
   for (Eigen::Index d = 0; d < dofs; ++d) diagonal_slots_[static_cast<std::size_t>(d)] = slot(d, d);
-  solver_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
+  solver_ = std::make_unique<Factorisation>();
   solver_->analyzePattern(system_);
 }
 
 // Newton's polar iteration where the element is not inverted (fast, exact); the warm-started turns
 // where it is (they never yield a reflection)
-void CorotationalFem::update_rotations() {
+void CorotationalFem::update_rotation(Element& element, const Eigen::Matrix3d& deformation) {
   constexpr double kLeastVolumeRatio = 1e-3;
-  for (auto& element : elements_) {
-    const Eigen::Matrix3d deformation = edge_matrix(positions_, element.nodes) * element.rest_inverse;
-    if (deformation.determinant() > kLeastVolumeRatio && polar_newton(deformation, element.rotation)) {
-      element.quaternion = Eigen::Quaterniond(element.rotation);
-      continue;
-    }
-    rotation_turns_ += extract_rotation(deformation, element.quaternion);
-    element.rotation = element.quaternion.toRotationMatrix();
+  if (deformation.determinant() > kLeastVolumeRatio && polar_newton(deformation, element.rotation)) {
+    element.quaternion = Eigen::Quaterniond(element.rotation);
+    return;
   }
+  rotation_turns_ += extract_rotation(deformation, element.quaternion);
+  element.rotation = element.quaternion.toRotationMatrix();
 }
 
-// f_a = -R sum_b K_ab (R^T x_b - X_b), added to `forces`
-void CorotationalFem::elastic_forces(std::vector<Eigen::Vector3d>& forces) const {
-  for (const auto& element : elements_) {
-    const Eigen::Matrix3d& rot = element.rotation;
-    std::array<Eigen::Vector3d, 4> offset;
+// One element's elastic forces (into the right-hand side) and rotated stiffness (into the system).
+// With the rest stiffness K_ab = V (lambda g_a g_b^T + mu g_b g_a^T + mu (g_a . g_b) I) of the shape
+// gradients g, the rotated block R K_ab R^T is the same expression in the rotated gradients R g,
+// and the force f_a = -R sum_b K_ab (R^T x_b - X_b) is -V R sigma g_a, sigma the linear stress of
+// the strain sym(R^T F) - I: no 12 x 12 matrix is stored or multiplied.
+void CorotationalFem::assemble_element(const Element& element, std::size_t index, const Eigen::Matrix3d& deformation,
+                                       double stiffness_coefficient) {
+  const Eigen::Matrix3d& rot = element.rotation;
+  const Eigen::Matrix3d stretch = rot.transpose() * deformation;
+  const Eigen::Matrix3d strain = 0.5 * (stretch + stretch.transpose()) - Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d stress = lambda_ * strain.trace() * Eigen::Matrix3d::Identity() + 2.0 * mu_ * strain;
+  const Eigen::Matrix3d first_piola = element.volume * rot * stress;
+  std::array<Eigen::Vector3d, 4> turned;
+  std::array<std::int32_t, 4> free{};
+  for (std::size_t a = 0; a < 4; ++a) {
+    turned[a] = rot * element.gradients[a];
+    free[a] = free_index_[at(element.nodes[a])];
+    if (free[a] >= 0) rhs_.segment<3>(3 * free[a]) -= first_piola * element.gradients[a];
+  }
+  const double scale = stiffness_coefficient * element.volume;
+  const auto block = [&](std::size_t a, std::size_t b) {
+    Eigen::Matrix3d k = lambda_ * turned[a] * turned[b].transpose() + mu_ * turned[b] * turned[a].transpose();
+    k.diagonal().array() += mu_ * element.gradients[a].dot(element.gradients[b]);
+    return Eigen::Matrix3d(scale * k);
+  };
+  double* values = system_.valuePtr();
+  for (std::size_t a = 0; a < 4; ++a) {
     for (std::size_t b = 0; b < 4; ++b) {
-      const std::int32_t n = element.nodes[b];
-      offset[b] = rot.transpose() * positions_[at(n)] - mesh_.nodes[at(n)];
-    }
-    for (std::size_t a = 0; a < 4; ++a) {
-      Eigen::Vector3d local = Eigen::Vector3d::Zero();
-      for (std::size_t b = 0; b < 4; ++b) local += element.stiffness[a * 4 + b] * offset[b];
-      forces[at(element.nodes[a])] -= rot * local;
+      if (free[a] < 0 && free[b] >= 0) {
+        // a held node's prescribed motion loads the free node b
+        const std::int32_t held = element.nodes[a];
+        const Eigen::Vector3d motion = held_[at(held)] - positions_[at(held)];
+        if (!motion.isZero(0.0)) rhs_.segment<3>(3 * free[b]) -= block(b, a) * motion;
+        continue;
+      }
+      if (free[a] < 0 || free[b] < 0 || free[a] < free[b]) continue;
+      const Eigen::Matrix3d k = block(a, b);
+      const std::int32_t* slots = &block_slots_[(index * 16 + a * 4 + b) * 3];
+      for (int c = 0; c < 3; ++c) {
+        for (int r = free[a] == free[b] ? c : 0, i = 0; r < 3; ++r, ++i) values[slots[c] + i] += k(r, c);
+      }
     }
   }
 }
 
-// Solves (m M + k K') dx = loads for the free nodes, the fixed ones moving to where they are held,
-// and moves the nodes by dx; K' is the stiffness rotated by each element's current rotation
-Status CorotationalFem::solve_increment(double mass_coefficient, double stiffness_coefficient,
-                                        const std::vector<Eigen::Vector3d>& loads) {
+// The system (m M + k K' + contact stiffness) dx = loads + elastic forces + contact forces for the
+// free nodes, K' the stiffness rotated by each element's current rotation; fixed nodes move to
+// where they are held
+void CorotationalFem::assemble(double mass_coefficient, double stiffness_coefficient,
+                               const std::vector<Eigen::Vector3d>& loads, const std::vector<NodeContact>& contacts) {
   double* values = system_.valuePtr();
   std::fill(values, values + system_.nonZeros(), 0.0);
   for (std::size_t node = 0; node < positions_.size(); ++node) {
@@ -241,39 +317,38 @@ Status CorotationalFem::solve_increment(double mass_coefficient, double stiffnes
     for (int c = 0; c < 3; ++c) values[diagonal_slots_[at(3 * f + c)]] += mass_coefficient * masses_[node];
   }
   for (std::size_t e = 0; e < elements_.size(); ++e) {
-    const Element& element = elements_[e];
-    const Eigen::Matrix3d& rot = element.rotation;
-    for (std::size_t a = 0; a < 4; ++a) {
-      const std::int32_t fa = free_index_[at(element.nodes[a])];
-      for (std::size_t b = 0; b < 4; ++b) {
-        const std::int32_t fb = free_index_[at(element.nodes[b])];
-        if (fa < 0 && fb < 0) continue;
-        // block (row b, column a) of the rotated stiffness
-        const Eigen::Matrix3d block = stiffness_coefficient * rot * element.stiffness[b * 4 + a] * rot.transpose();
-        if (fa < 0) {
-          // a held node's prescribed motion loads the free node b
-          const std::int32_t held = element.nodes[a];
-          rhs_.segment<3>(3 * fb) -= block * (held_[at(held)] - positions_[at(held)]);
-          continue;
-        }
-        if (fb < 0) continue;
-        const std::int32_t* slots = &block_slots_[(e * 16 + a * 4 + b) * 3];
-        for (int c = 0; c < 3; ++c) {
-          for (int r = 0; r < 3; ++r) values[slots[c] + r] += block(r, c);
-        }
-      }
+    Element& element = elements_[e];
+    Eigen::Matrix3d deformation = Eigen::Matrix3d::Zero();
+    for (std::size_t b = 0; b < 4; ++b) deformation += positions_[at(element.nodes[b])] * element.gradients[b].transpose();
+    update_rotation(element, deformation);
+    assemble_element(element, e, deformation, stiffness_coefficient);
+  }
+  for (const NodeContact& contact : contacts) {
+    const std::int32_t f = free_index_[at(contact.node)];
+    if (f < 0) continue;
+    rhs_.segment<3>(3 * f) += contact.force;
+    for (int c = 0; c < 3; ++c) {
+      for (int r = c, i = 0; r < 3; ++r, ++i) values[diagonal_slots_[at(3 * f + c)] + i] += contact.stiffness(r, c);
     }
   }
-  return solve_system();
+}
+
+void CorotationalFem::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  y.noalias() = system_.selfadjointView<Eigen::Lower>() * x;
 }
 
 // Preconditioned conjugate gradients on the current system, preconditioned by the factorisation of
-// an earlier one: rotations change little from step to step, so a few iterations reach the exact
+// an earlier one: rotations change little from step to step, so a few iterations reach the
 // solution. When they do not, the current system is factorised and solved directly, and that
 // factorisation preconditions the next steps.
 Status CorotationalFem::solve_system() {
   iterations_ = 0;
-  if (factorised_ && conjugate_gradients()) return Ok{};
+  if (!solver_options_.direct && factorised_ && conjugate_gradients()) return Ok{};
+  return factorise_and_solve();
+}
+
+Status CorotationalFem::factorise_and_solve() {
+  iterations_ = 0;
   solver_->factorize(system_);
   factorised_ = solver_->info() == Eigen::Success;
   if (!factorised_) {
@@ -281,33 +356,101 @@ Status CorotationalFem::solve_system() {
                  ErrorKind::kInvalid};
   }
   ++factorisations_;
+  keep_preconditioner();
   increment_ = solver_->solve(rhs_);
   if (!increment_.allFinite()) return Error{"soft::CorotationalFem: the solve gave a non-finite step", ErrorKind::kInvalid};
   return Ok{};
 }
 
+void CorotationalFem::keep_preconditioner() {
+  const auto& lower = solver_->matrixL().nestedExpression();
+  const auto nodes = static_cast<std::int32_t>(lower.cols() / 3);
+  factor_starts_.assign(1, 0);
+  factor_rows_.clear();
+  factor_blocks_.clear();
+  factor_diagonal_.assign(at(nodes), {0.0F, 0.0F, 0.0F});
+  std::vector<std::int32_t> block_of_node(at(nodes), -1);  // the block of node row I in this column
+  for (std::int32_t column_node = 0; column_node < nodes; ++column_node) {
+    for (int c = 0; c < 3; ++c) {
+      const std::int32_t column = 3 * column_node + c;
+      for (auto k = lower.outerIndexPtr()[column]; k < lower.outerIndexPtr()[column + 1]; ++k) {
+        const std::int32_t row = lower.innerIndexPtr()[k];
+        const auto value = static_cast<float>(lower.valuePtr()[k]);
+        if (row <= column) continue;
+        const std::int32_t row_node = row / 3;
+        if (row_node == column_node) {
+          factor_diagonal_[at(column_node)][at(c + row % 3 - 1)] = value;  // (1,0) -> 0, (2,0) -> 1, (2,1) -> 2
+          continue;
+        }
+        std::int32_t& block = block_of_node[at(row_node)];
+        if (block < 0) {
+          block = static_cast<std::int32_t>(factor_rows_.size());
+          factor_rows_.push_back(row_node);
+          factor_blocks_.resize(factor_blocks_.size() + 9, 0.0F);
+        }
+        factor_blocks_[at(9 * block + 3 * c + row % 3)] = value;
+      }
+    }
+    for (auto b = at(factor_starts_.back()); b < factor_rows_.size(); ++b) block_of_node[at(factor_rows_[b])] = -1;
+    factor_starts_.push_back(static_cast<std::int32_t>(factor_rows_.size()));
+  }
+  diagonal_inverse_ = solver_->vectorD().cwiseInverse();
+}
+
+// result = L^-T D^-1 L^-1 residual with the single-precision blocks of L
+void CorotationalFem::precondition(const Eigen::VectorXd& residual, Eigen::VectorXd& result) {
+  const auto nodes = static_cast<std::int32_t>(factor_diagonal_.size());
+  result = residual;
+  double* y = result.data();
+  for (std::int32_t j = 0; j < nodes; ++j) {
+    const auto& d = factor_diagonal_[at(j)];
+    double* yj = y + 3 * j;
+    yj[1] -= static_cast<double>(d[0]) * yj[0];
+    yj[2] -= static_cast<double>(d[1]) * yj[0] + static_cast<double>(d[2]) * yj[1];
+    for (std::int32_t b = factor_starts_[at(j)]; b < factor_starts_[at(j + 1)]; ++b) {
+      const float* l = &factor_blocks_[at(9 * b)];
+      double* yi = y + 3 * factor_rows_[at(b)];
+      for (int c = 0; c < 3; ++c) {
+        for (int r = 0; r < 3; ++r) yi[r] -= static_cast<double>(l[3 * c + r]) * yj[c];
+      }
+    }
+  }
+  result.array() *= diagonal_inverse_.array();
+  for (std::int32_t j = nodes - 1; j >= 0; --j) {
+    double* yj = y + 3 * j;
+    for (std::int32_t b = factor_starts_[at(j)]; b < factor_starts_[at(j + 1)]; ++b) {
+      const float* l = &factor_blocks_[at(9 * b)];
+      const double* yi = y + 3 * factor_rows_[at(b)];
+      for (int c = 0; c < 3; ++c) {
+        for (int r = 0; r < 3; ++r) yj[c] -= static_cast<double>(l[3 * c + r]) * yi[r];
+      }
+    }
+    const auto& d = factor_diagonal_[at(j)];
+    yj[1] -= static_cast<double>(d[2]) * yj[2];
+    yj[0] -= static_cast<double>(d[0]) * yj[1] + static_cast<double>(d[1]) * yj[2];
+  }
+}
+
 bool CorotationalFem::conjugate_gradients() {
-  constexpr int kMaxIterations = 12;
-  constexpr double kRelativeResidual = 1e-8;
-  const double target = kRelativeResidual * rhs_.norm();
-  // the last solve's increment is the first guess: the motion is smooth from step to step
-  residual_ = rhs_ - system_ * increment_;
-  preconditioned_ = solver_->solve(residual_);
+  const double target = solver_options_.relative_residual * rhs_.norm();
+  multiply(increment_, product_);
+  residual_ = rhs_ - product_;
+  precondition(residual_, preconditioned_);
   direction_ = preconditioned_;
   double rz = residual_.dot(preconditioned_);
-  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+  for (int iteration = 0; iteration < solver_options_.max_iterations; ++iteration) {
     iterations_ = iteration;
     if (!(residual_.norm() > target)) return increment_.allFinite();
-    product_.noalias() = system_ * direction_;
+    multiply(direction_, product_);
     const double alpha = rz / direction_.dot(product_);
     increment_ += alpha * direction_;
     residual_ -= alpha * product_;
-    preconditioned_ = solver_->solve(residual_);
+    precondition(residual_, preconditioned_);
     const double rz_next = residual_.dot(preconditioned_);
     direction_ = preconditioned_ + (rz_next / rz) * direction_;
     rz = rz_next;
   }
-  iterations_ = kMaxIterations;
+  iterations_ = solver_options_.max_iterations;
   return !(residual_.norm() > target) && increment_.allFinite();
 }
 
@@ -330,6 +473,7 @@ Status CorotationalFem::set_state(std::vector<Eigen::Vector3d> positions, std::v
   }
   positions_ = std::move(positions);
   velocities_ = std::move(velocities);
+  previous_velocities_ = velocities_;
   return Ok{};
 }
 
@@ -351,10 +495,23 @@ double CorotationalFem::apply_increment(double dt_s) {
     const Eigen::Vector3d move = f < 0 ? Eigen::Vector3d(held_[node] - positions_[node])
                                        : Eigen::Vector3d(increment_.segment<3>(3 * f));
     positions_[node] += move;
+    previous_velocities_[node] = dt_s > 0.0 ? velocities_[node] : Eigen::Vector3d::Zero();
     velocities_[node] = dt_s > 0.0 ? Eigen::Vector3d(move / dt_s) : Eigen::Vector3d::Zero();
     largest = std::max(largest, move.norm());
   }
   return largest;
+}
+
+Status CorotationalFem::check_contacts(const std::vector<NodeContact>& contacts) const {
+  for (const NodeContact& contact : contacts) {
+    if (contact.node < 0 || at(contact.node) >= positions_.size() || !contact.force.allFinite() ||
+        !contact.stiffness.allFinite()) {
+      return Error{"soft::CorotationalFem: a contact names node " + std::to_string(contact.node) + " of " +
+                       std::to_string(positions_.size()) + " or is not finite",
+                   ErrorKind::kInvalid};
+    }
+  }
+  return Ok{};
 }
 
 // backward Euler, M (dx - h v) / h^2 = f_ext + f_el(x) - K' dx - C dx / h with C = alpha M + beta K':
@@ -364,30 +521,43 @@ Status CorotationalFem::step(double dt_s, const std::vector<Eigen::Vector3d>& ex
     return Error{"soft::CorotationalFem::step: dt_s must be positive and finite", ErrorKind::kInvalid};
   }
   if (auto loads = check_loads(external_forces); !loads) return loads;
-  update_rotations();
   for (std::size_t node = 0; node < positions_.size(); ++node) {
     forces_[node] = external_forces[node] + masses_[node] / dt_s * velocities_[node];
   }
-  elastic_forces(forces_);
   const double mass_coefficient = 1.0 / (dt_s * dt_s) + material_.mass_damping_per_s / dt_s;
   const double stiffness_coefficient = 1.0 + material_.stiffness_damping_s / dt_s;
-  if (auto solved = solve_increment(mass_coefficient, stiffness_coefficient, forces_); !solved) return solved;
+  contacts_.clear();
+  assemble(mass_coefficient, stiffness_coefficient, forces_, contacts_);
+  // the first guess of the iterations: the motion carried on with its last acceleration,
+  // dx = h (v + (v - v_previous)); the iterations converge the same from any guess, in fewer
+  // iterations from a good one
+  for (std::size_t node = 0; node < positions_.size(); ++node) {
+    const std::int32_t f = free_index_[node];
+    if (f >= 0) increment_.segment<3>(3 * f) = dt_s * (2.0 * velocities_[node] - previous_velocities_[node]);
+  }
+  if (auto solved = solve_system(); !solved) return solved;
   apply_increment(dt_s);
   return Ok{};
 }
 
 Result<int> CorotationalFem::solve_static(const std::vector<Eigen::Vector3d>& external_forces, int max_iterations,
                                           double tolerance_m) {
+  return solve_static(external_forces, ContactModel{}, max_iterations, tolerance_m);
+}
+
+Result<int> CorotationalFem::solve_static(const std::vector<Eigen::Vector3d>& external_forces,
+                                          const ContactModel& contacts, int max_iterations, double tolerance_m) {
   if (auto loads = check_loads(external_forces); !loads) return loads.error();
   if (std::none_of(free_index_.begin(), free_index_.end(), [](std::int32_t f) { return f < 0; })) {
     return Error{"soft::CorotationalFem::solve_static: a body with no fixed node has no equilibrium",
                  ErrorKind::kInvalid};
   }
   for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-    update_rotations();
-    forces_ = external_forces;
-    elastic_forces(forces_);
-    if (auto solved = solve_increment(0.0, 1.0, forces_); !solved) return solved.error();
+    contacts_.clear();
+    if (contacts) contacts(positions_, contacts_);
+    if (auto valid = check_contacts(contacts_); !valid) return valid.error();
+    assemble(0.0, 1.0, external_forces, contacts_);
+    if (auto solved = solve_system(); !solved) return solved.error();
     if (apply_increment(0.0) <= tolerance_m) return iteration;
   }
   return Error{"soft::CorotationalFem::solve_static: no equilibrium within " + std::to_string(max_iterations) +

@@ -84,6 +84,12 @@ TEST(CorotationalFem, RejectsBadMaterialNodesAndLoads) {
   EXPECT_FALSE(fem->step(0.0, no_load));
   EXPECT_FALSE(fem->hold(0, Eigen::Vector3d::Zero()));  // not a fixed node
   EXPECT_FALSE(fem->set_state({}, fem->velocities()));
+  auto held = CorotationalFem::create(*mesh, {}, {0});
+  ASSERT_TRUE(held);
+  const auto stray = [](const std::vector<Eigen::Vector3d>&, std::vector<NodeContact>& contacts) {
+    contacts.push_back({.node = 99});
+  };
+  EXPECT_FALSE(held->solve_static(no_load, stray));  // a contact on no node
 }
 
 }  // namespace

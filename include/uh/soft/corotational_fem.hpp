@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -24,6 +25,30 @@ struct ElasticMaterial {
   double stiffness_damping_s = 0.0; ///< beta [s], >= 0; damps deformation only
 };
 
+/// How a step's linear system is solved. The default iterates: conjugate gradients preconditioned by
+/// the factorisation of an earlier step's system, refactorised only when the iterations do not
+/// reach `relative_residual` within `max_iterations`. `direct` factorises every system and solves
+/// it exactly (to rounding): the reference the iterations are tested against, several times slower.
+struct SolverOptions {
+  double relative_residual = 1e-6;  ///< stop when |b - A dx| <= this * |b|, in (0, 1)
+  int max_iterations = 10;          ///< beyond this the system is factorised and solved directly, >= 1
+  bool direct = false;              ///< factorise and solve every system directly
+};
+
+/// A node pressed by a rigid obstacle, linearised at the node's current position: the `force` [N]
+/// on it, object frame, and its `stiffness` [N/m] = -d force / d position (symmetric, positive
+/// semidefinite), which only speeds up the iterations: the equilibrium is where the forces balance.
+struct NodeContact {
+  std::int32_t node = 0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d stiffness = Eigen::Matrix3d::Zero();
+};
+
+/// An obstacle's contacts at the node positions [m]: appends to `contacts` (given empty) an entry
+/// per pressed node; entries naming the same node add up (several obstacles may press one node).
+using ContactModel =
+    std::function<void(const std::vector<Eigen::Vector3d>& positions, std::vector<NodeContact>& contacts)>;
+
 /// The nodes of `mesh` inside the box [min, max] (bounds included) [m], object frame.
 std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3d& min, const Eigen::Vector3d& max);
 
@@ -31,17 +56,19 @@ std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3
 /// the polar decomposition of its deformation gradient, its forces are the linear ones in that
 /// rotated frame. Lumped mass from the density. Steps are implicit (backward Euler), linearised
 /// with the rotations of the step's start, and solved by conjugate gradients preconditioned with a
-/// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once), which is
-/// refactored only when the iterations do not converge quickly. Fixed nodes are eliminated: they
+/// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once, kept as a
+/// single-precision copy in 3 x 3 node blocks), which is refactored only when the iterations do
+/// not converge quickly (SolverOptions). Fixed nodes are eliminated: they
 /// stay at their held position (the rest position unless moved with `hold`).
 /// Not thread-safe: one simulation thread owns it. Not real-time: the assembly writes into fixed
 /// slots, but Eigen's products, solves and factorisations may allocate.
 class CorotationalFem {
  public:
   /// A model of `mesh` (positively oriented tetrahedra of nonzero volume) with `fixed` nodes held.
-  /// Fails (kInvalid) on a bad material or node index, (kMesh) on an empty or degenerate mesh.
+  /// Fails (kInvalid) on a bad material, solver option or node index, (kMesh) on an empty or
+  /// degenerate mesh.
   static Result<CorotationalFem> create(TetMesh mesh, const ElasticMaterial& material,
-                                        const std::vector<std::int32_t>& fixed);
+                                        const std::vector<std::int32_t>& fixed, const SolverOptions& solver = {});
 
   /// One backward-Euler step of `dt_s` [s] under `external_forces` [N] (one per node, object frame;
   /// those on fixed nodes are ignored). Fails when dt_s is not positive and finite, the forces are
@@ -54,6 +81,12 @@ class CorotationalFem {
   /// are set to zero. Returns the solves it took.
   Result<int> solve_static(const std::vector<Eigen::Vector3d>& external_forces, int max_iterations = 50,
                            double tolerance_m = 1e-12);
+
+  /// The same with an obstacle's position-dependent contact forces added to `external_forces`, each
+  /// solve linearised with the contacts of the last iterate (forces on fixed nodes are ignored).
+  /// Fails as solve_static does, and when a contact names no node or is not finite.
+  Result<int> solve_static(const std::vector<Eigen::Vector3d>& external_forces, const ContactModel& contacts,
+                           int max_iterations = 50, double tolerance_m = 1e-12);
 
   /// Sets every node's position [m] and velocity [m/s] (one finite vector per node each): an
   /// initial shape and motion. Fixed nodes stay held where `hold` put them (their rest position).
@@ -73,43 +106,58 @@ class CorotationalFem {
   int factorisations() const { return factorisations_; }
   /// Conjugate-gradient iterations of the last solve (0 when it was factorised and solved directly).
   int last_iterations() const { return iterations_; }
+  const SolverOptions& solver_options() const { return solver_options_; }
   /// Turns of the rotation extraction over all elements and steps so far.
   std::int64_t rotation_turns() const { return rotation_turns_; }
 
  private:
-  using Block = Eigen::Matrix3d;
   struct Element {
     std::array<std::int32_t, 4> nodes{};
-    Eigen::Matrix3d rest_inverse;     // inverse of the rest edge matrix [X1-X0, X2-X0, X3-X0]
-    std::array<Block, 16> stiffness;  // rest stiffness K_ab [N/m], a * 4 + b
+    std::array<Eigen::Vector3d, 4> gradients;  // of the linear shape functions at rest [1/m]
+    double volume = 0.0;                        // at rest [m^3]
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
     Eigen::Quaterniond quaternion = Eigen::Quaterniond::Identity();  // the same, warm start of the next
   };
 
   CorotationalFem() = default;
+  void order_free_nodes();
   void build_pattern();
-  void update_rotations();
-  void elastic_forces(std::vector<Eigen::Vector3d>& forces) const;
-  Status solve_increment(double mass_coefficient, double stiffness_coefficient,
-                         const std::vector<Eigen::Vector3d>& loads);
+  void update_rotation(Element& element, const Eigen::Matrix3d& deformation);
+  void assemble(double mass_coefficient, double stiffness_coefficient, const std::vector<Eigen::Vector3d>& loads,
+                const std::vector<NodeContact>& contacts);
+  void assemble_element(const Element& element, std::size_t index, const Eigen::Matrix3d& deformation,
+                        double stiffness_coefficient);
   Status solve_system();
+  Status factorise_and_solve();
   bool conjugate_gradients();
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  void keep_preconditioner();
+  void precondition(const Eigen::VectorXd& residual, Eigen::VectorXd& result);
   Status check_loads(const std::vector<Eigen::Vector3d>& external_forces) const;
+  Status check_contacts(const std::vector<NodeContact>& contacts) const;
   double apply_increment(double dt_s);
 
   TetMesh mesh_;
   ElasticMaterial material_;
+  SolverOptions solver_options_;
+  double lambda_ = 0.0;  // Lame's first parameter [Pa]
+  double mu_ = 0.0;      // shear modulus [Pa]
   std::vector<Element> elements_;
   std::vector<Eigen::Vector3d> positions_;
   std::vector<Eigen::Vector3d> velocities_;
+  std::vector<Eigen::Vector3d> previous_velocities_;  // of the step before the last, for the first guess
   std::vector<Eigen::Vector3d> held_;      // target positions of fixed nodes
   std::vector<double> masses_;
   std::vector<std::int32_t> free_index_;   // node -> its index among free nodes, -1 when fixed
-  Eigen::SparseMatrix<double> system_;     // over free DOFs, fixed pattern
-  std::vector<std::int32_t> block_slots_;  // per element block (a, b) and column c: value index of row 3 b'
+  Eigen::SparseMatrix<double> system_;     // over free DOFs, fixed pattern, lower triangle only
+  std::vector<std::int32_t> block_slots_;  // per element node pair (a, b) and column c: value index of row 0
   std::vector<std::int32_t> diagonal_slots_;
   // owned through a pointer: Eigen's solvers cannot be moved
-  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> solver_;
+  // free nodes are numbered in a fill-reducing order of the node graph, so the factor keeps each
+  // node's three rows together (3 x 3 blocks) and is factorised in that order as it stands
+  using Factorisation =
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>;
+  std::unique_ptr<Factorisation> solver_;
   bool factorised_ = false;
   int factorisations_ = 0;
   int iterations_ = 0;
@@ -117,7 +165,16 @@ class CorotationalFem {
   Eigen::VectorXd rhs_;
   Eigen::VectorXd increment_;
   Eigen::VectorXd residual_, preconditioned_, direction_, product_;  // scratch of the iterations
-  std::vector<Eigen::Vector3d> forces_;    // scratch: elastic + external loads
+  // the preconditioner: a single-precision copy of the factorisation L D L^T = A in 3 x 3 blocks
+  // (a fraction of the memory traffic of its solves, which dominate a step; the iterations stay
+  // in double precision): per node column J, the strict lower part of its diagonal block and the
+  // blocks below it, with their node rows
+  std::vector<std::int32_t> factor_starts_, factor_rows_;
+  std::vector<float> factor_blocks_;                  // 9 per block, column-major
+  std::vector<std::array<float, 3>> factor_diagonal_;  // L(1,0), L(2,0), L(2,1) of each diagonal block
+  Eigen::VectorXd diagonal_inverse_;
+  std::vector<Eigen::Vector3d> forces_;    // scratch: external loads and inertia
+  std::vector<NodeContact> contacts_;      // scratch: the obstacle's contacts of the last iterate
 };
 
 }  // namespace uh::soft
