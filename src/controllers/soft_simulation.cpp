@@ -35,6 +35,8 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
 }
 
 void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame) {
+  // another object's own frame says nothing of this one (a tool against everything says all)
+  if (frame.object_a != object && frame.object_a != ContactFrame::kEveryObject) return;
   std::span<const SpherePairContact> pairs;
   double share = 0.0;
   if (frame.object_a == object) {

@@ -53,7 +53,10 @@ class SoftSimulation {
   LatestValue<collette::SphereTree>& trees() { return trees_; }
 
   /// Collision thread: the pairs of `frame`'s that touch this object (object `object`, on side A
-  /// of a pair as the session watches it) become tool `tool`'s newest contacts. Real-time safe.
+  /// of a pair as the session watches it) become tool `tool`'s newest contacts; a frame of another
+  /// object's watcher is ignored. A tool-against-everything frame gives the object's share of the
+  /// tool's contact volume; a frame of this object alone gives it all of the tool's force.
+  /// Real-time safe.
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
