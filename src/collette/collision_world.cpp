@@ -43,6 +43,8 @@ Vec3 to_vec(const SphereTreeNode& n) {
 struct CollisionWorld::Object {
   ObjectId id = -1;
   std::shared_ptr<const SphereTree> tree;
+  LatestValue<SphereTree>* deformed_trees = nullptr;  // a soft body's, newest taken each step
+  const SphereTree* now = nullptr;  // the tree queried: `tree`, or the newest deformed one (collision thread)
   std::string name;
   double coverage = 1.0;
   bool is_static = false;
@@ -52,8 +54,8 @@ struct CollisionWorld::Object {
   bool has_pose = false;
   std::int32_t proxy = DynamicAabbTree::kNull;  // broad-phase proxy once posed
   // the root sphere in the world at `pose`
-  Vec3 centre_world() const { return transform_point(pose, to_vec(tree->root())); }
-  double radius() const { return static_cast<double>(tree->root().radius); }
+  Vec3 centre_world() const { return transform_point(pose, to_vec(now->root())); }
+  double radius() const { return static_cast<double>(now->root().radius); }
 };
 
 struct CollisionWorld::Watcher {
@@ -223,9 +225,13 @@ Result<ObjectId> CollisionWorld::add_object(CollisionObjectDef def) {
     return Error{fmt::format(
         "CollisionWorld::add_object: object '{}' does not fit: the world holds at most {} objects", def.name,
         options_.max_objects)};
+  if (def.deformed_trees != nullptr && def.is_static)
+    return Error{fmt::format("CollisionWorld::add_object: object '{}' deforms: it cannot be static", def.name)};
   auto object = std::make_unique<Object>();
   object->id = id;
   object->tree = std::move(def.tree);
+  object->now = object->tree.get();
+  object->deformed_trees = def.deformed_trees;
   object->name = std::move(def.name);
   object->coverage = def.coverage;
   object->is_static = def.is_static;
@@ -398,7 +404,7 @@ void CollisionWorld::query_pair(Watcher& watcher, ContactFrame& frame) {
   if (root_gap < options_.contact_margin) {
     const auto query_start = std::chrono::steady_clock::now();
     VolumeQuery& query = watcher.coherent_query ? *watcher.coherent_query : volume_query_;
-    query.run(*a.tree, *b.tree, a.pose, b.pose, frame);
+    query.run(*a.now, *b.now, a.pose, b.pose, frame);
     if (query.result().reused_candidates) coherent_queries_.increment();
     query_time_.record(elapsed_ns(query_start));
     queries_.increment();
@@ -416,7 +422,7 @@ void CollisionWorld::query_pair(Watcher& watcher, ContactFrame& frame) {
   }
   if (!(frame.total_volume > 0.0) && options_.compute_distance) {
     // the root gap is only a lower bound; the distance query gives the packing's separation
-    frame.distance = distance_query_.run(*a.tree, *b.tree, inverse(a.pose) * b.pose).distance;
+    frame.distance = distance_query_.run(*a.now, *b.now, inverse(a.pose) * b.pose).distance;
   } else if (frame.total_volume > 0.0) {
     frame.distance = 0.0;
   }
@@ -453,7 +459,7 @@ void CollisionWorld::query_tool(Watcher& watcher, ContactFrame& frame) {
     const double root_gap = norm(tool_centre - o->centre_world()) - o->radius() - tool.radius();
     if (!(root_gap < margin)) continue;
     const auto query_start = std::chrono::steady_clock::now();
-    const ContactSection& s = volume_query_.append_section(*o->tree, *tool.tree, o->pose, tool.pose, frame);
+    const ContactSection& s = volume_query_.append_section(*o->now, *tool.now, o->pose, tool.pose, frame);
     query_time_.record(elapsed_ns(query_start));
     queries_.increment();
     const VolumeQueryResult& r = volume_query_.result();
@@ -485,11 +491,17 @@ void CollisionWorld::run_step(double time_s) {
   const auto step_start = std::chrono::steady_clock::now();
   apply_pending();
   for (Object* object : moving_) {
+    bool moved = false;
     if (object->pose_in.update()) {
       object->pose = object->pose_in.read_buffer();
       object->has_pose = true;
-      update_broad_phase(*object);
+      moved = true;
     }
+    if (object->deformed_trees != nullptr && object->deformed_trees->update()) {
+      object->now = &object->deformed_trees->read_buffer();
+      moved = true;
+    }
+    if (moved && object->has_pose) update_broad_phase(*object);
   }
 
   std::int64_t pairs_this_step = 0;

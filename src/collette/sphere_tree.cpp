@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -199,6 +200,71 @@ Status validate(const SphereTree& tree) {
   if (max_depth != tree.depth())
     return Error{"sphere tree: stored depth " + std::to_string(tree.depth()) + " but the longest path has " + std::to_string(max_depth) + " levels"};
   return check_enclosure(nodes);
+}
+
+bool SphereTree::refittable() const {
+  for (std::size_t i = 0; i < nodes_.size(); ++i)
+    if (!nodes_[i].is_leaf() && nodes_[i].first <= static_cast<std::int32_t>(i)) return false;
+  return !nodes_.empty();
+}
+
+void SphereTree::refit(std::span<const Sphere> leaves) {
+  const std::size_t n = std::min(leaves.size(), leaves_.size());
+  std::copy_n(leaves.begin(), n, leaves_.begin());
+  // children after parents: a reverse sweep sees every child refitted before its parent
+  for (std::size_t i = nodes_.size(); i-- > 0;) {
+    SphereTreeNode& node = nodes_[i];
+    if (node.is_leaf()) {
+      const Sphere& s = leaves_[static_cast<std::size_t>(node.first)];
+      node.x = s.x;
+      node.y = s.y;
+      node.z = s.z;
+      node.radius = s.radius;
+      node.volume = static_cast<float>(sphere_volume(static_cast<double>(s.radius)));
+      continue;
+    }
+    const auto children = std::span<const SphereTreeNode>(nodes_).subspan(static_cast<std::size_t>(node.first),
+                                                                           static_cast<std::size_t>(node.count));
+    double volume = 0.0, cx = 0.0, cy = 0.0, cz = 0.0;
+    for (const SphereTreeNode& c : children) {
+      const auto v = static_cast<double>(c.volume);
+      volume += v;
+      cx += v * static_cast<double>(c.x);
+      cy += v * static_cast<double>(c.y);
+      cz += v * static_cast<double>(c.z);
+    }
+    // the centre as stored (float), and the radius measured from it, rounded up: the node
+    // encloses each child exactly as the queries read them
+    node.x = static_cast<float>(cx / volume);
+    node.y = static_cast<float>(cy / volume);
+    node.z = static_cast<float>(cz / volume);
+    double radius = 0.0;
+    for (const SphereTreeNode& c : children) {
+      const double dx = static_cast<double>(c.x) - static_cast<double>(node.x);
+      const double dy = static_cast<double>(c.y) - static_cast<double>(node.y);
+      const double dz = static_cast<double>(c.z) - static_cast<double>(node.z);
+      radius = std::max(radius, std::sqrt(dx * dx + dy * dy + dz * dz) + static_cast<double>(c.radius));
+    }
+    node.radius = std::nextafter(static_cast<float>(radius), std::numeric_limits<float>::infinity());
+    node.volume = static_cast<float>(volume);
+  }
+  const auto w = static_cast<std::size_t>(block_width_);
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    const SphereTreeNode& node = nodes_[i];
+    const double ball = sphere_volume(static_cast<double>(node.radius));
+    density_[i] = node.is_leaf() || !(ball > 0.0) ? 1.f : static_cast<float>(std::min(1.0, static_cast<double>(node.volume) / ball));
+    if (node.is_leaf()) continue;
+    float* b = block_bounds_.data() + k * 4 * w;
+    for (std::size_t j = 0; j < static_cast<std::size_t>(node.count); ++j) {
+      const SphereTreeNode& child = nodes_[static_cast<std::size_t>(node.first) + j];
+      b[j] = child.x;
+      b[w + j] = child.y;
+      b[2 * w + j] = child.z;
+      b[3 * w + j] = child.radius;
+    }
+    ++k;
+  }
 }
 
 }  // namespace uh::collette

@@ -103,6 +103,9 @@ struct HapticSession::ToolRig {
     s.haptic_rate_hz = haptic_rate_hz.load(std::memory_order_relaxed);
     s.collision_rate_hz = session->collision_rate_hz_.load(std::memory_order_relaxed);
     s.buttons = sample.state.buttons;
+    // what the tool felt goes back to the soft objects it presses (their own triple buffers)
+    for (const auto& soft : session->soft_)
+      if (soft) soft->post_tool_force(static_cast<std::size_t>(index), s.force_world);
     tick_event.broadcast(s);
     state_out.publish();
   }
@@ -164,10 +167,18 @@ Status HapticSession::add_objects(const SessionRunOptions& options) {
       .coherence_skin = scene.coherence_skin});
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& object = scene.objects[i];
+    auto& soft = soft_.emplace_back();
+    if (model_->objects[i].soft) {
+      auto made = SoftSimulation::create(model_->objects[i].soft, model_->objects[i].tree, object.pose,
+                                         scene.tools.size());
+      if (!made) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, made.error().message)};
+      soft = std::move(*made);
+    }
     auto id = world_->add_object({.tree = model_->objects[i].tree,
                                   .world_from_object = object.pose,
                                   .coverage = model_->objects[i].coverage,
-                                  .name = object.name});
+                                  .name = object.name,
+                                  .deformed_trees = soft ? &soft->trees() : nullptr});
     if (!id) return id.error();
     object_ids_.push_back(*id);
   }
@@ -284,7 +295,8 @@ Status HapticSession::wire_controllers(ToolRig& rig) {
                                         .stiffness_n_m = proxy_spring_n_m(tool.force, material, *model_->tools[t].tree),
                                         .object_texture = material.object_texture,
                                         .tool_texture = material.tool_texture,
-                                        .surface = model_->objects[i].surface});
+                                        // a soft object's rest surface is not where it is: its spheres are
+                                        .surface = soft_[i] ? nullptr : model_->objects[i].surface});
   }
   if (rig.proxy) rig.proxy->bind();
   rig.bridging_controller = std::make_unique<BridgingController>(*world_, rig.tool_id, tool.workspace,
@@ -336,7 +348,10 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
   ToolRig* rig = nullptr;
   for (auto& r : rigs_)
     if (r->tool_id == b) rig = r.get();
-  if (rig == nullptr || rig->proxy) return;  // a proxy's contacts are its constraints' (on_step)
+  if (rig == nullptr) return;
+  for (std::size_t i = 0; i < soft_.size(); ++i)
+    if (soft_[i]) soft_[i]->post_contacts(static_cast<std::size_t>(rig->index), object_ids_[i], frame);
+  if (rig->proxy) return;  // a proxy's contacts are its constraints' (on_step)
   auto& touching = rig->touching;
   if (a != ContactFrame::kEveryObject) {
     if (a < 0 || static_cast<std::size_t>(a) >= touching.size()) return;
@@ -481,10 +496,19 @@ Status HapticSession::start(std::ostream* trace) {
   started_s_ = steady_seconds();
   t0_s_ = started_s_;
   if (auto started = world_->start(); !started) return started;
+  for (std::size_t i = 0; i < soft_.size(); ++i) {
+    if (!soft_[i]) continue;
+    if (auto started = soft_[i]->start(kSoftRateHz); !started) {
+      stop_soft();
+      world_->stop();
+      return started;
+    }
+  }
   for (std::size_t t = 0; t < rigs_.size(); ++t) {
     if (auto started = rigs_[t]->manager->start(); !started) {
       // the loops already running end with zero
       for (std::size_t u = 0; u < t; ++u) rigs_[u]->manager->stop();
+      stop_soft();
       world_->stop();
       if (rigs_.size() == 1) return started;
       return Error{fmt::format("{}: {}.device: {}", model_->scene.source, rigs_[t]->path, started.error().message),
@@ -545,6 +569,7 @@ Status HapticSession::stop() {
   monitor_thread_.join();
   collect_report(seconds, false);  // before the loops stop: their statistics describe the run itself
   for (auto& rig : rigs_) rig->manager->stop();
+  stop_soft();
   world_->stop();
   // the haptic threads are joined and the devices got zero: this thread becomes the states' writer
   for (std::size_t t = 0; t < rigs_.size(); ++t) {
@@ -567,7 +592,23 @@ Status HapticSession::stop() {
     stopped_ = Error{"the collision thread ended before the session was stopped", ErrorKind::kThread};
   else if (trace_ != nullptr && !*trace_)
     stopped_ = Error{"the trace could not be written", ErrorKind::kFile};
+  else if (Status soft = soft_error(); !soft)
+    stopped_ = soft;
   return stopped_;
+}
+
+void HapticSession::stop_soft() {
+  for (auto& soft : soft_)
+    if (soft) soft->stop();
+}
+
+Status HapticSession::soft_error() const {
+  for (std::size_t i = 0; i < soft_.size(); ++i)
+    if (soft_[i] && !soft_[i]->failure())
+      return Error{fmt::format("object '{}': the simulation stopped: {}", model_->scene.objects[i].name,
+                               soft_[i]->failure().error().message),
+                   ErrorKind::kThread};
+  return Ok{};
 }
 
 Status HapticSession::run(double seconds, const std::function<void(const SessionState&)>& on_status,
@@ -618,9 +659,16 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
     for (std::size_t t = 0; t < rigs_.size(); ++t) take_trace(*rigs_[t], buffer, t == 0 ? trace : nullptr);
   };
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
+  // the soft objects step in simulated time too, at their own rate
+  const std::int64_t ticks_per_soft_step = std::max<std::int64_t>(1, std::llround(haptic_hz_ / kSoftRateHz));
+  const double soft_dt_s = static_cast<double>(ticks_per_soft_step) / haptic_hz_;
+  Status soft_stepped = Ok{};
   std::int64_t k = 0;
-  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed) && !any_fault(); ++k) {
+  for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed) && !any_fault() && soft_stepped; ++k) {
     const double t = static_cast<double>(k) / haptic_hz_;
+    if (k % ticks_per_soft_step == 0)
+      for (auto& soft : soft_)
+        if (soft && soft_stepped) soft_stepped = soft->step(soft_dt_s);
     // the collision step sees the tool poses of the previous tick, as the threaded world would
     if (k % ticks_per_collision_step == 0) world_->step(t);
     for (auto& rig : rigs_) rig->manager->step(t);
@@ -634,6 +682,7 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   publish_report();
   report_.stopped_early = k < ticks;
   phase_ = Phase::kStopped;
+  if (!soft_stepped) return soft_stepped;
   return device_error();
 }
 

@@ -34,6 +34,41 @@ Error named(const Scene& scene, const std::string& part, const Error& error) {
   return Error{fmt::format("{}: {}: {}", scene.source, part, error.message), error.kind};
 }
 
+soft::SoftBodyParams soft_params(const scene::SceneDeformable& d) {
+  soft::SoftBodyParams params;
+  params.material = {.young_modulus_pa = d.young_modulus_pa,
+                     .poisson_ratio = d.poisson_ratio,
+                     .density_kg_m3 = d.density_kg_m3,
+                     .mass_damping_per_s = 0.0,
+                     .stiffness_damping_s = d.damping};
+  params.target_tetrahedra = static_cast<int>(d.tetrahedra);
+  if (d.fixed_box) {
+    const auto eigen = [](const Vec3& v) { return Eigen::Vector3d(v.x, v.y, v.z); };
+    params.fixed = soft::Box{.min = eigen(d.fixed_box->min), .max = eigen(d.fixed_box->max)};
+  }
+  return params;
+}
+
+// a deformable object's lattice around its packing, inside its mesh surface (loaded here when
+// the model keeps no surface)
+Result<std::shared_ptr<const soft::SoftBodyModel>> compile_soft_body(const SceneObject& object, const ShapeTree& tree,
+                                                                     std::shared_ptr<const collette::MeshInside> surface,
+                                                                     const CompileOptions& options) {
+  if (!object.deformable) return std::shared_ptr<const soft::SoftBodyModel>{};
+  if (!surface) {
+    auto loaded = load_shape_surface(object.shape);
+    if (!loaded) return loaded.error();
+    surface = *loaded;
+  }
+  const std::string stage = fmt::format("meshing the volume of '{}'", object.name);
+  if (options.progress) options.progress(stage, 0.0);
+  const auto inside = [&](const Eigen::Vector3d& p) { return surface->contains({p.x(), p.y(), p.z()}); };
+  auto body = soft::build_soft_body(inside, tree.tree->leaves(), soft_params(*object.deformable));
+  if (!body) return body.error();
+  if (options.progress) options.progress(stage, 1.0);
+  return std::make_shared<const soft::SoftBodyModel>(std::move(*body));
+}
+
 Status compile_objects(collette::IstCache& cache, const CompileOptions& options, SessionModel& model) {
   const Scene& scene = model.scene;
   SurfaceLoader surfaces(options.surfaces, options.surface_beside_given_tree);
@@ -43,7 +78,9 @@ Status compile_objects(collette::IstCache& cache, const CompileOptions& options,
     if (!tree) return named(scene, part, tree.error());
     auto surface = surfaces.load(object.shape);
     if (!surface) return named(scene, part, surface.error());
-    model.objects.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = *surface});
+    auto body = compile_soft_body(object, *tree, *surface, options);
+    if (!body) return named(scene, part, body.error());
+    model.objects.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = *surface, .soft = *body});
     object.shape.tree = tree->tree;
     object.shape.coverage = tree->coverage;
   }
@@ -56,7 +93,7 @@ Status compile_tools(collette::IstCache& cache, const CompileOptions& options, S
     auto tree = tree_of(tool.shape, cache, options.progress);
     if (!tree) return named(scene, fmt::format("tool '{}'", tool.name), tree.error());
     // a tool's surface is not used: the proxy rests the tool's spheres on the objects' surfaces
-    model.tools.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = nullptr});
+    model.tools.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = nullptr, .soft = nullptr});
     tool.shape.tree = tree->tree;
     tool.shape.coverage = tree->coverage;
     auto& row = model.materials.emplace_back();

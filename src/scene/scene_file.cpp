@@ -164,6 +164,37 @@ Status read_shape(const FieldReader& r, const json& j, const std::string& path, 
   return r.number(j, path, "max_sphere_radius", shape.max_sphere_radius);
 }
 
+// `objects[i].deformable` (the ranges are validate()'s)
+Status read_deformable(const FieldReader& r, const json& j, const std::string& path, SceneDeformable& d) {
+  UH_CHECK(r.require_object(j, path));
+  UH_CHECK(r.check_keys(j, path,
+                        {"young_modulus_pa", "poisson_ratio", "density_kg_m3", "damping", "tetrahedra", "fixed"}));
+  UH_CHECK(r.number(j, path, "young_modulus_pa", d.young_modulus_pa));
+  UH_CHECK(r.number(j, path, "poisson_ratio", d.poisson_ratio));
+  UH_CHECK(r.number(j, path, "density_kg_m3", d.density_kg_m3));
+  UH_CHECK(r.number(j, path, "damping", d.damping));
+  UH_CHECK(r.integer(j, path, "tetrahedra", d.tetrahedra));
+  const auto fixed = j.find("fixed");
+  if (fixed == j.end()) return Ok{};
+  const std::string p = FieldReader::join(path, "fixed");
+  UH_CHECK(r.require_object(*fixed, p));
+  UH_CHECK(r.check_keys(*fixed, p, {"box"}));
+  const auto box = fixed->find("box");
+  if (box == fixed->end()) return r.error(p, "missing 'box' (expected [[x0, y0, z0], [x1, y1, z1]])");
+  const std::string b = FieldReader::join(p, "box");
+  if (!box->is_array() || box->size() != 2)
+    return r.error(b, fmt::format("expected [[x0, y0, z0], [x1, y1, z1]], got {}", box->dump()));
+  SceneDeformable::Box out;
+  Vec3* corners[2] = {&out.min, &out.max};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json corner{{"corner", (*box)[i]}};
+    if (auto s = r.vec3(corner, "", "corner", *corners[i]); !s)
+      return r.error(fmt::format("{}[{}]", b, i), fmt::format("expected [x, y, z] of finite numbers, got {}", (*box)[i].dump()));
+  }
+  d.fixed_box = out;
+  return Ok{};
+}
+
 // Device settings are text in haptico::DeviceConfig; JSON numbers and [x, y, z] arrays are converted.
 Status read_device_config(const FieldReader& r, const json& config, const std::string& path,
                           const std::filesystem::path& base_dir, haptico::DeviceConfig& out) {
@@ -520,12 +551,15 @@ Result<Scene> parse_scene(std::string_view json_text, const std::string& source,
     UH_CHECK(r.require_object(o, path));
     UH_CHECK(r.check_keys(
         o, path,
-        {"name", "mesh", "ist", "spheres", "max_sphere_radius", "meters_per_unit", "pose", "material"}));
+        {"name", "mesh", "ist", "spheres", "max_sphere_radius", "meters_per_unit", "pose", "material",
+         "deformable"}));
     SceneObject object;
     UH_CHECK(r.string(o, path, "name", object.name, true));
     UH_CHECK(read_shape(r, o, path, base_dir, object.shape));
     UH_CHECK(r.pose(o, path, "pose", object.pose));
     UH_CHECK(read_material(r, o, path, materials, object.material));
+    if (const auto it = o.find("deformable"); it != o.end())
+      UH_CHECK(read_deformable(r, *it, FieldReader::join(path, "deformable"), object.deformable.emplace()));
     scene.objects.push_back(std::move(object));
   }
 

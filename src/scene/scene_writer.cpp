@@ -51,6 +51,16 @@ json material_json(const forcecomp::Material& m) {
   return j;
 }
 
+json deformable_json(const SceneDeformable& d) {
+  json j{{"young_modulus_pa", d.young_modulus_pa},
+         {"poisson_ratio", d.poisson_ratio},
+         {"density_kg_m3", d.density_kg_m3},
+         {"damping", d.damping}};
+  if (d.tetrahedra != 0) j["tetrahedra"] = d.tetrahedra;  // left out: chosen from the object's size
+  if (d.fixed_box) j["fixed"] = {{"box", json::array({array_of(d.fixed_box->min), array_of(d.fixed_box->max)})}};
+  return j;
+}
+
 // device settings are text: what the config reads as [x, y, z] or a number goes back as one
 json config_value(const haptico::DeviceConfig& config, const std::string& key, const std::string& text) {
   if (const auto v = config.vec3(key, {}); v) return array_of(*v);
@@ -142,6 +152,7 @@ Result<std::string> write_scene(const Scene& scene) {
     (*j)["name"] = object.name;
     (*j)["pose"] = {{"position", array_of(object.pose.position)}, {"rotation", array_of(object.pose.rotation)}};
     if (const json m = material_json(object.material); !m.empty()) (*j)["material"] = m;
+    if (object.deformable) (*j)["deformable"] = deformable_json(*object.deformable);
     objects.push_back(std::move(*j));
   }
   root["objects"] = std::move(objects);

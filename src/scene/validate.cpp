@@ -224,9 +224,36 @@ Status validate_material(const forcecomp::Material& m, const std::string& path) 
   return validate_texture(m.texture, join(path, "texture"));
 }
 
+namespace {
+
+Status validate_deformable(const SceneObject& object, const std::string& path) {
+  const SceneDeformable& d = *object.deformable;
+  // the volume is meshed around the mesh's inside: a .ist alone has no surface to mesh
+  if (object.shape.mesh.empty())
+    return invalid(path, "a deformable object needs a 'mesh' (its volume is meshed from the mesh's inside)");
+  UH_VALIDATE(in_range(join(path, "young_modulus_pa"), d.young_modulus_pa, 10.0, 1e10));
+  UH_VALIDATE(in_range(join(path, "poisson_ratio"), d.poisson_ratio, 0.0, 0.49));
+  UH_VALIDATE(in_range(join(path, "density_kg_m3"), d.density_kg_m3, 1.0, 1e5));
+  UH_VALIDATE(in_range(join(path, "damping"), d.damping, 0.0, 1.0));
+  // 0 (or the field left out): chosen from the object's size
+  if (d.tetrahedra != 0) UH_VALIDATE(whole_in_range(join(path, "tetrahedra"), d.tetrahedra, 6, 200'000));
+  if (!d.fixed_box) return Ok{};
+  const std::string box = join(path, "fixed.box");
+  UH_VALIDATE(finite(box + "[0]", d.fixed_box->min));
+  UH_VALIDATE(finite(box + "[1]", d.fixed_box->max));
+  const Vec3& a = d.fixed_box->min;
+  const Vec3& b = d.fixed_box->max;
+  if (a.x > b.x || a.y > b.y || a.z > b.z)
+    return invalid(box, "expected [[x0, y0, z0], [x1, y1, z1]] with x0 <= x1, y0 <= y1 and z0 <= z1");
+  return Ok{};
+}
+
+}  // namespace
+
 Status validate_object(const SceneObject& object, const std::string& path) {
   UH_VALIDATE(validate_shape(object.shape, path));
   UH_VALIDATE(pose(join(path, "pose"), object.pose));
+  if (object.deformable) UH_VALIDATE(validate_deformable(object, join(path, "deformable")));
   return validate_material(object.material, join(path, "material"));
 }
 

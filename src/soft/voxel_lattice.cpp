@@ -37,25 +37,41 @@ Grid make_grid(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double ed
   return Grid{min, extent.cwiseQuotient(cells.cast<double>()), cells};
 }
 
+// the cells holding a cover point, one flag per cell (x fastest)
+std::vector<char> covered_cells(const Grid& grid, const std::vector<Eigen::Vector3d>& cover) {
+  const auto count = static_cast<std::size_t>(grid.cells.prod());
+  std::vector<char> covered(cover.empty() ? 0 : count, 0);
+  for (const Eigen::Vector3d& p : cover) {
+    const Eigen::Vector3d at = (p - grid.min).cwiseQuotient(grid.cell_size);
+    if (!at.allFinite() || (at.array() < 0.0).any() || (at.array() > grid.cells.cast<double>().array()).any()) continue;
+    const Eigen::Vector3i cell = at.cast<int>().cwiseMin(grid.cells - Eigen::Vector3i::Ones());
+    covered[static_cast<std::size_t>(cell.x() + grid.cells.x() * (cell.y() + grid.cells.y() * cell.z()))] = 1;
+  }
+  return covered;
+}
+
 template <typename Visit>
-void for_each_kept_cell(const Grid& grid, const InsidePredicate& inside, Visit&& visit) {
+void for_each_kept_cell(const Grid& grid, const InsidePredicate& inside, const std::vector<Eigen::Vector3d>& cover,
+                        Visit&& visit) {
+  const std::vector<char> covered = covered_cells(grid, cover);
+  std::size_t index = 0;
   for (int z = 0; z < grid.cells.z(); ++z) {
     for (int y = 0; y < grid.cells.y(); ++y) {
-      for (int x = 0; x < grid.cells.x(); ++x) {
+      for (int x = 0; x < grid.cells.x(); ++x, ++index) {
         const Eigen::Vector3i cell(x, y, z);
-        if (inside(grid.corner(cell) + 0.5 * grid.cell_size)) visit(cell);
+        if ((!covered.empty() && covered[index]) || inside(grid.corner(cell) + 0.5 * grid.cell_size)) visit(cell);
       }
     }
   }
 }
 
-std::size_t count_kept_cells(const Grid& grid, const InsidePredicate& inside) {
+std::size_t count_kept_cells(const Grid& grid, const InsidePredicate& inside, const std::vector<Eigen::Vector3d>& cover) {
   std::size_t kept = 0;
-  for_each_kept_cell(grid, inside, [&](const Eigen::Vector3i&) { ++kept; });
+  for_each_kept_cell(grid, inside, cover, [&](const Eigen::Vector3i&) { ++kept; });
   return kept;
 }
 
-TetMesh mesh_grid(const Grid& grid, const InsidePredicate& inside) {
+TetMesh mesh_grid(const Grid& grid, const InsidePredicate& inside, const std::vector<Eigen::Vector3d>& cover = {}) {
   TetMesh mesh;
   const std::size_t slots = grid.node_slot(grid.cells) + 1;
   std::vector<std::int32_t> node_of_slot(slots, -1);
@@ -67,7 +83,7 @@ TetMesh mesh_grid(const Grid& grid, const InsidePredicate& inside) {
     }
     return id;
   };
-  for_each_kept_cell(grid, inside, [&](const Eigen::Vector3i& cell) {
+  for_each_kept_cell(grid, inside, cover, [&](const Eigen::Vector3i& cell) {
     for (const auto& order : kAxisOrders) {
       std::array<std::int32_t, 4> tet{};
       Eigen::Vector3i corner = cell;
@@ -109,13 +125,13 @@ Result<TetMesh> build_voxel_lattice(const InsidePredicate& inside, const Lattice
   double edge = std::cbrt(extent.prod() / target_cells);
   Grid grid = make_grid(options.min, options.max, edge);
   for (int pass = 0; pass < 4; ++pass) {
-    const auto kept = static_cast<double>(count_kept_cells(grid, inside));
+    const auto kept = static_cast<double>(count_kept_cells(grid, inside, options.cover));
     if (kept == 0.0) break;
     if (std::abs(kept / target_cells - 1.0) < 0.1) break;
     edge *= std::cbrt(kept / target_cells);
     grid = make_grid(options.min, options.max, edge);
   }
-  TetMesh mesh = mesh_grid(grid, inside);
+  TetMesh mesh = mesh_grid(grid, inside, options.cover);
   if (mesh.tets.empty()) {
     return Error{"soft::build_voxel_lattice: no lattice cell centre is inside the object (is the region its bounds?)",
                  ErrorKind::kMesh};

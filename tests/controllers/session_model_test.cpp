@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "scene_test_support.hpp"
 #include "uh/collette/sphere_tree_builder.hpp"
@@ -130,6 +133,48 @@ TEST(SessionModel, CompileRefusesAnInvalidSceneNamingTheField) {
   ASSERT_FALSE(model.has_value());
   EXPECT_EQ(model.error().message,
             "small.json: field 'objects[0].spheres': expected a whole number in [1, 2000000], got 0");
+}
+
+// a 7 x 7 x 2 cm block (top face at z = 0), soft, its base held
+Scene soft_block_scene(const std::string& fixed_box) {
+  auto json = nlohmann::json::parse(small_scene_json());
+  json["objects"][0] = nlohmann::json::parse(R"({"name": "block", "mesh": "meshes/block.obj", "meters_per_unit": 0.01,
+      "spheres": 600, "deformable": {"young_modulus_pa": 3e4, "poisson_ratio": 0.4}})");
+  if (!fixed_box.empty()) json["objects"][0]["deformable"]["fixed"] = nlohmann::json::parse(fixed_box);
+  json["watch"] = {"block"};
+  auto scene = parse_scene(json.dump(), "soft.json", test_assets());
+  EXPECT_TRUE(scene.has_value()) << scene.error().message;
+  return *scene;
+}
+
+TEST(SessionModel, ADeformableObjectCarriesItsLatticeAndEmbeddedPacking) {
+  collette::IstCache cache(testing::fresh_cache("model-soft"));
+  std::vector<std::string> stages;
+  CompileOptions options;
+  options.surfaces = false;  // the lattice loads the surface it needs itself
+  options.progress = [&](const std::string& what, double) { stages.push_back(what); };
+  auto model = compile(soft_block_scene(R"({"box": [[-1, -1, -1], [1, 1, -0.0195]]})"), cache, options);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  const CompiledShape& block = (*model)->objects[0];
+  ASSERT_NE(block.soft, nullptr);
+  EXPECT_EQ((*model)->tools[0].soft, nullptr);
+  const soft::SoftBodyModel& body = *block.soft;
+  // the default size: cells of a tenth of 7 cm over the 7 x 7 x 2 cm packing
+  const auto tets = static_cast<int>(body.mesh.tets.size());
+  EXPECT_GE(tets, 384);
+  EXPECT_LE(tets, 3000 * 11 / 10);
+  EXPECT_EQ(body.spheres.size(), block.tree->leaves().size());
+  ASSERT_FALSE(body.fixed.empty());
+  for (std::int32_t n : body.fixed) EXPECT_LE(body.mesh.nodes[static_cast<std::size_t>(n)].z(), -0.0195);
+  EXPECT_EQ(body.material.young_modulus_pa, 3e4);
+  EXPECT_NE(std::find(stages.begin(), stages.end(), "meshing the volume of 'block'"), stages.end());
+
+  // a box above the block holds nothing: refused, naming the object
+  auto refused = compile(soft_block_scene(R"({"box": [[-1, -1, 0.01], [1, 1, 0.02]]})"), cache);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().message.find("object 'block': soft::build_soft_body: the fixed box holds no node"),
+            std::string::npos)
+      << refused.error().message;
 }
 
 }  // namespace

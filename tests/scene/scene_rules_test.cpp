@@ -25,6 +25,12 @@ using testing::kFieldRanges;
 
 using Setter = std::function<void(Scene&, double)>;
 
+// the first object's deformable part, made soft (defaults) when it was rigid
+SceneDeformable& deformable(Scene& s) {
+  if (!s.objects[0].deformable) s.objects[0].deformable.emplace();
+  return *s.objects[0].deformable;
+}
+
 // How each field of the table is set on a scene in memory.
 const std::map<std::string, Setter>& setters() {
   static const std::map<std::string, Setter> table{
@@ -46,6 +52,13 @@ const std::map<std::string, Setter>& setters() {
          s.objects[0].material.has_damping = true;
          s.objects[0].material.damping = v;
        }},
+      {"objects[0].deformable.young_modulus_pa",
+       [](Scene& s, double v) { deformable(s).young_modulus_pa = v; }},
+      {"objects[0].deformable.poisson_ratio", [](Scene& s, double v) { deformable(s).poisson_ratio = v; }},
+      {"objects[0].deformable.density_kg_m3", [](Scene& s, double v) { deformable(s).density_kg_m3 = v; }},
+      {"objects[0].deformable.damping", [](Scene& s, double v) { deformable(s).damping = v; }},
+      {"objects[0].deformable.tetrahedra",
+       [](Scene& s, double v) { deformable(s).tetrahedra = static_cast<std::int64_t>(v); }},
       {"tool.spheres", [](Scene& s, double v) { s.tool().shape.spheres = static_cast<std::int64_t>(v); }},
       {"tool.meters_per_unit", [](Scene& s, double v) { s.tool().shape.meters_per_unit = v; }},
       {"tool.force.stiffness", [](Scene& s, double v) { s.tool().force.stiffness = v; }},
@@ -195,6 +208,46 @@ TEST(SceneRules, RulesBetweenFieldsNameTheField) {
   valid = validate(scene);
   ASSERT_FALSE(valid);
   EXPECT_EQ(valid.error().message.rfind("field 'objects[0].mesh': file not found: ", 0), 0u) << valid.error().message;
+}
+
+TEST(SceneRules, ADeformableObjectsBoxAndShapeAreChecked) {
+  Scene scene = good_scene();
+  deformable(scene).fixed_box = SceneDeformable::Box{.min = {0.0, 0.0, 0.01}, .max = {0.1, 0.1, 0.0}};
+  Status valid = validate(scene);
+  ASSERT_FALSE(valid);
+  EXPECT_EQ(valid.error().message.rfind("field 'objects[0].deformable.fixed.box': expected [[x0, y0, z0], [x1, y1, z1]] "
+                                        "with x0 <= x1",
+                                        0),
+            0u)
+      << valid.error().message;
+
+  scene = good_scene();
+  deformable(scene);
+  scene.objects[0].shape.ist = scene.objects[0].shape.mesh;  // a regular file: only its kind matters here
+  scene.objects[0].shape.mesh.clear();
+  valid = validate(scene);
+  ASSERT_FALSE(valid);
+  EXPECT_NE(valid.error().message.find("field 'objects[0].deformable': a deformable object needs a 'mesh'"),
+            std::string::npos)
+      << valid.error().message;
+
+  // the file: a box of one corner, a corner of two numbers, an unknown field
+  nlohmann::json j = nlohmann::json::parse(small_scene_json());
+  j["objects"][0]["deformable"] = {{"fixed", {{"box", {{0, 0, 0}}}}}};
+  auto parsed = parse_scene(j.dump(), "soft.json", test_assets());
+  ASSERT_FALSE(parsed.has_value());
+  EXPECT_EQ(parsed.error().message.rfind("soft.json: field 'objects[0].deformable.fixed.box': expected [[x0", 0), 0u)
+      << parsed.error().message;
+  j["objects"][0]["deformable"] = {{"fixed", {{"box", {{0, 0, 0}, {1, 1}}}}}};
+  parsed = parse_scene(j.dump(), "soft.json", test_assets());
+  ASSERT_FALSE(parsed.has_value());
+  EXPECT_EQ(parsed.error().message.rfind("soft.json: field 'objects[0].deformable.fixed.box[1]': expected [x, y, z]", 0), 0u)
+      << parsed.error().message;
+  j["objects"][0]["deformable"] = {{"youngs_modulus", 1e5}};
+  parsed = parse_scene(j.dump(), "soft.json", test_assets());
+  ASSERT_FALSE(parsed.has_value());
+  EXPECT_EQ(parsed.error().message.rfind("soft.json: field 'objects[0].deformable.youngs_modulus': unknown field", 0), 0u)
+      << parsed.error().message;
 }
 
 TEST(SceneRules, TheCommittedScenesAreValid) {

@@ -105,6 +105,44 @@ TEST(SceneWriter, EveryCommittedSceneIsWrittenWithAllItSaysAndReadsBackToItself)
   EXPECT_GE(files, 10);
 }
 
+TEST(SceneWriter, ADeformableObjectReadsBackToItself) {
+  nlohmann::json j = json::parse(controllers::testing::small_scene_json());
+  j["objects"][0]["deformable"] = {{"young_modulus_pa", 2.5e4},
+                                   {"poisson_ratio", 0.4},
+                                   {"density_kg_m3", 1100.0},
+                                   {"damping", 0.02},
+                                   {"tetrahedra", 1500},
+                                   {"fixed", {{"box", {{-0.1, -0.1, -0.1}, {0.1, 0.1, -0.02}}}}}};
+  const auto scene = parse_scene(j.dump(), "soft.json", controllers::testing::test_assets());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  const auto text = write_scene(*scene);
+  ASSERT_TRUE(text.has_value()) << text.error().message;
+  expect_said(j["objects"][0]["deformable"], json::parse(*text)["objects"][0]["deformable"], "deformable");
+  const auto again = parse_scene(*text, "written.json", controllers::testing::test_assets());
+  ASSERT_TRUE(again.has_value()) << again.error().message;
+  ASSERT_TRUE(again->objects[0].deformable.has_value());
+  const SceneDeformable& d = *again->objects[0].deformable;
+  EXPECT_EQ(d.young_modulus_pa, 2.5e4);
+  EXPECT_EQ(d.poisson_ratio, 0.4);
+  EXPECT_EQ(d.density_kg_m3, 1100.0);
+  EXPECT_EQ(d.damping, 0.02);
+  EXPECT_EQ(d.tetrahedra, 1500);
+  ASSERT_TRUE(d.fixed_box.has_value());
+  EXPECT_EQ(d.fixed_box->min.z, -0.1);
+  EXPECT_EQ(d.fixed_box->max.z, -0.02);
+  // a rigid object stays rigid, and a soft one without `tetrahedra` or `fixed` keeps neither
+  EXPECT_FALSE(json::parse(*write_scene(*parse_scene(controllers::testing::small_scene_json(), "small.json",
+                                                     controllers::testing::test_assets())))["objects"][0]
+                   .contains("deformable"));
+  j["objects"][0]["deformable"] = json::object();
+  const auto bare = parse_scene(j.dump(), "bare.json", controllers::testing::test_assets());
+  ASSERT_TRUE(bare.has_value()) << bare.error().message;
+  const json written = json::parse(*write_scene(*bare))["objects"][0]["deformable"];
+  EXPECT_FALSE(written.contains("tetrahedra"));
+  EXPECT_FALSE(written.contains("fixed"));
+  EXPECT_EQ(written["young_modulus_pa"], SceneDeformable{}.young_modulus_pa);
+}
+
 TEST(SceneWriter, RefusesATreeHeldOnlyInMemoryAndAnInvalidScene) {
   auto scene = parse_scene(controllers::testing::small_scene_json(), "small.json", controllers::testing::test_assets());
   ASSERT_TRUE(scene.has_value()) << scene.error().message;

@@ -106,6 +106,11 @@ struct CollisionObjectDef {
   /// The packing's coverage (sphere volume / mesh volume, (0, 1]); frames carry c_A c_B per section.
   double coverage = 1.0;
   std::string name;                        ///< for messages
+  /// A deforming object's trees (a soft body's: uh::controllers::SoftSimulation refits and
+  /// publishes them): each step takes the newest one, as it takes a pose, and queries it instead
+  /// of `tree` (its rest shape, the same topology). Null for a rigid object. Owned by the caller,
+  /// alive while the object is registered; the collision thread is its only reader. Not static.
+  LatestValue<SphereTree>* deformed_trees = nullptr;
 };
 
 /// Statistics of the collision thread since start(). Plain data.

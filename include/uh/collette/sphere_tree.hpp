@@ -77,6 +77,18 @@ class SphereTree {
   /// leaf. Derived by the constructor for the time-critical query's expected overlaps.
   std::span<const float> density() const { return density_; }
 
+  /// Whether refit() may run on this tree: every inner node's children come after it in the node
+  /// array (as build_sphere_tree() lays them out), so a reverse sweep is bottom-up. Setup only.
+  bool refittable() const;
+
+  /// The one change a tree allows, for a deformable object's own copies of its tree (uh::soft: a
+  /// copy per slot of a triple buffer, refitted by the simulation thread before it is published;
+  /// never a tree other threads read meanwhile): moves the leaf spheres to `leaves` (one per leaf,
+  /// packing order, positive radii) and refits every inner node bottom-up to enclose its
+  /// children (centre: their volume-weighted centroid), with volumes, densities and the
+  /// traversal blocks. The topology stays. Needs refittable(). Real-time safe: no allocation.
+  void refit(std::span<const Sphere> leaves);
+
   Blocks blocks() const {
     return {block_bounds_.data(), block_child_.data(), block_count_.data(), block_leaf_mask_.data(), block_width_, root_id_,
             static_cast<std::int32_t>(block_count_.size())};

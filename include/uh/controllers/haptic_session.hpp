@@ -23,6 +23,7 @@
 #include "uh/controllers/force_controller.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/controllers/session_model.hpp"
+#include "uh/controllers/soft_simulation.hpp"
 #include "uh/core/delegator.hpp"
 #include "uh/core/event_counter.hpp"
 #include "uh/core/latest_value.hpp"
@@ -292,6 +293,13 @@ class HapticSession {
   const Scene& scene() const { return model_->scene; }
   const SessionModel& model() const { return *model_; }
   const collette::CollisionWorld& world() const { return *world_; }
+  /// Scene object `object`'s simulation when it is deformable, else null. While the session runs
+  /// only the simulation's own thread may read its state; before start() and after stop(), anyone.
+  const SoftSimulation* soft_simulation(std::size_t object) const {
+    return object < soft_.size() ? soft_[object].get() : nullptr;
+  }
+  /// The rate of every deformable object's simulation thread [Hz] (docs/deformables.md, "In a session").
+  static constexpr double kSoftRateHz = 100.0;
 
  private:
   enum class Phase : std::uint8_t { kReady, kRunning, kStopped };
@@ -320,6 +328,8 @@ class HapticSession {
   void contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s, double volume,
                     std::int32_t pairs);
   bool any_fault() const;
+  void stop_soft();
+  Status soft_error() const;
   bool haptic_threads_running() const;
   Status device_error() const;
   Status thread_error() const;
@@ -328,6 +338,8 @@ class HapticSession {
   std::shared_ptr<const SessionModel> model_;
   double haptic_hz_ = 1000.0;
   double collision_hz_ = 1000.0;
+  // per scene object, null when rigid; before world_: the trees it publishes outlive the collision thread
+  std::vector<std::unique_ptr<SoftSimulation>> soft_;
   std::unique_ptr<collette::CollisionWorld> world_;
   haptico::FaultGroup fault_group_;  // before the rigs: their managers use it to the end
   std::vector<std::unique_ptr<ToolRig>> rigs_;

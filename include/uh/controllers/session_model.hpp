@@ -17,6 +17,7 @@
 #include "uh/controllers/scene.hpp"
 #include "uh/core/result.hpp"
 #include "uh/forcecomp/material.hpp"
+#include "uh/soft/soft_body.hpp"
 
 namespace uh::controllers {
 
@@ -26,6 +27,9 @@ struct CompiledShape {
   std::shared_ptr<const collette::SphereTree> tree;
   double coverage = 1.0;  ///< sphere volume / mesh volume, (0, 1]
   std::shared_ptr<const collette::MeshInside> surface;  ///< null without a mesh file
+  /// A deformable object's rest model (`objects[].deformable`): its lattice around the tree's
+  /// packing, the held nodes, the leaves embedded; null for a rigid object and for tools.
+  std::shared_ptr<const soft::SoftBodyModel> soft;
 };
 
 /// A compiled scene. Read-only once compile() returned it; any thread may read it.
@@ -53,7 +57,8 @@ struct CompileOptions {
 
 /// Validates `scene` and resolves it: trees through `cache` (loaded, or packed and cached on first
 /// use; shapes of one packing share one tree; a tree the scene holds is used as it is), every
-/// object's mesh surface where it has a mesh file (objects of one mesh share it), the materials.
+/// object's mesh surface where it has a mesh file (objects of one mesh share it), the materials,
+/// and each deformable object's lattice (built here, a progress stage of its own).
 /// The model's scene holds each shape's tree and coverage. Errors name the scene's source and the
 /// object or tool. Setup only.
 Result<std::shared_ptr<const SessionModel>> compile(const Scene& scene, collette::IstCache& cache,

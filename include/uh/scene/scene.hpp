@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,22 @@ struct SceneShape {
   double meters_per_unit = 1.0;      ///< length of one mesh unit [m]; the session works in metres
 };
 
+/// `objects[].deformable`: a soft object, simulated on its own thread (issue 26; docs/deformables.md,
+/// docs/scenes.md "Deformable objects"). Its volume is a lattice of tetrahedra around its mesh.
+struct SceneDeformable {
+  double young_modulus_pa = 5.0e4;  ///< E [Pa]
+  double poisson_ratio = 0.45;      ///< nu
+  double density_kg_m3 = 1000.0;    ///< rho [kg/m^3]
+  double damping = 0.01;            ///< stiffness-proportional (Rayleigh) damping [s]: damps deformation only
+  std::int64_t tetrahedra = 0;      ///< about this many elements; 0 = chosen from the object's size
+  /// `fixed.box`: mesh vertices and tet nodes inside it [m], object frame, are held in place.
+  struct Box {
+    Vec3 min{};
+    Vec3 max{};
+  };
+  std::optional<Box> fixed_box{};
+};
+
 /// A static object of the scene.
 struct SceneObject {
   std::string name;
@@ -51,6 +68,8 @@ struct SceneObject {
   /// `objects[].material`: what the surface feels like (stiffness, damping, friction, texture);
   /// nothing set = as the tool's force parameters say (docs/scenes.md, "Materials").
   forcecomp::Material material{};
+  /// `objects[].deformable`: set for a soft object; a rigid one has none.
+  std::optional<SceneDeformable> deformable{};
 };
 
 /// The device a tool is bound to: a registered driver name and its settings.

@@ -1,0 +1,99 @@
+#pragma once
+/// \file
+/// SoftSimulation: one deformable object of a session (issue 26; docs/deformables.md, "In a
+/// session"). Three kinds of thread meet here, each through its own lock-free handoff:
+///  - the simulation thread (step(), at a fixed rate): takes the newest contacts and tool
+///    forces, turns them into nodal loads, steps the FEM, moves the packing's spheres with their
+///    tetrahedra and refits a copy of the tree, which it publishes (LatestValue: the newest wins);
+///  - the collision thread queries the newest published tree (CollisionObjectDef::deformed_trees)
+///    and posts the object's pairs of each tool's frame (post_contacts);
+///  - each tool's haptic thread posts the force its tool felt (post_tool_force).
+/// The haptic thread never waits on the simulation: it only writes into its own triple buffer.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "uh/collette/sphere_tree.hpp"
+#include "uh/core/contact.hpp"
+#include "uh/core/fixed_rate_loop.hpp"
+#include "uh/core/latest_value.hpp"
+#include "uh/core/math.hpp"
+#include "uh/core/result.hpp"
+#include "uh/soft/corotational_fem.hpp"
+#include "uh/soft/soft_body.hpp"
+
+namespace uh::controllers {
+
+/// The contact spheres of one tool on the object, as the collision thread last saw them.
+struct SoftContacts {
+  /// The most spheres a frame hands over; more are dropped (the weights of the rest still sum to 1).
+  static constexpr std::int32_t kCapacity = 4096;
+  std::int32_t count = 0;
+  /// This object's share of the tool's contact (its section's volume over the frame's), [0, 1].
+  double share = 0.0;
+  std::array<std::int32_t, kCapacity> leaves{};  ///< the object's leaf spheres in contact
+  std::array<float, kCapacity> weights{};         ///< each pair's overlap volume
+};
+
+class SoftSimulation {
+ public:
+  /// The simulation of `body` (its rest model) whose rest tree is `rest_tree`, placed with
+  /// `world_from_object`, touched by `tools` tools. Fails when the FEM cannot be built or the tree
+  /// cannot be refitted. Setup only.
+  static Result<std::unique_ptr<SoftSimulation>> create(std::shared_ptr<const soft::SoftBodyModel> body,
+                                                        std::shared_ptr<const collette::SphereTree> rest_tree,
+                                                        const Pose& world_from_object, std::size_t tools);
+
+  /// The trees the collision thread queries (its only reader).
+  LatestValue<collette::SphereTree>& trees() { return trees_; }
+
+  /// Collision thread: the pairs of `frame`'s that touch this object (object `object`, on side A
+  /// of a pair as the session watches it) become tool `tool`'s newest contacts; a frame of another
+  /// object's watcher is ignored. A tool-against-everything frame gives the object's share of the
+  /// tool's contact volume; a frame of this object alone gives it all of the tool's force.
+  /// Real-time safe.
+  void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
+  /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
+  void post_tool_force(std::size_t tool, const Vec3& force_world);
+
+  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree.
+  Status step(double dt_s);
+
+  /// Runs step() at `rate_hz` on its own thread until stop(). Controlling thread.
+  Status start(double rate_hz);
+  void stop();
+  /// The simulation thread's failure (a step that failed ends the thread), once it stopped.
+  Status failure() const { return failure_; }
+  FixedRateLoopStats stats() const { return loop_ ? loop_->stats() : FixedRateLoopStats{}; }
+
+  /// The last step's nodal loads [N, object frame]. Simulation thread (or after stop()).
+  const std::vector<Eigen::Vector3d>& loads() const { return loads_; }
+  /// The last step's deformed leaf spheres [m, object frame]. Simulation thread (or after stop()).
+  std::span<const Sphere> spheres() const { return spheres_; }
+  const soft::CorotationalFem& fem() const { return fem_; }
+  const soft::SoftBodyModel& body() const { return *body_; }
+
+ private:
+  SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body, std::shared_ptr<const collette::SphereTree> rest_tree,
+                 soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools);
+  void gather_loads();
+
+  std::shared_ptr<const soft::SoftBodyModel> body_;
+  std::shared_ptr<const collette::SphereTree> rest_tree_;
+  soft::CorotationalFem fem_;
+  Quat object_from_world_;
+  LatestValue<collette::SphereTree> trees_;
+  std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
+  std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
+  std::vector<Eigen::Vector3d> loads_;
+  std::vector<Sphere> spheres_;
+  std::unique_ptr<FixedRateLoop> loop_;  // made by start()
+  Status failure_ = Ok{};
+};
+
+}  // namespace uh::controllers

@@ -1,0 +1,178 @@
+#include "uh/soft/soft_body.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace uh::soft {
+namespace {
+
+Eigen::Matrix3d edge_matrix(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                            const Eigen::Vector3d& d) {
+  Eigen::Matrix3d m;
+  m << b - a, c - a, d - a;
+  return m;
+}
+
+const Eigen::Vector3d& node_of(const std::vector<Eigen::Vector3d>& positions, std::int32_t node) {
+  return positions[static_cast<std::size_t>(node)];
+}
+
+Eigen::Matrix3d tet_edges(const TetMesh& mesh, const std::vector<Eigen::Vector3d>& positions, std::size_t tet) {
+  const auto& t = mesh.tets[tet];
+  return edge_matrix(node_of(positions, t[0]), node_of(positions, t[1]), node_of(positions, t[2]),
+                     node_of(positions, t[3]));
+}
+
+// Buckets of tetrahedra on a uniform grid over the mesh, by their bounding boxes: a point is
+// looked up among the few tetrahedra of its bucket.
+class TetLocator {
+ public:
+  TetLocator(const TetMesh& mesh, const std::vector<Eigen::Matrix3d>& rest_inverse)
+      : mesh_(mesh), rest_inverse_(rest_inverse) {
+    min_ = max_ = mesh.nodes.front();
+    for (const auto& p : mesh.nodes) {
+      min_ = min_.cwiseMin(p);
+      max_ = max_.cwiseMax(p);
+    }
+    const Eigen::Vector3d extent = (max_ - min_).cwiseMax(1e-12);
+    const double cell = std::cbrt(extent.prod() / static_cast<double>(mesh.tets.size()));
+    for (int axis = 0; axis < 3; ++axis) cells_[axis] = std::clamp(static_cast<int>(extent[axis] / cell), 1, 256);
+    size_ = extent.cwiseQuotient(cells_.cast<double>());
+    buckets_.resize(static_cast<std::size_t>(cells_.prod()));
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+      Eigen::Vector3d lo = mesh.nodes[static_cast<std::size_t>(mesh.tets[t][0])], hi = lo;
+      for (std::int32_t n : mesh.tets[t]) {
+        lo = lo.cwiseMin(mesh.nodes[static_cast<std::size_t>(n)]);
+        hi = hi.cwiseMax(mesh.nodes[static_cast<std::size_t>(n)]);
+      }
+      const Eigen::Vector3i a = cell_of(lo), b = cell_of(hi);
+      for (int z = a.z(); z <= b.z(); ++z)
+        for (int y = a.y(); y <= b.y(); ++y)
+          for (int x = a.x(); x <= b.x(); ++x) buckets_[bucket(x, y, z)].push_back(static_cast<std::int32_t>(t));
+    }
+  }
+
+  // the tetrahedron holding p with the largest smallest weight (a point on a shared face is in
+  // both), or none when no weight of any candidate is above -tolerance
+  std::optional<EmbeddedSphere> locate(const Eigen::Vector3d& p) const {
+    std::optional<EmbeddedSphere> best;
+    double best_min = -1e-9;
+    const Eigen::Vector3i c = cell_of(p);
+    for (std::int32_t t : buckets_[bucket(c.x(), c.y(), c.z())]) {
+      const Eigen::Vector3d b =
+          rest_inverse_[static_cast<std::size_t>(t)] * (p - mesh_.nodes[static_cast<std::size_t>(mesh_.tets[static_cast<std::size_t>(t)][0])]);
+      const Eigen::Vector4d w(1.0 - b.sum(), b.x(), b.y(), b.z());
+      if (w.minCoeff() < best_min) continue;
+      best_min = w.minCoeff();
+      const Eigen::Vector4d clamped = w.cwiseMax(0.0);
+      best = EmbeddedSphere{.tet = t, .weights = clamped / clamped.sum(), .rest_radius = 0.0};
+    }
+    return best;
+  }
+
+ private:
+  Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d at = (p - min_).cwiseQuotient(size_);
+    Eigen::Vector3i c;
+    for (int axis = 0; axis < 3; ++axis)
+      c[axis] = std::clamp(static_cast<int>(std::floor(at[axis])), 0, cells_[axis] - 1);
+    return c;
+  }
+  std::size_t bucket(int x, int y, int z) const {
+    return static_cast<std::size_t>(x + cells_.x() * (y + cells_.y() * z));
+  }
+
+  const TetMesh& mesh_;
+  const std::vector<Eigen::Matrix3d>& rest_inverse_;
+  Eigen::Vector3d min_, max_, size_;
+  Eigen::Vector3i cells_;
+  std::vector<std::vector<std::int32_t>> buckets_;
+};
+
+Eigen::Vector3d centre_of(const Sphere& s) {
+  return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+}
+
+Status embed_leaves(std::span<const Sphere> leaves, SoftBodyModel& body) {
+  const TetLocator locator(body.mesh, body.rest_inverse);
+  body.spheres.reserve(leaves.size());
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    auto embedded = locator.locate(centre_of(leaves[i]));
+    if (!embedded)
+      return Error{"soft::build_soft_body: leaf sphere " + std::to_string(i) + "'s centre lies in no tetrahedron",
+                   ErrorKind::kMesh};
+    embedded->rest_radius = static_cast<double>(leaves[i].radius);
+    body.spheres.push_back(*embedded);
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+int default_tetrahedra(const Eigen::Vector3d& extent) {
+  const double edge = extent.maxCoeff() / 10.0;
+  if (!(edge > 0.0)) return 384;
+  const double cells = (extent / edge).cwiseMax(1.0).prod();
+  return static_cast<int>(std::clamp(6.0 * cells, 384.0, 3000.0));
+}
+
+Result<SoftBodyModel> build_soft_body(const InsidePredicate& inside, std::span<const Sphere> leaves,
+                                      const SoftBodyParams& params) {
+  if (leaves.empty()) return Error{"soft::build_soft_body: the packing has no spheres", ErrorKind::kInvalid};
+  LatticeOptions lattice;
+  lattice.min = lattice.max = centre_of(leaves.front());
+  for (const Sphere& s : leaves) {
+    const Eigen::Vector3d r = Eigen::Vector3d::Constant(static_cast<double>(s.radius));
+    lattice.min = lattice.min.cwiseMin(centre_of(s) - r);
+    lattice.max = lattice.max.cwiseMax(centre_of(s) + r);
+    lattice.cover.push_back(centre_of(s));
+  }
+  lattice.target_tetrahedra =
+      params.target_tetrahedra > 0 ? params.target_tetrahedra : default_tetrahedra(lattice.max - lattice.min);
+  auto mesh = build_voxel_lattice(inside, lattice);
+  if (!mesh) return mesh.error();
+  SoftBodyModel body;
+  body.mesh = std::move(*mesh);
+  body.material = params.material;
+  body.rest_inverse.reserve(body.mesh.tets.size());
+  for (std::size_t t = 0; t < body.mesh.tets.size(); ++t)
+    body.rest_inverse.push_back(tet_edges(body.mesh, body.mesh.nodes, t).inverse());
+  if (params.fixed) {
+    body.fixed = nodes_in_box(body.mesh, params.fixed->min, params.fixed->max);
+    if (body.fixed.empty())
+      return Error{"soft::build_soft_body: the fixed box holds no node of the lattice (the box is in metres, object frame)",
+                   ErrorKind::kInvalid};
+  }
+  if (Status s = embed_leaves(leaves, body); !s) return s.error();
+  return body;
+}
+
+void deform_spheres(const SoftBodyModel& body, const std::vector<Eigen::Vector3d>& positions, std::span<Sphere> out) {
+  const std::size_t n = std::min(out.size(), body.spheres.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const EmbeddedSphere& e = body.spheres[i];
+    const auto tet = static_cast<std::size_t>(e.tet);
+    const auto& t = body.mesh.tets[tet];
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) centre += e.weights[k] * node_of(positions, t[static_cast<std::size_t>(k)]);
+    const Eigen::Matrix3d f = tet_edges(body.mesh, positions, tet) * body.rest_inverse[tet];
+    // fixed-size singular values: no allocation; an inverted element's smallest is taken as 0
+    const Eigen::Vector3d sigma = Eigen::JacobiSVD<Eigen::Matrix3d>(f).singularValues();
+    const double stretch = f.determinant() > 0.0 ? std::max(sigma.minCoeff(), kMinSphereStretch) : kMinSphereStretch;
+    out[i] = Sphere{static_cast<float>(centre.x()), static_cast<float>(centre.y()), static_cast<float>(centre.z()),
+                    static_cast<float>(e.rest_radius * stretch)};
+  }
+}
+
+void spread_sphere_force(const SoftBodyModel& body, std::int32_t leaf, const Eigen::Vector3d& force,
+                         std::vector<Eigen::Vector3d>& nodal_loads) {
+  const EmbeddedSphere& e = body.spheres[static_cast<std::size_t>(leaf)];
+  const auto& t = body.mesh.tets[static_cast<std::size_t>(e.tet)];
+  for (int k = 0; k < 4; ++k) nodal_loads[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])] += e.weights[k] * force;
+}
+
+}  // namespace uh::soft

@@ -1,0 +1,37 @@
+// A soft block in a threaded session (issue 26): its simulation runs on its own thread beside the
+// haptic and collision threads (this file runs under ThreadSanitizer too, label "threads"), the
+// collision thread queries the trees it publishes, and stop() ends it with the others.
+
+#include <gtest/gtest.h>
+
+#include "scene_test_support.hpp"
+#include "soft_block_support.hpp"
+#include "uh/controllers/haptic_session.hpp"
+
+namespace uh::controllers {
+namespace {
+
+TEST(SoftSessionThreads, TheSimulationThreadStepsBesideTheHapticAndCollisionThreads) {
+  SessionOptions options;
+  options.cache_dir = testing::fresh_cache("soft-threads");
+  auto session = HapticSession::create(testing::soft_block(0.004), options);
+  ASSERT_TRUE(session.has_value()) << session.error().message;
+  const SoftSimulation* sim = (*session)->soft_simulation(0);
+  ASSERT_NE(sim, nullptr);
+  EXPECT_EQ((*session)->soft_simulation(1), nullptr);
+  // one second of the press: the ball reaches its depth after half of it
+  const Status ran = (*session)->run(1.0);
+  ASSERT_TRUE(ran) << ran.error().message;
+  EXPECT_GT(sim->stats().ticks, 10u) << "the simulation thread stepped";
+  EXPECT_TRUE(sim->failure());
+  EXPECT_GT((*session)->report().contact_ticks, 0u);
+  // the block went down under the ball (the loads came back from the haptic thread)
+  double indentation = 0.0;
+  const auto& rest = sim->body().mesh.nodes;
+  for (std::size_t n = 0; n < rest.size(); ++n)
+    indentation = std::max(indentation, rest[n].z() - sim->fem().positions()[n].z());
+  EXPECT_GT(indentation, 1e-4);
+}
+
+}  // namespace
+}  // namespace uh::controllers
