@@ -270,16 +270,7 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   if (!pad_tree) return pad_tree.error();
   const auto tip = std::make_shared<const collette::SphereTree>(std::move(*tool_tree));
   const auto pad = std::make_shared<const collette::SphereTree>(std::move(*pad_tree));
-  controllers::Scene scene;
-  scene.name = "museum table";
-  scene.source = "the museum's table";
-  scene.objects = {piece};
-  scene.tool().name = "stylus";
-  scene.tool().shape.tree = tip;
-  scene.tool().shape.coverage = 1.0;
-  scene.watch = {piece.name};
-  scene.haptic_hz = options.haptic_hz;
-  scene.collision_hz = options.haptic_hz;
+  controllers::Scene scene = museum_artifacts::table_scene(piece, tip, options.haptic_hz);
   // the piece's tree compiled once; each site's exploration reuses it (and leaves the mesh surface
   // out, exploration::explore_scene)
   collette::IstCache cache(cache_dir);
@@ -333,27 +324,35 @@ constexpr double kSteepWindowM = 0.002;
 
 // a - b across b's slope (where the surface is steep, a little shift along the way is a large
 // difference of height but a small one across), minus its least-squares line (a piece standing a
-// little off, or tilted, moves whole tracks)
-std::vector<double> detrended_difference(const double* a, const double* b, std::size_t n, double step) {
+// little off, or tilted, moves whole tracks); the line is fitted over the samples `compared` keeps
+// (all when empty), and the others are 0 (what is left out must not tilt what is kept)
+std::vector<double> detrended_difference(const double* a, const double* b, std::size_t n, double step,
+                                         const std::vector<bool>& compared = {}) {
+  const auto kept = [&compared](std::size_t i) { return compared.empty() || compared[i]; };
   std::vector<double> d(n);
   double mx = 0.0, my = 0.0;
+  std::size_t count = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const double slope = n < 3 ? 0.0 : (b[std::min(i + 1, n - 1)] - b[i > 0 ? i - 1 : 0]) / (2.0 * step);
     d[i] = (a[i] - b[i]) / std::sqrt(1.0 + slope * slope);
+    if (!kept(i)) continue;
     mx += static_cast<double>(i);
     my += d[i];
+    ++count;
   }
-  mx /= static_cast<double>(n);
-  my /= static_cast<double>(n);
+  if (count == 0) return std::vector<double>(n, 0.0);
+  mx /= static_cast<double>(count);
+  my /= static_cast<double>(count);
   // the line's slope, fitted in the centred variables
-  std::vector<double> u(n), v(n);
+  std::vector<double> u, v;
   for (std::size_t i = 0; i < n; ++i) {
-    u[i] = static_cast<double>(i) - mx;
-    v[i] = d[i] - my;
+    if (!kept(i)) continue;
+    u.push_back(static_cast<double>(i) - mx);
+    v.push_back(d[i] - my);
   }
   const core::LeastSquaresFit line = core::least_squares(u, 1, v);
   const double slope = line.coefficients.empty() ? 0.0 : line.coefficients[0];
-  for (std::size_t i = 0; i < n; ++i) d[i] -= my + slope * (static_cast<double>(i) - mx);
+  for (std::size_t i = 0; i < n; ++i) d[i] = kept(i) ? d[i] - (my + slope * (static_cast<double>(i) - mx)) : 0.0;
   return d;
 }
 
@@ -426,20 +425,26 @@ double surface_difference(const SurfaceTrack& a, const SurfaceTrack& b, bool wal
     const std::ptrdiff_t from = std::max(trim, trim - k), to = std::min(na - trim, nb - trim - k);
     if (to - from < need) continue;
     const auto n = static_cast<std::size_t>(to - from);
-    std::vector<double> d =
-        detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step);
+    std::vector<bool> compared;
     if (wall_only) {
-      // only where b's surface rises more steeply than it turns in or out (a wall, not a shelf)
-      const auto& h = b.height;
+      // only where both surfaces rise more steeply than they turn in or out (a wall, not a shelf
+      // nor an overhang: a hand stroking up under a flaring cup sticks there now and then, and its
+      // trace rises straight up inside the flare, or follows it, as the friction cone lets it)
       const auto w = static_cast<std::ptrdiff_t>(0.001 / b.step);
+      const auto leans = [w](const SurfaceTrack& t, std::ptrdiff_t j) {
+        const auto n_t = static_cast<std::ptrdiff_t>(t.height.size());
+        const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(0, j - w), hi = std::min(n_t - 1, j + w);
+        return hi > lo && std::fabs(t.height[static_cast<std::size_t>(hi)] - t.height[static_cast<std::size_t>(lo)]) >
+                              kStrokeSteepest * static_cast<double>(hi - lo) * t.step;
+      };
+      compared.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        const std::ptrdiff_t j = from + k + static_cast<std::ptrdiff_t>(i);
-        const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(0, j - w), hi = std::min(nb - 1, j + w);
-        if (hi > lo && std::fabs(h[static_cast<std::size_t>(hi)] - h[static_cast<std::size_t>(lo)]) >
-                           kStrokeSteepest * static_cast<double>(hi - lo) * b.step)
-          d[i] = 0.0;
+        const std::ptrdiff_t j = from + static_cast<std::ptrdiff_t>(i);
+        compared[i] = !leans(b, j + k) && !leans(a, j);
       }
     }
+    const std::vector<double> d =
+        detrended_difference(a.height.data() + from, b.height.data() + from + k, n, a.step, compared);
     const double ms = mean_square(d);
     if (ms < best) {
       best = ms;

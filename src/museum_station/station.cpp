@@ -264,16 +264,8 @@ Status Station::load_piece(const InHand& h) {
   auto stylus = collette::build_sphere_tree(std::span<const Sphere>(&ball, 1));
   if (!stylus) return stylus.error();
 
-  controllers::Scene scene;
-  scene.name = "museum station";
-  scene.source = "Phantom's table";
-  scene.objects = {*object};
-  scene.tool().name = "stylus";
-  scene.tool().shape.tree = std::make_shared<const collette::SphereTree>(std::move(*stylus));
-  scene.tool().shape.coverage = 1.0;
-  scene.watch = {h.kind};
-  scene.haptic_hz = options_.haptic_hz;
-  scene.collision_hz = options_.haptic_hz;
+  controllers::Scene scene = museum_artifacts::table_scene(
+      *object, std::make_shared<const collette::SphereTree>(std::move(*stylus)), options_.haptic_hz);
   scene.tool().device.driver = device_driver_;
   scene.tool().device.config = device_config_;
   collette::IstCache cache(options_.cache_dir);

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -103,5 +104,14 @@ Result<controllers::SceneObject> artifact_object(const museum::PieceForm& form,
                                                  const std::filesystem::path& cache_dir,
                                                  const std::string& name, const Pose& pose = {},
                                                  std::int64_t spheres = 10000);
+
+/// The scene of a piece on Phantom's table, felt with `tool` (a ball: the stylus, or a finger's
+/// pad) at `haptic_hz` (the collision thread at the same rate): the piece watched, the device and
+/// its settings left to the caller. Rendered through the 6-DOF proxy whatever the scene default
+/// is (ToolProxyOptions::enabled): the stylus stays on the side of the surface it came from, and
+/// what the hand feels (a shape, friction, a stiffness within what the coupling renders
+/// passively) is what a player is asked to judge. The station and the blind player both play on it.
+controllers::Scene table_scene(const controllers::SceneObject& piece,
+                               std::shared_ptr<const collette::SphereTree> tool, double haptic_hz);
 
 }  // namespace uh::museum_artifacts
