@@ -33,9 +33,10 @@ namespace {
 
 constexpr double kStrokeStepM = 0.00025;  // surface tracks along strokes: a sample every 0.25 mm
 constexpr int kAroundSamples = 720;       // around the piece: every half degree
-// The pad presses on the top: how many, on a ring of what radius, read at what depth, and the force
-// at which a press stops short of it (a finger presses glaze 0.8 mm in with 4-8 N; deeper, the pad
-// meets more of the packing's spheres and the presses spread half as much as at 0.45 mm)
+// The stiffness presses on the top: how many, on a ring of what radius, read at what depth, and the
+// force at which a press stops short of it. Through the proxy the force is the spring the stylus
+// feels times the depth past first contact (the proxy stays on the surface), whatever the packing
+// under it: a finger's pad (a wider ball) would feel the same spring capped by the coupling.
 constexpr int kTopPresses = 24;
 constexpr double kTopPressRingsM[2] = {0.004, 0.008};  // every other press on the outer ring
 constexpr double kPressReadDepthM = 0.0008;
@@ -61,12 +62,9 @@ Bounds world_bounds(const collette::SphereTree& tree, const Pose& pose) {
 }
 
 // The press's stiffness [N/mm] read at `depth` past first contact: the force there (along the
-// press's mean force direction) over the depth. Under a packed face the force grows faster than the
-// depth (the packing fills the first millimetre of the solid unevenly), so a slope read between two
-// forces compares like depths on like materials only: a softer surface is read deeper, where the
-// packing is fuller, and a resin 45 % softer than glaze reads only about 25 % softer. Read at one
-// depth, the force is the material's stiffness times the same packed volume. Nothing when the press
-// did not reach the depth.
+// press's mean force direction) over the depth. Through the proxy it is the spring the stylus
+// feels (the proxy stays on the surface as the handle goes in), capped by the coupling's passive
+// stiffness. Nothing when the press did not reach the depth.
 std::optional<double> stiffness_at_depth(const ExploreTrace& trace, double depth) {
   Vec3 sum{};
   for (const auto& s : trace.samples)
@@ -96,7 +94,7 @@ std::optional<double> stiffness_at_depth(const ExploreTrace& trace, double depth
 struct SurveySite {
   std::string name;
   ExploreOptions options;
-  bool pad = false;  // pressed with the finger's pad (a larger ball) rather than the stylus's tip
+  bool stiffness = false;  // a press whose stiffness is read
 };
 
 // fills the gaps of a resampled track (bins no sample fell in) by linear interpolation; false when empty
@@ -200,14 +198,13 @@ std::vector<SurveySite> plan_survey(const Bounds& b, const SurveyOptions& o) {
   base.stroke_turn_rad = 0.0;
   base.stroke_stops_at_edge_rad = 0.6;  // about 35 degrees: the rim of a top
   base.presses = 1;                     // the survey presses at sites of its own (below)
-  base.press_depth_m.reset();           // the top's press goes to a force (the pad presses: to a depth)
+  base.press_depth_m.reset();           // the top's press goes to a force (the stiffness presses: to a depth)
   base.press_force_n = 3.0;
   base.strokes_through_site = false;  // each site's strokes start at the site
   // the top, as `uh explore` does it: the material
   sites.push_back({"top", base});
-  // presses on a ring round the middle of the top (a press reads the packing's grain under the pad
-  // as well as the material: the judge compares the presses' ranks), off the axes along which
-  // ridges and grooves run
+  // presses on a ring round the middle of the top (the judge compares the presses' ranks), off the
+  // axes along which ridges and grooves run
   for (int k = 0; k < kTopPresses; ++k) {
     ExploreOptions press = base;
     const double angle = kPi / kTopPresses + 2.0 * kPi * k / kTopPresses;
@@ -265,11 +262,7 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   const Sphere ball{0.f, 0.f, 0.f, static_cast<float>(options.tool_radius_m)};
   auto tool_tree = collette::build_sphere_tree(std::span<const Sphere>(&ball, 1));
   if (!tool_tree) return tool_tree.error();
-  const Sphere pad_ball{0.f, 0.f, 0.f, static_cast<float>(options.pad_radius_m)};
-  auto pad_tree = collette::build_sphere_tree(std::span<const Sphere>(&pad_ball, 1));
-  if (!pad_tree) return pad_tree.error();
   const auto tip = std::make_shared<const collette::SphereTree>(std::move(*tool_tree));
-  const auto pad = std::make_shared<const collette::SphereTree>(std::move(*pad_tree));
   controllers::Scene scene = museum_artifacts::table_scene(piece, tip, options.haptic_hz);
   // the piece's tree compiled once; each site's exploration reuses it (and leaves the mesh surface
   // out, exploration::explore_scene)
@@ -285,12 +278,11 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   PieceSurvey survey;
   for (SurveySite& site : plan_survey(world_bounds(*piece_shape.tree, piece.pose), options)) {
     site.options.max_seconds = std::max(1.0, options.max_piece_seconds - survey.simulated_s);
-    scene.tool().shape.tree = site.pad ? pad : tip;
     auto explored = exploration::explore_scene(scene, piece.name, site.options, session);
     if (!explored) return Error{fmt::format("{} ({}): {}", piece.name, site.name, explored.error().message)};
     const exploration::ObjectExploration& e = explored->front();
     if (site.name == "top") survey.material = e.estimate;
-    if (site.pad)
+    if (site.stiffness)
       if (const auto k = stiffness_at_depth(e.trace, kPressReadDepthM))
         survey.site_stiffness.emplace_back(site.name, *k);
     add_tracks(site, e.trace, survey.tracks);
@@ -304,8 +296,7 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
 namespace {
 
 constexpr double kSurfaceFloorM = 0.0003;  // a surface difference under 0.3 mm is not told apart
-// nor stiffness under 25 % (a hand's Weber fraction for stiffness is about 23 %, Jones and Hunter 1990;
-// a pad press also reads the packing's grain under it)
+// nor stiffness under 25 % (a hand's Weber fraction for stiffness is about 23 %, Jones and Hunter 1990)
 constexpr double kStiffnessFloor = 0.25;
 constexpr double kFrictionFloor = 0.10;      // nor friction under 10 % (half of what a hand tells apart)
 constexpr double kNoiseMargin = 2.0;         // a difference must exceed twice the reference's own spread
@@ -545,9 +536,8 @@ Judgement judge_piece(const PieceSurvey& piece, const PieceSurvey& reference,
                           .p_value = std::nullopt});
   };
   // stiffness: every press on the top of the piece against every press on the reference's two
-  // explorations. A press reads the packing's grain under the pad as well as the material (presses
-  // on one flat top spread by 30 % and more), so a difference of the medians counts only when the
-  // rank test finds it is not that grain.
+  // explorations; a difference of the medians counts only when the rank test finds the presses do
+  // not interleave (a press reads where the proxy rests a little differently from spot to spot).
   const auto top_presses = [](const PieceSurvey& survey) {
     std::vector<double> k;
     for (const auto& [site, value] : survey.site_stiffness)

@@ -65,7 +65,10 @@ struct MaterialTell {
 MaterialTell material_tell(ArtifactKind kind, museum::Difficulty difficulty);
 
 /// What the piece's surface feels like: the kind's material (fired clay, bronze, stone, silver...),
-/// changed by material_tell() on a forgery.
+/// changed by material_tell() on a forgery. Through the proxy the stylus feels a material as the
+/// spring 2 pi r k (r = kStylusRadiusM), capped by the coupling's passive stiffness (1.5 kN/m at
+/// 1 kHz): every material stiffer than that feels the same, so a stiffness tell is made below it
+/// (the bowl's glaze and resin).
 forcecomp::Material artifact_material(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
 
 /// The piece as the numbers a station builds it from (museum::PieceForm: no label); the mesh and
@@ -104,6 +107,9 @@ Result<controllers::SceneObject> artifact_object(const museum::PieceForm& form,
                                                  const std::filesystem::path& cache_dir,
                                                  const std::string& name, const Pose& pose = {},
                                                  std::int64_t spheres = 10000);
+
+/// The stylus Phantom holds, at the station and in the blind player's hand: a ball of this radius [m].
+inline constexpr double kStylusRadiusM = 0.004;
 
 /// The scene of a piece on Phantom's table, felt with `tool` (a ball: the stylus, or a finger's
 /// pad) at `haptic_hz` (the collision thread at the same rate): the piece watched, the device and
