@@ -60,7 +60,7 @@ struct SurveyOptions {
 };
 
 /// Explores `piece` (a scene object standing on its base, any turn about the vertical) with the
-/// stylus. Sites: the top (press, four strokes, a circle, taps: the material); 24 presses with
+/// stylus. Sites: the top (press, four strokes, a circle, taps: the material); 12 presses with
 /// the stylus on two rings round the top's middle (the stiffness); a raster of long
 /// strokes over the top of a flat piece; on a piece with a round footprint, contours once around
 /// it at heights every `ring_spacing_m` and strokes up and down its side.
