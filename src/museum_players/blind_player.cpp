@@ -131,12 +131,22 @@ void add_tracks(const SurveySite& site, const ExploreTrace& trace, std::vector<S
       {"stroke +x", "stroke -x", "stroke +y", "stroke -y"},
       {"stroke up", "stroke down", "stroke across", "stroke back"}};
   const auto& x = trace.samples;
+  // a stroke down the side that slides on round the base's edge (the proxy slides at mu_d where it
+  // used to stick) goes under the piece: below half the contours' clearance over the base (the
+  // axis point's height) the hand is no longer on the side
+  // a hand pushing more than twice the stroke's force is jammed against a rise it does not slide
+  // over (the proxy held on a shelf while the handle went on): where it is tells how far it pushed
+  const auto on_stroke = [&](const auto& s, std::int32_t leg) {
+    return s.phase == ExplorePhase::kStroke && s.leg == leg && norm(s.force) > 0.05 &&
+           norm(s.force) <= 2.0 * site.options.stroke_force_n &&
+           (!side || s.position.z >= axis.z + 0.5 * kEdgeClearM);
+  };
   for (std::int32_t leg = 0; leg < 4; ++leg) {
     // along the leg's axis, binned every kStrokeStepM
     const Vec3 along = trace.stroke_axes[leg / 2];
     double lo = 1e300, hi = -1e300;
     for (const auto& s : x)
-      if (s.phase == ExplorePhase::kStroke && s.leg == leg && norm(s.force) > 0.05) {
+      if (on_stroke(s, leg)) {
         lo = std::min(lo, dot(s.position, along));
         hi = std::max(hi, dot(s.position, along));
       }
@@ -150,7 +160,7 @@ void add_tracks(const SurveySite& site, const ExploreTrace& trace, std::vector<S
     std::vector<double> sum(bins, 0.0);
     std::vector<int> count(bins, 0);
     for (const auto& s : x) {
-      if (s.phase != ExplorePhase::kStroke || s.leg != leg || norm(s.force) <= 0.05) continue;
+      if (!on_stroke(s, leg)) continue;
       const auto i =
           std::min(bins - 1, static_cast<std::size_t>((dot(s.position, along) - lo) / kStrokeStepM));
       sum[i] += height(s.position);
