@@ -71,14 +71,22 @@ ExplorePlan plan_top(const WorldSpheres& w, const Vec3& middle, const collette::
   plan.axis_point = middle;
   const Vec3 target{middle.x + options.site.offset_m[0] + jitter.a, middle.y + options.site.offset_m[1] + jitter.b,
                     0.0};
-  double top = -1e300;
-  for (const auto& [c, r] : w.spheres) {
-    const double d2 = (c.x - target.x) * (c.x - target.x) + (c.y - target.y) * (c.y - target.y);
-    if (d2 < r * r) top = std::max(top, c.z + std::sqrt(r * r - d2));
-  }
-  if (top < -1e299) top = w.hi.z;
   plan.approach = {0, 0, -1};
   const Vec3 tip = tool_tip(tool, plan.approach);
+  // the tip's height where the tool, coming straight down over the target, first meets a sphere of
+  // the object: not only the one under the tip (a wide tool over a gap in the packing would start
+  // inside its neighbours, and a proxy that begins inside keeps no side)
+  double top = -1e300;
+  for (const Sphere& t : tool.leaves()) {
+    const Vec3 from_tip = Vec3{static_cast<double>(t.x), static_cast<double>(t.y), static_cast<double>(t.z)} - tip;
+    const Vec3 centre{target.x + from_tip.x, target.y + from_tip.y, 0.0};
+    for (const auto& [c, r] : w.spheres) {
+      const double reach = r + static_cast<double>(t.radius);
+      const double d2 = (c.x - centre.x) * (c.x - centre.x) + (c.y - centre.y) * (c.y - centre.y);
+      if (d2 < reach * reach) top = std::max(top, c.z + std::sqrt(reach * reach - d2) - from_tip.z);
+    }
+  }
+  if (top < -1e299) top = w.hi.z;
   plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + 0.003 - tip.z};
   plan.axes[0] = {std::cos(jitter.turn), std::sin(jitter.turn), 0.0};
   plan.axes[1] = {-std::sin(jitter.turn), std::cos(jitter.turn), 0.0};
@@ -94,21 +102,23 @@ Result<ExplorePlan> plan_side(const WorldSpheres& w, const Vec3& middle, const c
   const Vec3 out{std::cos(azimuth), std::sin(azimuth), 0.0};
   // (up or down by a third of the seed's move: a band round a coin's edge is a few millimetres high)
   const double z = w.lo.z + std::clamp(options.site.height_fraction, 0.0, 1.0) * (w.hi.z - w.lo.z) + jitter.b / 3.0;
-  // the outermost surface point on the level ray from the centre line: per sphere, the circle it
-  // cuts at height z, crossed by the ray
-  double outer = -1e300;
-  for (const auto& [c, r] : w.spheres) {
-    const double dz = c.z - z;
-    if (std::fabs(dz) >= r) continue;
-    const double rho2 = r * r - dz * dz;
-    const Vec3 rel{c.x - middle.x, c.y - middle.y, 0.0};
-    const double along = dot(rel, out);
-    const double across2 = dot(rel, rel) - along * along;
-    if (across2 < rho2) outer = std::max(outer, along + std::sqrt(rho2 - across2));
-  }
-  if (outer < -1e299) return Error{fmt::format("nothing of the object is at height {:.4f} m", z)};
   plan.approach = -out;
   const Vec3 tip = tool_tip(tool, plan.approach);
+  // how far out along the level ray from the centre line the tool's tip is where the tool, coming
+  // in along it, first meets a sphere of the object (a wide tool, or one over a flaring foot, meets
+  // a neighbour before the sphere on the ray: a proxy that begins inside keeps no side)
+  double outer = -1e300;
+  for (const Sphere& t : tool.leaves()) {
+    const Vec3 from_tip = Vec3{static_cast<double>(t.x), static_cast<double>(t.y), static_cast<double>(t.z)} - tip;
+    for (const auto& [c, r] : w.spheres) {
+      const double reach = r + static_cast<double>(t.radius);
+      const Vec3 rel = c - Vec3{middle.x + from_tip.x, middle.y + from_tip.y, z + from_tip.z};
+      const double along = dot(rel, out);
+      const double across2 = dot(rel, rel) - along * along;
+      if (across2 < reach * reach) outer = std::max(outer, along + std::sqrt(reach * reach - across2));
+    }
+  }
+  if (outer < -1e299) return Error{fmt::format("nothing of the object is at height {:.4f} m", z)};
   const Vec3 surface{middle.x + outer * out.x, middle.y + outer * out.y, z};
   plan.start = surface + 0.003 * out - tip;
   plan.axes[0] = {0, 0, 1};

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -249,7 +250,9 @@ forcecomp::Material artifact_material(ArtifactKind kind, Difficulty difficulty, 
       case ArtifactKind::amphora:
         return {1.5e5, 0.45, 0.35};  // fired clay
       case ArtifactKind::bowl:
-        return {2e5, 0.3, 0.22};  // glazed ceramic
+        // glazed ceramic, as stiff as the stylus feels a surface through the proxy below the
+        // coupling's passive stiffness (2 pi r k = 1.38 kN/m): its resin forgery is felt softer
+        return {5.5e4, 0.3, 0.22};
       case ArtifactKind::coin:
         return {2.5e5, 0.35, 0.25};  // bronze
       case ArtifactKind::tablet:
@@ -471,6 +474,22 @@ Result<controllers::SceneObject> artifact_object(ArtifactKind kind, Difficulty d
                                                  const std::string& name, const Pose& pose,
                                                  std::int64_t spheres) {
   return artifact_object(piece_form(kind, difficulty, piece), cache_dir, name, pose, spheres);
+}
+
+controllers::Scene table_scene(const controllers::SceneObject& piece,
+                               std::shared_ptr<const collette::SphereTree> tool, double haptic_hz) {
+  controllers::Scene scene;
+  scene.name = "museum table";
+  scene.source = "Phantom's table";
+  scene.objects = {piece};
+  scene.tool().name = "stylus";
+  scene.tool().shape.tree = std::move(tool);
+  scene.tool().shape.coverage = 1.0;
+  scene.watch = {piece.name};
+  scene.haptic_hz = haptic_hz;
+  scene.collision_hz = haptic_hz;
+  scene.force.proxy.enabled = true;
+  return scene;
 }
 
 }  // namespace uh::museum_artifacts

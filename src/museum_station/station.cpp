@@ -20,7 +20,6 @@ using museum_protocol::ServerError;
 
 namespace {
 
-constexpr double kStylusRadiusM = 0.004;  // the stylus: a 4 mm ball, as the automated player's
 constexpr double kHomeAboveTopM = 0.03;   // home: this far over the middle of the piece's top
 constexpr double kVolumeStep = 0.1;
 constexpr const char* kSimulatedHand = "sim-hand";
@@ -260,20 +259,12 @@ Status Station::load_piece(const InHand& h) {
     return Error{fmt::format("the server sent the form of a '{}' for a '{}'", h.form.kind, h.kind)};
   auto object = museum_artifacts::artifact_object(h.form, options_.cache_dir, h.kind, Pose{});
   if (!object) return object.error();
-  const Sphere ball{0.f, 0.f, 0.f, static_cast<float>(kStylusRadiusM)};
+  const Sphere ball{0.f, 0.f, 0.f, static_cast<float>(museum_artifacts::kStylusRadiusM)};
   auto stylus = collette::build_sphere_tree(std::span<const Sphere>(&ball, 1));
   if (!stylus) return stylus.error();
 
-  controllers::Scene scene;
-  scene.name = "museum station";
-  scene.source = "Phantom's table";
-  scene.objects = {*object};
-  scene.tool().name = "stylus";
-  scene.tool().shape.tree = std::make_shared<const collette::SphereTree>(std::move(*stylus));
-  scene.tool().shape.coverage = 1.0;
-  scene.watch = {h.kind};
-  scene.haptic_hz = options_.haptic_hz;
-  scene.collision_hz = options_.haptic_hz;
+  controllers::Scene scene = museum_artifacts::table_scene(
+      *object, std::make_shared<const collette::SphereTree>(std::move(*stylus)), options_.haptic_hz);
   scene.tool().device.driver = device_driver_;
   scene.tool().device.config = device_config_;
   collette::IstCache cache(options_.cache_dir);
@@ -293,8 +284,8 @@ Status Station::load_piece(const InHand& h) {
     // model, its trees and surface shared)
     auto scripted = std::make_shared<controllers::SessionModel>(*model);
     haptico::DeviceConfig& config = scripted->scene.tool().device.config;
-    config.set("target_start", Vec3{0.0, 0.0, top + kStylusRadiusM + 0.015});
-    config.set("target_end", Vec3{peak.x, peak.y, top + kStylusRadiusM - 0.004});
+    config.set("target_start", Vec3{0.0, 0.0, top + museum_artifacts::kStylusRadiusM + 0.015});
+    config.set("target_end", Vec3{peak.x, peak.y, top + museum_artifacts::kStylusRadiusM - 0.004});
     config.set("duration_s", 1.5);
     config.set("bounce", 1.0);
     model = std::move(scripted);

@@ -1,6 +1,7 @@
 // The exploration's estimators on synthetic traces built from textbook laws (a ball pressed into
 // a plane, Coulomb friction with a breakaway, a sine grating): what they must read back is known
-// exactly, independent of the rendering that `uh explore` checks end to end (tests/cli).
+// exactly, independent of the rendering that `uh explore` checks end to end (tests/cli); and where
+// the hand starts, off every sphere a wide tool would meet.
 
 #include "uh/exploration/exploration.hpp"
 
@@ -8,7 +9,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <span>
 
+#include "uh/collette/sphere_tree_builder.hpp"
+#include "uh/exploration/explore_scene.hpp"
 #include "uh/forcecomp/material.hpp"
 
 namespace uh::exploration {
@@ -256,6 +261,46 @@ TEST(Exploration, ARandomTextureHasNoPeriodAndRipplesWithItsRoughness) {
 TEST(Exploration, AnEmptyTraceGivesNoEstimates) {
   const MaterialEstimate e = estimate_material(ExploreTrace{});
   EXPECT_FALSE(e.stiffness_n_per_mm || e.friction_static || e.friction_dynamic || e.texture_period_m);
+}
+
+// A wide tool coming down over a gap in the object's spheres starts 3 mm off every sphere it would
+// meet, not only the one under its tip: through the proxy, a tool that begins inside an object
+// keeps no side, follows the hand in with zero force and never touches it
+TEST(Exploration, AWideToolOverAGapInThePackingStartsOffItAndTouchesItThroughTheProxy) {
+  // two tall spheres either side of a low one under the site: a 10 mm pad 3 mm over the low one
+  // would overlap both tall ones
+  const Sphere object_spheres[3] = {{-0.012f, 0.f, 0.f, 0.01f}, {0.012f, 0.f, 0.f, 0.01f}, {0.f, 0.f, -0.002f, 0.004f}};
+  const Sphere pad{0.f, 0.f, 0.f, 0.01f};
+  auto object = collette::build_sphere_tree(std::span<const Sphere>(object_spheres, 3));
+  auto tool = collette::build_sphere_tree(std::span<const Sphere>(&pad, 1));
+  ASSERT_TRUE(object.has_value() && tool.has_value());
+  controllers::Scene scene;
+  scene.name = "gap";
+  scene.source = "a packing with a gap";
+  controllers::SceneObject gap;
+  gap.name = "gap";
+  gap.shape.tree = std::make_shared<const collette::SphereTree>(std::move(*object));
+  scene.objects = {gap};
+  scene.watch = {"gap"};
+  scene.tool().shape.tree = std::make_shared<const collette::SphereTree>(std::move(*tool));
+  scene.force.proxy.enabled = true;
+  ExploreOptions o;
+  o.presses = 1;
+  o.stroke_legs = 0;
+  o.contour = ContourPath::kNone;
+  o.taps = 0;
+  o.max_seconds = 5.0;
+  controllers::SessionOptions session;
+  session.cache_dir = testing::TempDir();
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {  // the site moved by up to 3 mm
+    o.seed = seed;
+    auto explored = explore_scene(scene, "gap", o, session);
+    ASSERT_TRUE(explored.has_value()) << explored.error().message;
+    double pressed = 0.0;
+    for (const auto& sample : explored->front().trace.samples)
+      if (sample.phase == ExplorePhase::kPress) pressed = std::max(pressed, norm(sample.force));
+    EXPECT_GT(pressed, 0.5) << "seed " << seed;
+  }
 }
 
 }  // namespace

@@ -6,11 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <fmt/format.h>
 
 #include "uh/collette/ist_builder.hpp"
 #include "uh/collette/mesh_import.hpp"
+#include "uh/forcecomp/virtual_coupling.hpp"
 
 namespace uh::museum_artifacts {
 namespace {
@@ -130,6 +132,35 @@ TEST(MuseumArtifacts, TheDefaultPackingResolvesTheFinestTells) {
     EXPECT_GT(reach_b - reach_p, 0.5 * t.depth)
         << to_string(f.kind) << ": reach " << reach_b << " vs " << reach_p << " from 5 mm inside";
   }
+}
+
+// Through the proxy the stylus feels a material as the spring 2 pi r k, capped by the coupling's
+// passive stiffness: a stiffness tell is one a player feels only when both pieces lie below the
+// cap, and then it is felt at its ratio. The table renders through the proxy whatever the default.
+TEST(MuseumArtifacts, AStiffnessTellIsFeltThroughTheProxyAtItsRatio) {
+  controllers::SceneObject piece;
+  piece.name = "piece";
+  const controllers::Scene table = table_scene(piece, nullptr, 1000.0);
+  EXPECT_TRUE(table.force.proxy.enabled);
+  const forcecomp::VirtualCouplingOptions& c = table.force.coupling;
+  const double cap = std::min(c.stiffness, c.passivity_margin * forcecomp::max_passive_stiffness(
+                                                                   c.device_damping, 1.0 / table.haptic_hz, c.damping));
+  const auto felt = [cap](const forcecomp::Material& m) {
+    return std::min(cap, 2.0 * std::numbers::pi * kStylusRadiusM * m.stiffness);
+  };
+  int told = 0;
+  for (const ArtifactKind kind : kArtifactKinds) {
+    for (const Difficulty d : {Difficulty::easy, Difficulty::hard}) {
+      const MaterialTell t = material_tell(kind, d);
+      if (t.property != "stiffness") continue;
+      ++told;
+      const forcecomp::Material genuine = artifact_material(kind, d, Piece::genuine);
+      const forcecomp::Material forgery = artifact_material(kind, d, Piece::forgery);
+      EXPECT_LT(felt(genuine), cap) << to_string(kind);
+      EXPECT_NEAR(felt(forgery) / felt(genuine), t.ratio, 1e-9) << to_string(kind);
+    }
+  }
+  EXPECT_EQ(told, 2) << "the bowl's resin, at both levels";
 }
 
 TEST(MuseumArtifacts, ShapesAreWrittenOnceAndPackedAndCachedLikeSceneObjects) {

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -64,7 +65,10 @@ struct MaterialTell {
 MaterialTell material_tell(ArtifactKind kind, museum::Difficulty difficulty);
 
 /// What the piece's surface feels like: the kind's material (fired clay, bronze, stone, silver...),
-/// changed by material_tell() on a forgery.
+/// changed by material_tell() on a forgery. Through the proxy the stylus feels a material as the
+/// spring 2 pi r k (r = kStylusRadiusM), capped by the coupling's passive stiffness (1.5 kN/m at
+/// 1 kHz): every material stiffer than that feels the same, so a stiffness tell is made below it
+/// (the bowl's glaze and resin).
 forcecomp::Material artifact_material(ArtifactKind kind, museum::Difficulty difficulty, Piece piece);
 
 /// The piece as the numbers a station builds it from (museum::PieceForm: no label); the mesh and
@@ -103,5 +107,17 @@ Result<controllers::SceneObject> artifact_object(const museum::PieceForm& form,
                                                  const std::filesystem::path& cache_dir,
                                                  const std::string& name, const Pose& pose = {},
                                                  std::int64_t spheres = 10000);
+
+/// The stylus Phantom holds, at the station and in the blind player's hand: a ball of this radius [m].
+inline constexpr double kStylusRadiusM = 0.004;
+
+/// The scene of a piece on Phantom's table, felt with `tool` (a ball: the stylus, or a finger's
+/// pad) at `haptic_hz` (the collision thread at the same rate): the piece watched, the device and
+/// its settings left to the caller. Rendered through the 6-DOF proxy whatever the scene default
+/// is (ToolProxyOptions::enabled): the stylus stays on the side of the surface it came from, and
+/// what the hand feels (a shape, friction, a stiffness within what the coupling renders
+/// passively) is what a player is asked to judge. The station and the blind player both play on it.
+controllers::Scene table_scene(const controllers::SceneObject& piece,
+                               std::shared_ptr<const collette::SphereTree> tool, double haptic_hz);
 
 }  // namespace uh::museum_artifacts

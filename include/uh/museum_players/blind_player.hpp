@@ -42,7 +42,7 @@ struct SurfaceTrack {
 /// What the blind player read off one piece.
 struct PieceSurvey {
   exploration::MaterialEstimate material;  ///< from the press, strokes and contour on the top
-  /// Each pad press on the top: the force 0.8 mm past first contact over that depth [N/mm], by site
+  /// Each press on the top: the force 0.8 mm past first contact over that depth [N/mm], by site
   /// ("top press 1" ..)
   std::vector<std::pair<std::string, double>> site_stiffness;
   std::vector<SurfaceTrack> tracks;
@@ -52,9 +52,7 @@ struct PieceSurvey {
 
 /// Settings of the survey (options aggregate).
 struct SurveyOptions {
-  double tool_radius_m = 0.004;  ///< the stylus: a ball of this radius
-  double pad_radius_m =
-      0.01;  ///< the presses that feel the stiffness: a ball of this radius (a finger's pad)
+  double tool_radius_m = museum_artifacts::kStylusRadiusM;  ///< the stylus: a ball of this radius
   double haptic_hz = 1000.0;
   double ring_spacing_m = 0.008;     ///< side contours every this much of height [m]
   double max_piece_seconds = 240.0;  ///< budget of simulated time per piece [s]
@@ -62,8 +60,8 @@ struct SurveyOptions {
 };
 
 /// Explores `piece` (a scene object standing on its base, any turn about the vertical) with the
-/// stylus. Sites: the top (press, four strokes, a circle, taps: the material); 24 presses with
-/// a finger's pad on two rings round the top's middle (the stiffness); a raster of long
+/// stylus. Sites: the top (press, four strokes, a circle, taps: the material); 12 presses with
+/// the stylus on two rings round the top's middle (the stiffness); a raster of long
 /// strokes over the top of a flat piece; on a piece with a round footprint, contours once around
 /// it at heights every `ring_spacing_m` and strokes up and down its side.
 Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const SurveyOptions& options,
