@@ -571,6 +571,7 @@ Status HapticSession::stop() {
   for (auto& rig : rigs_) rig->manager->stop();
   stop_soft();
   world_->stop();
+  record_proxy_ends();
   // the haptic threads are joined and the devices got zero: this thread becomes the states' writer
   for (std::size_t t = 0; t < rigs_.size(); ++t) {
     SessionState last = state(t);
@@ -679,6 +680,7 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   drain();
   collision_hz_ = haptic_hz_ / ticks_per_collision_step;
   collect_report(static_cast<double>(k) / haptic_hz_, true);
+  record_proxy_ends();
   publish_report();
   report_.stopped_early = k < ticks;
   phase_ = Phase::kStopped;
@@ -733,10 +735,14 @@ void HapticSession::collect_tool_report(ToolRig& rig, bool stepped) {
   t.model_error_max_n = fc.model_error_max_n;
   t.coupling = fcon.options().use_coupling;
   t.proxy = rig.proxy != nullptr;
-  if (rig.proxy) {
-    t.proxy_stats = rig.proxy->stats();
-    t.proxy_position = rig.proxy->pose().position;
-  }
+  if (rig.proxy) t.proxy_stats = rig.proxy->stats();  // atomics: read while the collision thread runs
+}
+
+// Where each tool's proxy ended: its pose belongs to the collision thread, so it is read once that
+// thread has stopped (or in a stepped run, after its last step).
+void HapticSession::record_proxy_ends() {
+  for (auto& rig : rigs_)
+    if (rig->proxy) rig->report.proxy_position = rig->proxy->pose().position;
 }
 
 void HapticSession::collect_report(double seconds, bool stepped) {

@@ -320,6 +320,7 @@ class HapticSession {
   // trace is taken) the tools' reports into report_
   void collect_tool_report(ToolRig& rig, bool stepped);
   void collect_report(double seconds, bool stepped);
+  void record_proxy_ends();
   void publish_report();
   void take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
   void monitor(std::stop_token stop);
