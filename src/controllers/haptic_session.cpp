@@ -524,6 +524,10 @@ bool HapticSession::any_fault() const {
   return std::any_of(rigs_.begin(), rigs_.end(), [](const auto& rig) { return rig->manager->faulted(); });
 }
 
+bool HapticSession::soft_threads_running() const {
+  return std::all_of(soft_.begin(), soft_.end(), [](const auto& soft) { return !soft || soft->running(); });
+}
+
 bool HapticSession::haptic_threads_running() const {
   return std::all_of(rigs_.begin(), rigs_.end(), [](const auto& rig) { return rig->manager->running(); });
 }
@@ -626,9 +630,10 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
                                std::chrono::duration<double>(seconds));
   auto next_status = begin + std::chrono::milliseconds(250);
   // a stop request is seen within 20 ms; a thread that ended by itself (the haptic one has sent
-  // zero already), or a device fault (every device gets zero from its next tick on), ends the run
+  // zero already; a soft object's simulation leaves its object frozen), or a device fault (every
+  // device gets zero from its next tick on), ends the run
   while (std::chrono::steady_clock::now() < end && !stop_requested_.load(std::memory_order_relaxed) &&
-         haptic_threads_running() && world_->running() && !any_fault()) {
+         haptic_threads_running() && world_->running() && soft_threads_running() && !any_fault()) {
     const auto soon = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
     std::this_thread::sleep_until(std::min({end, next_status, soon}));
     if (on_status && std::chrono::steady_clock::now() >= next_status) {

@@ -332,6 +332,7 @@ class HapticSession {
   void stop_soft();
   Status soft_error() const;
   bool haptic_threads_running() const;
+  bool soft_threads_running() const;
   Status device_error() const;
   Status thread_error() const;
   std::string tool_label(std::int32_t tool) const;

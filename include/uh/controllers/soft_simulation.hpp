@@ -67,6 +67,8 @@ class SoftSimulation {
   /// Runs step() at `rate_hz` on its own thread until stop(). Controlling thread.
   Status start(double rate_hz);
   void stop();
+  /// Whether the simulation thread runs (true before start()): a failed step ends it.
+  bool running() const { return !loop_ || loop_->running(); }
   /// The simulation thread's failure (a step that failed ends the thread), once it stopped.
   Status failure() const { return failure_; }
   FixedRateLoopStats stats() const { return loop_ ? loop_->stats() : FixedRateLoopStats{}; }
