@@ -34,6 +34,17 @@ double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::Co
   return 2.0 * std::numbers::pi * radius * material.stiffness;
 }
 
+// Through the proxy a tool rests on an object's mesh, which lies up to the packing's surface gap G
+// above its spheres, and a tool sphere gets its surface row from a pair within the margin (step_m).
+// The world reports the object's pairs G - step_m / 2 farther, so that the row comes before the
+// tool reaches the mesh when it moves up to half a step per step; the full G would cover a whole
+// step, but the default session's queries took three times as long (docs/forcecomp.md).
+double proxy_surface_margin(const SessionModel& model, std::size_t object) {
+  const CompiledShape& o = model.objects[object];
+  if (!model.scene.force.proxy.enabled || !o.surface || o.soft) return 0.0;
+  return std::max(0.0, o.surface_gap_m - 0.5 * model.scene.force.proxy.step_m);
+}
+
 }  // namespace
 
 Scene with_session_options(const Scene& scene, const SessionOptions& options) {
@@ -178,7 +189,8 @@ Status HapticSession::add_objects(const SessionRunOptions& options) {
                                   .world_from_object = object.pose,
                                   .coverage = model_->objects[i].coverage,
                                   .name = object.name,
-                                  .deformed_trees = soft ? &soft->trees() : nullptr});
+                                  .deformed_trees = soft ? &soft->trees() : nullptr,
+                                  .extra_margin_m = proxy_surface_margin(*model_, i)});
     if (!id) return id.error();
     object_ids_.push_back(*id);
   }
