@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 
@@ -36,7 +37,7 @@ constexpr double kDt = 1.0 / 200.0;
 class SwungBlock {
  public:
   explicit SwungBlock(CorotationalFem fem) : fem_(std::move(fem)), loads_(fem_.mesh().nodes.size(), Eigen::Vector3d::Zero()) {
-    double top = -INFINITY;
+    double top = -std::numeric_limits<double>::infinity();
     for (const Eigen::Vector3d& node : fem_.mesh().nodes) top = std::max(top, node.z());
     for (std::size_t i = 0; i < fem_.mesh().nodes.size(); ++i) {
       if (fem_.mesh().nodes[i].z() > top - 1e-9) top_.push_back(static_cast<std::int32_t>(i));

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -34,7 +35,6 @@ namespace {
 constexpr double kYoung = 1.0e4;  // [Pa]
 constexpr double kPoisson = 0.3;
 constexpr double kRadius = 0.03;     // [m], the sphere
-constexpr double kHalfWidth = 0.05;  // [m], the quarter block [0, w]^2 x [-w, 0]
 
 double hertz_force(double depth) {
   const double reduced = kYoung / (1.0 - kPoisson * kPoisson);
@@ -70,7 +70,7 @@ struct Block {
 
 // the shortest cell edge of the lattice (the cells' sides are the axis-aligned edges)
 double finest_cell(const TetMesh& mesh) {
-  double finest = INFINITY;
+  double finest = std::numeric_limits<double>::infinity();
   for (const auto& t : mesh.tets) {
     for (std::size_t i = 0; i < 4; ++i) {
       for (std::size_t j = i + 1; j < 4; ++j) {

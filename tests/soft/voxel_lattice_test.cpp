@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -141,7 +142,7 @@ TEST(VoxelLattice, RejectsABadRefinement) {
   const auto everywhere = [](const Eigen::Vector3d&) { return true; };
   for (const LatticeRefinement& bad : {LatticeRefinement{.growth_ratio = 0.9}, LatticeRefinement{.growth_ratio = 3.0},
                                        LatticeRefinement{.fine_half_width_m = -1.0},
-                                       LatticeRefinement{.point = Eigen::Vector3d(NAN, 0.0, 0.0)}}) {
+                                       LatticeRefinement{.point = Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0)}}) {
     const auto mesh = build_voxel_lattice(everywhere, {.refinement = bad});
     ASSERT_FALSE(mesh);
     EXPECT_EQ(mesh.error().kind, ErrorKind::kInvalid);
