@@ -1,11 +1,30 @@
 #include "uh/controllers/soft_simulation.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <utility>
 
 #include <fmt/format.h>
 
 namespace uh::controllers {
+namespace {
+
+// A pair's gap at the poses of its query: centre distance less both radii [m] (< 0: overlapping).
+double pair_gap(const SpherePairContact& p, const ContactSection& s) {
+  const auto centre = [](const Sphere& x) {
+    return Vec3{static_cast<double>(x.x), static_cast<double>(x.y), static_cast<double>(x.z)};
+  };
+  const Vec3 a = transform_point(s.world_from_a, centre(p.sphere_a_local));
+  const Vec3 b = transform_point(s.world_from_b, centre(p.sphere_b_local));
+  return norm(b - a) - static_cast<double>(p.sphere_a_local.radius) - static_cast<double>(p.sphere_b_local.radius);
+}
+
+std::span<const SpherePairContact> section_pairs(const ContactFrame& frame, const ContactSection& s) {
+  return frame.pairs().subspan(static_cast<std::size_t>(s.first_pair), static_cast<std::size_t>(s.pair_count));
+}
+
+}  // namespace
 
 Result<std::unique_ptr<SoftSimulation>> SoftSimulation::create(std::shared_ptr<const soft::SoftBodyModel> body,
                                                                std::shared_ptr<const collette::SphereTree> rest_tree,
@@ -32,26 +51,35 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
     contacts_.push_back(std::make_unique<LatestValue<SoftContacts>>());
     tool_forces_.push_back(std::make_unique<LatestValue<Vec3>>());
   }
+  proxy_smoothing_m_.assign(tools, 0.0);
+}
+
+void SoftSimulation::rest_on_proxy(std::size_t tool, double smoothing_m) {
+  proxy_smoothing_m_[tool] = std::max(smoothing_m, 1e-6);
 }
 
 void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame) {
   // another object's own frame says nothing of this one (a tool against everything says all)
   if (frame.object_a != object && frame.object_a != ContactFrame::kEveryObject) return;
-  std::span<const SpherePairContact> pairs;
-  double share = 0.0;
-  if (frame.object_a == object) {
-    pairs = frame.pairs();
-    share = 1.0;
-  } else if (frame.object_a == ContactFrame::kEveryObject) {
-    for (const ContactSection& s : frame.sections()) {
-      if (s.object_a != object) continue;
-      pairs = frame.pairs().subspan(static_cast<std::size_t>(s.first_pair), static_cast<std::size_t>(s.pair_count));
-      share = frame.total_volume > 0.0 ? s.total_volume / frame.total_volume : 0.0;
-    }
-  }
   SoftContacts& out = contacts_[tool]->write_buffer();
   out.count = 0;
-  out.share = share;
+  out.share = 0.0;
+  if (proxy_smoothing_m_[tool] > 0.0) {
+    weigh_by_nearness(proxy_smoothing_m_[tool], object, frame, out);
+    contacts_[tool]->publish();
+    return;
+  }
+  std::span<const SpherePairContact> pairs;
+  if (frame.object_a == object) {
+    pairs = frame.pairs();
+    out.share = 1.0;
+  } else {
+    for (const ContactSection& s : frame.sections()) {
+      if (s.object_a != object) continue;
+      pairs = section_pairs(frame, s);
+      out.share = frame.total_volume > 0.0 ? s.total_volume / frame.total_volume : 0.0;
+    }
+  }
   for (const SpherePairContact& p : pairs) {
     if (out.count == SoftContacts::kCapacity) break;
     if (!(p.volume > 0.f) || p.leaf_a < 0 || static_cast<std::size_t>(p.leaf_a) >= body_->spheres.size()) continue;
@@ -62,10 +90,41 @@ void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const 
   contacts_[tool]->publish();
 }
 
+// Through a proxy: the proxy rests on the soft minimum of its pairs' gaps (ToolProxy), whose
+// gradient gives each pair exp(-gap / e) over the sum, so each pair takes that share of the force
+// holding the proxy. The frame's pairs are those within the margin; a pair more than 7 e (1.4 mm
+// at e = 0.2 mm) farther than the nearest takes under 0.1 % of the nearest's and is left out, so
+// the buffer holds those that matter. The object's share is its pairs' weight over the frame's.
+void SoftSimulation::weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame,
+                                       SoftContacts& out) const {
+  constexpr double kLeftOut = 1e-3;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const ContactSection& s : frame.sections())
+    for (const SpherePairContact& p : section_pairs(frame, s)) nearest = std::min(nearest, pair_gap(p, s));
+  double all = 0.0, mine = 0.0;
+  for (const ContactSection& s : frame.sections()) {
+    const bool this_object = s.object_a == object;
+    for (const SpherePairContact& p : section_pairs(frame, s)) {
+      const double w = std::exp(-(pair_gap(p, s) - nearest) / smoothing_m);
+      all += w;
+      if (!this_object) continue;
+      mine += w;
+      if (w < kLeftOut || out.count == SoftContacts::kCapacity || p.leaf_a < 0 ||
+          static_cast<std::size_t>(p.leaf_a) >= body_->spheres.size())
+        continue;
+      out.leaves[static_cast<std::size_t>(out.count)] = p.leaf_a;
+      out.weights[static_cast<std::size_t>(out.count)] = static_cast<float>(w);
+      ++out.count;
+    }
+  }
+  out.share = all > 0.0 ? mine / all : 0.0;
+}
+
 void SoftSimulation::post_tool_force(std::size_t tool, const Vec3& force_world) { tool_forces_[tool]->write(force_world); }
 
 // Each tool's felt force, this object's share of it, back on the object's contact spheres with
-// the opposite sign, spread by their overlap volumes: the loads sum to minus what the tools felt.
+// the opposite sign, spread by their weights (overlap volumes, or nearness through a proxy): the
+// loads sum to minus what the tools felt.
 void SoftSimulation::gather_loads() {
   std::fill(loads_.begin(), loads_.end(), Eigen::Vector3d::Zero());
   for (std::size_t t = 0; t < contacts_.size(); ++t) {

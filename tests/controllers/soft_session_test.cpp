@@ -1,5 +1,6 @@
 // A soft block in a session (issue 26): scenes/soft_block.json's block, its base held, pressed by
-// its 1 cm ball on a sim-line, in simulated time (run_stepped: the soft steps every 10 ticks).
+// its 1 cm ball on a sim-line, in simulated time (run_stepped: the soft steps every 10 ticks),
+// through the 6-DOF proxy (the scene's default) and on the penalty path:
 // - the loads on the block's nodes sum to minus the force the ball felt (the tick before the
 //   step), as the session's own published state says it;
 // - the block gives: pressed deeper, the ball feels more force and the block's top goes down
@@ -18,6 +19,7 @@
 namespace uh::controllers {
 namespace {
 
+using testing::Path;
 using testing::soft_block;
 
 struct Press {
@@ -25,10 +27,10 @@ struct Press {
   double indentation_m = 0.0;  // the largest downward displacement of a node of the block [m]
 };
 
-Press press(double depth_m, bool soft = true) {
+Press press(double depth_m, bool soft, Path path) {
   SessionOptions options;
   options.cache_dir = testing::fresh_cache("soft-session");
-  auto session = HapticSession::create(soft_block(depth_m, soft), options);
+  auto session = HapticSession::create(soft_block(depth_m, soft, path), options);
   EXPECT_TRUE(session.has_value()) << session.error().message;
   std::vector<Vec3> forces;
   auto seen = (*session)->on_haptic_tick().connect([&](const SessionState& s) { forces.push_back(s.force_world); });
@@ -50,22 +52,28 @@ Press press(double depth_m, bool soft = true) {
   return out;
 }
 
-TEST(SoftSession, TheBlockGivesUnderTheBallAndTakesWhatTheBallFelt) {
-  const Press shallow = press(0.002);
-  const Press deep = press(0.004);
-  const Press rigid = press(0.004, false);
-  RecordProperty("force_shallow_n", std::to_string(shallow.force_n));
-  RecordProperty("force_deep_n", std::to_string(deep.force_n));
-  RecordProperty("indentation_shallow_m", std::to_string(shallow.indentation_m));
-  RecordProperty("indentation_deep_m", std::to_string(deep.indentation_m));
+void expect_the_block_gives(Path path, const char* name) {
+  const Press shallow = press(0.002, true, path);
+  const Press deep = press(0.004, true, path);
+  const Press rigid = press(0.004, false, path);
+  ::testing::Test::RecordProperty("force_shallow_n", std::to_string(shallow.force_n));
+  ::testing::Test::RecordProperty("force_deep_n", std::to_string(deep.force_n));
+  ::testing::Test::RecordProperty("indentation_shallow_m", std::to_string(shallow.indentation_m));
+  ::testing::Test::RecordProperty("indentation_deep_m", std::to_string(deep.indentation_m));
   EXPECT_GT(shallow.force_n, 0.2);
   EXPECT_GT(deep.force_n, shallow.force_n * 1.2);
   EXPECT_GT(shallow.indentation_m, 1e-4);
   EXPECT_GT(deep.indentation_m, shallow.indentation_m * 1.2);
-  // the same press on a rigid block: the ball goes deeper into the spheres, and feels more
+  // the same press on a rigid block: the ball stops higher, and feels more
   EXPECT_GT(rigid.force_n, deep.force_n * 1.05);
-  std::printf("shallow %.3f N %.3f mm, deep %.3f N %.3f mm, rigid %.3f N\n", shallow.force_n,
+  std::printf("%s: shallow %.3f N %.3f mm, deep %.3f N %.3f mm, rigid %.3f N\n", name, shallow.force_n,
               shallow.indentation_m * 1e3, deep.force_n, deep.indentation_m * 1e3, rigid.force_n);
+}
+
+TEST(SoftSession, TheBlockGivesUnderTheBallAndTakesWhatTheBallFelt) { expect_the_block_gives(Path::kProxy, "proxy"); }
+
+TEST(SoftSession, OnThePenaltyPathTooTheBlockGivesAndTakesWhatTheBallFelt) {
+  expect_the_block_gives(Path::kPenalty, "penalty");
 }
 
 }  // namespace
