@@ -8,10 +8,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <vector>
 
+#include "hand_energy_support.hpp"
 #include "scene_test_support.hpp"
 #include "soft_block_support.hpp"
 #include "uh/controllers/haptic_session.hpp"
@@ -74,6 +77,55 @@ TEST(SoftSession, TheBlockGivesUnderTheBallAndTakesWhatTheBallFelt) { expect_the
 
 TEST(SoftSession, OnThePenaltyPathTooTheBlockGivesAndTakesWhatTheBallFelt) {
   expect_the_block_gives(Path::kPenalty, "penalty");
+}
+
+struct HandPress {
+  SessionReport report;
+  double lowest_m = 1.0;  // the ball's (the proxy's) lowest centre [m]; the rest top face is at 0
+};
+
+HandPress hand_press(double told_damping) {
+  SessionOptions options;
+  options.cache_dir = testing::fresh_cache("soft-hand");
+  const Scene scene = testing::soft_block_hand_press(told_damping);
+  auto session = HapticSession::create(scene, options);
+  EXPECT_TRUE(session.has_value()) << session.error().message;
+  HandPress out;
+  auto seen = (*session)->on_haptic_tick().connect(
+      [&](const SessionState& s) { out.lowest_m = std::min(out.lowest_m, s.tool_position_world.z); });
+  EXPECT_TRUE((*session)->run_stepped(scene.seconds, 1).has_value());
+  out.report = (*session)->report();
+  std::filesystem::remove_all(options.cache_dir);
+  return out;
+}
+
+// Passivity on a soft block (as ToolProxy.RepeatedPressesPutNoEnergyIntoAReactingHand on the rigid
+// bunny): a simulated hand presses the ball into the block through the proxy and releases it,
+// twice; the proxy rests on a surface that moves (down under the ball, back up on release), the
+// block stores energy and gives it back. Over the closed presses no energy reaches the hand
+// through the handle, and the motors' gain is within the zero-order hold's (K T / 2 per squared
+// speed). Told ten times the device's damping, the clamp lets a spring 9x too stiff through and the
+// same presses put energy into the hand: the measure sees it.
+TEST(SoftSession, RepeatedPressesOnTheSoftBlockPutNoEnergyIntoAReactingHand) {
+  constexpr double kHandDamping = 1.0;  // the sim-hand's, as soft_block_hand_press sets it
+  const HandPress p = hand_press(kHandDamping);
+  const SessionReport& r = p.report;
+  const double into_hand = testing::energy_into_hand(r, kHandDamping);
+  std::printf("soft block: motors' work %+.3f mJ, the device's damping in contact %.3f mJ, into the hand %+.3f mJ, "
+              "force up to %.2f N, the ball down to %.2f mm\n",
+              r.work_on_hand_j * 1e3, kHandDamping * r.contact_squared_speed_integral * 1e3, into_hand * 1e3,
+              r.force_max_n, p.lowest_m * 1e3);
+  EXPECT_GT(r.proxy_stats.contact_updates, 200u) << "the presses reach the block";
+  EXPECT_GT(r.force_max_n, 1.0) << "and are pushed back";
+  EXPECT_LT(p.lowest_m, 0.01 - 0.002) << "the block gives: the ball goes 2 mm below its rest top face";
+  EXPECT_LE(into_hand, 0.0);
+  EXPECT_LE(r.work_on_hand_j, 0.9 * kHandDamping * r.contact_squared_speed_integral);
+
+  const HandPress too_stiff = hand_press(10.0 * kHandDamping);
+  const double too_stiff_into_hand = testing::energy_into_hand(too_stiff.report, kHandDamping);
+  std::printf("told 10x the damping: motors' work %+.3f mJ, into the hand %+.3f mJ\n",
+              too_stiff.report.work_on_hand_j * 1e3, too_stiff_into_hand * 1e3);
+  EXPECT_GT(too_stiff_into_hand, 0.0);
 }
 
 }  // namespace
