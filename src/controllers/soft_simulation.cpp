@@ -46,10 +46,13 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
       fem_(std::move(fem)),
       object_from_world_(conjugate(world_from_object.rotation)),
       loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
+      unit_loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
+      unit_moves_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()) {
   for (std::size_t t = 0; t < tools; ++t) {
     contacts_.push_back(std::make_unique<LatestValue<SoftContacts>>());
     tool_forces_.push_back(std::make_unique<LatestValue<Vec3>>());
+    compliances_.push_back(std::make_unique<LatestValue<ContactCompliance>>());
   }
   proxy_smoothing_m_.assign(tools, 0.0);
 }
@@ -122,30 +125,61 @@ void SoftSimulation::weigh_by_nearness(double smoothing_m, std::int32_t object, 
 
 void SoftSimulation::post_tool_force(std::size_t tool, const Vec3& force_world) { tool_forces_[tool]->write(force_world); }
 
+// `force_world` (a load on the object) over tool `tool`'s contact spheres by their weights, and
+// each sphere's part to its tetrahedron's nodes, added to `loads`; false when it has no contact.
+bool SoftSimulation::spread_tool_force(std::size_t tool, const Vec3& force_world,
+                                       std::vector<Eigen::Vector3d>& loads) const {
+  const SoftContacts& c = contacts_[tool]->read_buffer();
+  double total = 0.0;
+  for (std::int32_t i = 0; i < c.count; ++i) total += static_cast<double>(c.weights[static_cast<std::size_t>(i)]);
+  if (!(total > 0.0)) return false;
+  const Vec3 f = rotate(object_from_world_, force_world) / total;
+  const Eigen::Vector3d per_weight(f.x, f.y, f.z);
+  for (std::int32_t i = 0; i < c.count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    soft::spread_sphere_force(*body_, c.leaves[k], static_cast<double>(c.weights[k]) * per_weight, loads);
+  }
+  return true;
+}
+
 // Each tool's felt force, this object's share of it, back on the object's contact spheres with
-// the opposite sign, spread by their weights (overlap volumes, or nearness through a proxy): the
-// loads sum to minus what the tools felt.
+// the opposite sign (spread_tool_force): the loads sum to minus what the tools felt.
 void SoftSimulation::gather_loads() {
   std::fill(loads_.begin(), loads_.end(), Eigen::Vector3d::Zero());
   for (std::size_t t = 0; t < contacts_.size(); ++t) {
     contacts_[t]->update();
     tool_forces_[t]->update();
-    const SoftContacts& c = contacts_[t]->read_buffer();
-    double total = 0.0;
-    for (std::int32_t i = 0; i < c.count; ++i) total += static_cast<double>(c.weights[static_cast<std::size_t>(i)]);
-    if (!(total > 0.0) || !tool_forces_[t]->has_value()) continue;
-    const Vec3 f = rotate(object_from_world_, tool_forces_[t]->read_buffer()) * (-c.share / total);
-    const Eigen::Vector3d per_volume(f.x, f.y, f.z);
-    for (std::int32_t i = 0; i < c.count; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      soft::spread_sphere_force(*body_, c.leaves[k], static_cast<double>(c.weights[k]) * per_volume, loads_);
-    }
+    if (tool_forces_[t]->has_value())
+      spread_tool_force(t, tool_forces_[t]->read_buffer() * -contacts_[t]->read_buffer().share, loads_);
   }
+}
+
+// For each tool, the force this step took and how far its contact will move per newton more in the
+// next one: a unit load along the step's, spread as the step's was, through the step's system
+// (CorotationalFem::step_response); the load-weighted mean of the moves along it.
+Status SoftSimulation::publish_compliances() {
+  for (std::size_t t = 0; t < compliances_.size(); ++t) {
+    ContactCompliance& out = compliances_[t]->write_buffer();
+    out = {};
+    const Vec3 felt = tool_forces_[t]->has_value() ? tool_forces_[t]->read_buffer() : Vec3{};
+    const double share = contacts_[t]->read_buffer().share;
+    const double magnitude = norm(felt);
+    std::fill(unit_loads_.begin(), unit_loads_.end(), Eigen::Vector3d::Zero());
+    if (magnitude > 0.0 && share > 0.0 && spread_tool_force(t, felt * (-1.0 / magnitude), unit_loads_)) {
+      if (Status s = fem_.step_response(unit_loads_, unit_moves_); !s) return s;
+      double compliance = 0.0;
+      for (std::size_t n = 0; n < unit_loads_.size(); ++n) compliance += unit_loads_[n].dot(unit_moves_[n]);
+      out = {.force_world = felt * share, .share = share, .compliance_m_per_n = std::max(compliance, 0.0)};
+    }
+    compliances_[t]->publish();
+  }
+  return Ok{};
 }
 
 Status SoftSimulation::step(double dt_s) {
   gather_loads();
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
+  if (Status s = publish_compliances(); !s) return s;
   soft::deform_spheres(*body_, fem_.positions(), spheres_);
   collette::SphereTree& tree = trees_.write_buffer();
   // a slot the reader never handed back before holds no tree yet: it gets the rest tree once

@@ -28,6 +28,7 @@ using testing::soft_block;
 struct Press {
   double force_n = 0.0;        // the ball's force at the end [N]
   double indentation_m = 0.0;  // the largest downward displacement of a node of the block [m]
+  double largest_step_n = 0.0; // the largest tick-to-tick change of the force [N]
 };
 
 Press press(double depth_m, bool soft, Path path) {
@@ -40,6 +41,7 @@ Press press(double depth_m, bool soft, Path path) {
   EXPECT_TRUE((*session)->run_stepped(1.0, 1).has_value());
   Press out;
   out.force_n = norm(forces.at(989));  // the run ends by sending zero: a tick before its end
+  for (std::size_t k = 1; k < 990; ++k) out.largest_step_n = std::max(out.largest_step_n, norm(forces[k] - forces[k - 1]));
   const SoftSimulation* sim = (*session)->soft_simulation(0);
   if (sim == nullptr) return out;
   const auto& rest = sim->body().mesh.nodes;
@@ -69,8 +71,15 @@ void expect_the_block_gives(Path path, const char* name) {
   EXPECT_GT(deep.indentation_m, shallow.indentation_m * 1.2);
   // the same press on a rigid block: the ball stops higher, and feels more
   EXPECT_GT(rigid.force_n, deep.force_n * 1.05);
-  std::printf("%s: shallow %.3f N %.3f mm, deep %.3f N %.3f mm, rigid %.3f N\n", name, shallow.force_n,
-              shallow.indentation_m * 1e3, deep.force_n, deep.indentation_m * 1e3, rigid.force_n);
+  // through the proxy the object's compliance is in the spring between its steps: the force does
+  // not step at the simulation's 100 Hz (0.077 N without it, 2.7 times the rigid block's largest)
+  if (path == Path::kProxy) {
+    EXPECT_LT(deep.largest_step_n, 1.5 * rigid.largest_step_n);
+  }
+  std::printf("%s: shallow %.3f N %.3f mm, deep %.3f N %.3f mm, rigid %.3f N; largest tick-to-tick step %.3f N "
+              "soft, %.3f N rigid\n",
+              name, shallow.force_n, shallow.indentation_m * 1e3, deep.force_n, deep.indentation_m * 1e3, rigid.force_n,
+              deep.largest_step_n, rigid.largest_step_n);
 }
 
 TEST(SoftSession, TheBlockGivesUnderTheBallAndTakesWhatTheBallFelt) { expect_the_block_gives(Path::kProxy, "proxy"); }
@@ -84,16 +93,17 @@ struct HandPress {
   double lowest_m = 1.0;  // the ball's (the proxy's) lowest centre [m]; the rest top face is at 0
 };
 
-HandPress hand_press(double told_damping) {
+HandPress hand_press(double told_damping, double haptic_hz) {
   SessionOptions options;
   options.cache_dir = testing::fresh_cache("soft-hand");
+  options.haptic_hz = haptic_hz;
   const Scene scene = testing::soft_block_hand_press(told_damping);
   auto session = HapticSession::create(scene, options);
   EXPECT_TRUE(session.has_value()) << session.error().message;
   HandPress out;
   auto seen = (*session)->on_haptic_tick().connect(
       [&](const SessionState& s) { out.lowest_m = std::min(out.lowest_m, s.tool_position_world.z); });
-  EXPECT_TRUE((*session)->run_stepped(scene.seconds, 1).has_value());
+  EXPECT_TRUE((*session)->run_stepped(scene.seconds, static_cast<int>(haptic_hz / 1000.0)).has_value());
   out.report = (*session)->report();
   std::filesystem::remove_all(options.cache_dir);
   return out;
@@ -108,20 +118,25 @@ HandPress hand_press(double told_damping) {
 // same presses put energy into the hand: the measure sees it.
 TEST(SoftSession, RepeatedPressesOnTheSoftBlockPutNoEnergyIntoAReactingHand) {
   constexpr double kHandDamping = 1.0;  // the sim-hand's, as soft_block_hand_press sets it
-  const HandPress p = hand_press(kHandDamping);
-  const SessionReport& r = p.report;
-  const double into_hand = testing::energy_into_hand(r, kHandDamping);
-  std::printf("soft block: motors' work %+.3f mJ, the device's damping in contact %.3f mJ, into the hand %+.3f mJ, "
-              "force up to %.2f N, the ball down to %.2f mm\n",
-              r.work_on_hand_j * 1e3, kHandDamping * r.contact_squared_speed_integral * 1e3, into_hand * 1e3,
-              r.force_max_n, p.lowest_m * 1e3);
-  EXPECT_GT(r.proxy_stats.contact_updates, 200u) << "the presses reach the block";
-  EXPECT_GT(r.force_max_n, 1.0) << "and are pushed back";
-  EXPECT_LT(p.lowest_m, 0.01 - 0.002) << "the block gives: the ball goes 2 mm below its rest top face";
-  EXPECT_LE(into_hand, 0.0);
-  EXPECT_LE(r.work_on_hand_j, 0.9 * kHandDamping * r.contact_squared_speed_integral);
-
-  const HandPress too_stiff = hand_press(10.0 * kHandDamping);
+  // at 1 kHz; at 4 kHz (a coupling four times stiffer against a surface that moves at 100 Hz) the
+  // same presses put +0.5 mJ into the hand (+24 mJ without the object's compliance in the spring):
+  // docs/deformables.md, "Not yet"
+  {
+    const double hz = 1000.0;
+    const HandPress p = hand_press(kHandDamping, hz);
+    const SessionReport& r = p.report;
+    const double into_hand = testing::energy_into_hand(r, kHandDamping);
+    std::printf("%.0f Hz: motors' work %+.3f mJ, the device's damping in contact %.3f mJ, into the hand %+.3f mJ, "
+                "force up to %.2f N, largest step %.3f N, the ball down to %.2f mm\n",
+                hz, r.work_on_hand_j * 1e3, kHandDamping * r.contact_squared_speed_integral * 1e3, into_hand * 1e3,
+                r.force_max_n, r.force_max_step_n, p.lowest_m * 1e3);
+    EXPECT_GT(r.proxy_stats.contact_updates, 200u) << hz << " Hz: the presses reach the block";
+    EXPECT_GT(r.force_max_n, 1.0) << hz << " Hz: and are pushed back";
+    EXPECT_LT(p.lowest_m, 0.01 - 0.002) << hz << " Hz: the block gives: the ball goes 2 mm below its rest top face";
+    EXPECT_LE(into_hand, 0.0) << hz << " Hz";
+    EXPECT_LE(r.work_on_hand_j, 0.9 * kHandDamping * r.contact_squared_speed_integral) << hz << " Hz";
+  }
+  const HandPress too_stiff = hand_press(10.0 * kHandDamping, 1000.0);
   const double too_stiff_into_hand = testing::energy_into_hand(too_stiff.report, kHandDamping);
   std::printf("told 10x the damping: motors' work %+.3f mJ, into the hand %+.3f mJ\n",
               too_stiff.report.work_on_hand_j * 1e3, too_stiff_into_hand * 1e3);

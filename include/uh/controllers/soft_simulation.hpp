@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "uh/collette/sphere_tree.hpp"
+#include "uh/controllers/contact_compliance.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/fixed_rate_loop.hpp"
 #include "uh/core/latest_value.hpp"
@@ -67,6 +68,9 @@ class SoftSimulation {
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
+  /// What each step tells tool `tool`'s haptic thread (its only reader) of the contact: the force
+  /// the step took and the object's compliance there (ForceController::feel_compliance_of).
+  LatestValue<ContactCompliance>& compliance(std::size_t tool) { return *compliances_[tool]; }
 
   /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree.
   Status step(double dt_s);
@@ -91,6 +95,8 @@ class SoftSimulation {
   SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body, std::shared_ptr<const collette::SphereTree> rest_tree,
                  soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools);
   void gather_loads();
+  bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
+  Status publish_compliances();
   void weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame, SoftContacts& out) const;
 
   std::shared_ptr<const soft::SoftBodyModel> body_;
@@ -101,7 +107,9 @@ class SoftSimulation {
   std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<double> proxy_smoothing_m_;  // per tool: 0 weighs pairs by overlap, > 0 by nearness
+  std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: simulation -> haptic
   std::vector<Eigen::Vector3d> loads_;
+  std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of publish_compliances
   std::vector<Sphere> spheres_;
   std::unique_ptr<FixedRateLoop> loop_;  // made by start()
   Status failure_ = Ok{};
