@@ -10,15 +10,24 @@
 namespace uh::controllers {
 namespace {
 
-// A pair's gap at the poses of its query: centre distance less both radii [m] (< 0: overlapping).
-double pair_gap(const SpherePairContact& p, const ContactSection& s) {
+// A pair at the poses of its query: its gap, centre distance less both radii [m] (< 0:
+// overlapping), and the unit normal from the object's sphere to the tool's.
+struct PairGeometry {
+  double gap = 0.0;
+  Vec3 normal{};
+};
+PairGeometry pair_geometry(const SpherePairContact& p, const ContactSection& s) {
   const auto centre = [](const Sphere& x) {
     return Vec3{static_cast<double>(x.x), static_cast<double>(x.y), static_cast<double>(x.z)};
   };
   const Vec3 a = transform_point(s.world_from_a, centre(p.sphere_a_local));
   const Vec3 b = transform_point(s.world_from_b, centre(p.sphere_b_local));
-  return norm(b - a) - static_cast<double>(p.sphere_a_local.radius) - static_cast<double>(p.sphere_b_local.radius);
+  const double distance = norm(b - a);
+  return {.gap = distance - static_cast<double>(p.sphere_a_local.radius) - static_cast<double>(p.sphere_b_local.radius),
+          .normal = distance > 0.0 ? (b - a) / distance : Vec3{}};
 }
+
+Vec3 unit_or_zero(const Vec3& v) { return norm(v) > 0.0 ? v / norm(v) : Vec3{}; }
 
 std::span<const SpherePairContact> section_pairs(const ContactFrame& frame, const ContactSection& s) {
   return frame.pairs().subspan(static_cast<std::size_t>(s.first_pair), static_cast<std::size_t>(s.pair_count));
@@ -67,6 +76,7 @@ void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const 
   SoftContacts& out = contacts_[tool]->write_buffer();
   out.count = 0;
   out.share = 0.0;
+  out.normal_world = {};
   if (proxy_smoothing_m_[tool] > 0.0) {
     weigh_by_nearness(proxy_smoothing_m_[tool], object, frame, out);
     contacts_[tool]->publish();
@@ -83,13 +93,18 @@ void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const 
       out.share = frame.total_volume > 0.0 ? s.total_volume / frame.total_volume : 0.0;
     }
   }
+  Vec3 normal{};
   for (const SpherePairContact& p : pairs) {
     if (out.count == SoftContacts::kCapacity) break;
     if (!(p.volume > 0.f) || p.leaf_a < 0 || static_cast<std::size_t>(p.leaf_a) >= body_->spheres.size()) continue;
     out.leaves[static_cast<std::size_t>(out.count)] = p.leaf_a;
     out.weights[static_cast<std::size_t>(out.count)] = p.volume;
     ++out.count;
+    normal += static_cast<double>(p.volume) * Vec3{static_cast<double>(p.normal_world[0]),
+                                                   static_cast<double>(p.normal_world[1]),
+                                                   static_cast<double>(p.normal_world[2])};
   }
+  out.normal_world = unit_or_zero(normal);
   contacts_[tool]->publish();
 }
 
@@ -103,12 +118,14 @@ void SoftSimulation::weigh_by_nearness(double smoothing_m, std::int32_t object, 
   constexpr double kLeftOut = 1e-3;
   double nearest = std::numeric_limits<double>::infinity();
   for (const ContactSection& s : frame.sections())
-    for (const SpherePairContact& p : section_pairs(frame, s)) nearest = std::min(nearest, pair_gap(p, s));
+    for (const SpherePairContact& p : section_pairs(frame, s)) nearest = std::min(nearest, pair_geometry(p, s).gap);
   double all = 0.0, mine = 0.0;
+  Vec3 normal{};
   for (const ContactSection& s : frame.sections()) {
     const bool this_object = s.object_a == object;
     for (const SpherePairContact& p : section_pairs(frame, s)) {
-      const double w = std::exp(-(pair_gap(p, s) - nearest) / smoothing_m);
+      const PairGeometry pair = pair_geometry(p, s);
+      const double w = std::exp(-(pair.gap - nearest) / smoothing_m);
       all += w;
       if (!this_object) continue;
       mine += w;
@@ -118,9 +135,11 @@ void SoftSimulation::weigh_by_nearness(double smoothing_m, std::int32_t object, 
       out.leaves[static_cast<std::size_t>(out.count)] = p.leaf_a;
       out.weights[static_cast<std::size_t>(out.count)] = static_cast<float>(w);
       ++out.count;
+      normal += w * pair.normal;
     }
   }
   out.share = all > 0.0 ? mine / all : 0.0;
+  out.normal_world = unit_or_zero(normal);
 }
 
 void SoftSimulation::post_tool_force(std::size_t tool, const Vec3& force_world) { tool_forces_[tool]->write(force_world); }
@@ -155,21 +174,24 @@ void SoftSimulation::gather_loads() {
 }
 
 // For each tool, the force this step took and how far its contact will move per newton more in the
-// next one: a unit load along the step's, spread as the step's was, through the step's system
-// (CorotationalFem::step_response); the load-weighted mean of the moves along it.
+// next one: a unit load into the object along the contact's normal, spread as the step's loads,
+// through the step's system (CorotationalFem::step_response); the load-weighted mean of the moves
+// along it. Known from the first step in contact, before any force is felt, so the first touch
+// is soft too.
 Status SoftSimulation::publish_compliances() {
   for (std::size_t t = 0; t < compliances_.size(); ++t) {
     ContactCompliance& out = compliances_[t]->write_buffer();
     out = {};
-    const Vec3 felt = tool_forces_[t]->has_value() ? tool_forces_[t]->read_buffer() : Vec3{};
-    const double share = contacts_[t]->read_buffer().share;
-    const double magnitude = norm(felt);
+    const SoftContacts& contacts = contacts_[t]->read_buffer();
     std::fill(unit_loads_.begin(), unit_loads_.end(), Eigen::Vector3d::Zero());
-    if (magnitude > 0.0 && share > 0.0 && spread_tool_force(t, felt * (-1.0 / magnitude), unit_loads_)) {
+    if (contacts.share > 0.0 && spread_tool_force(t, contacts.normal_world * -1.0, unit_loads_)) {
       if (Status s = fem_.step_response(unit_loads_, unit_moves_); !s) return s;
       double compliance = 0.0;
       for (std::size_t n = 0; n < unit_loads_.size(); ++n) compliance += unit_loads_[n].dot(unit_moves_[n]);
-      out = {.force_world = felt * share, .share = share, .compliance_m_per_n = std::max(compliance, 0.0)};
+      const Vec3 felt = tool_forces_[t]->has_value() ? tool_forces_[t]->read_buffer() : Vec3{};
+      out = {.force_world = felt * contacts.share,
+             .share = contacts.share,
+             .compliance_m_per_n = std::max(compliance, 0.0)};
     }
     compliances_[t]->publish();
   }

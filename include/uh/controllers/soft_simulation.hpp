@@ -40,6 +40,8 @@ struct SoftContacts {
   std::array<std::int32_t, kCapacity> leaves{};  ///< the object's leaf spheres in contact
   /// each pair's weight: its overlap volume, or through a proxy its nearness (rest_on_proxy)
   std::array<float, kCapacity> weights{};
+  /// the pairs' weighted mean normal, pushing the tool out of the object [unit, world]; zero: none
+  Vec3 normal_world{};
 };
 
 class SoftSimulation {
