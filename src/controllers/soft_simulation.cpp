@@ -191,7 +191,8 @@ Status SoftSimulation::publish_compliances() {
       const Vec3 felt = tool_forces_[t]->has_value() ? tool_forces_[t]->read_buffer() : Vec3{};
       out = {.force_world = felt * contacts.share,
              .share = contacts.share,
-             .compliance_m_per_n = std::max(compliance, 0.0)};
+             // the haptic thread divides by 1 + k C: never negative, never a NaN
+             .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0};
     }
     compliances_[t]->publish();
   }
