@@ -479,10 +479,30 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
                                                   : coupling_.stiffness();
   forcecomp::Wrench w;
   w.force = spring * (proxy.position - world_from_handle_tool.position);
+  if (proxy_state_.active > 0 && !compliances_.empty()) w.force = with_compliance(w.force, spring);
   if (component_.options().mode == forcecomp::ForceMode::k6Dof)
     w.torque = coupling_.angular_stiffness() *
                forcecomp::rotation_vector(proxy.rotation * conjugate(world_from_handle_tool.rotation));
   return w;
+}
+
+// The proxy rests on soft objects where their last steps left them under the forces they took
+// (F_i, each with its share s_i and its compliance C_i at the contact): pressed with F, each gives
+// C_i (s_i F - F_i) more by its next step. The spring k to the proxy moved so gives
+// F = k e - k sum C_i (s_i F - F_i), that is F = (k e + k sum C_i F_i) / (1 + k sum C_i s_i): between
+// the steps the hand feels the spring in series with the object, k / (1 + k C), and at a step, the
+// object having moved as foreseen, the force does not jump (docs/deformables.md).
+Vec3 ForceController::with_compliance(const Vec3& spring_force, double spring) {
+  double give = 0.0;
+  Vec3 taken{};
+  for (LatestValue<ContactCompliance>* source : compliances_) {
+    source->update();
+    if (!source->has_value()) continue;
+    const ContactCompliance& c = source->read_buffer();
+    give += c.compliance_m_per_n * c.share;
+    taken += c.compliance_m_per_n * c.force_world;
+  }
+  return (spring_force + spring * taken) / (1.0 + spring * give);
 }
 
 void ForceController::finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,

@@ -18,6 +18,7 @@
 #include <string>
 #include <sstream>
 
+#include "hand_energy_support.hpp"
 #include "scene_test_support.hpp"
 #include "uh/collette/collision_world.hpp"
 #include "uh/controllers/haptic_session.hpp"
@@ -472,20 +473,8 @@ TEST(ToolProxy, TheThinWallSceneHoldsTheHandWhereThePenaltyPathLetsItThrough) {
   std::filesystem::remove_all(cache);
 }
 
-// The hand device's own damping [N s/m], as its scene's sim-hand config sets it: the real one,
-// not what the coupling is told.
-double hand_device_damping(const Scene& scene) {
-  const auto damping = scene.tool().device.config.number("device_damping", 0.0);
-  EXPECT_TRUE(damping) << damping.error().message;
-  return damping ? *damping : 0.0;
-}
-
-// The energy that reaches the hand through the handle over the run [J]: the motors' work less what
-// the device's mechanism dissipates meanwhile (its damping b times the squared speed's integral
-// over the ticks in contact, counted low; free motion's is left out).
-double energy_into_hand(const SessionReport& r, double device_damping) {
-  return r.work_on_hand_j - device_damping * r.contact_squared_speed_integral;
-}
+using testing::energy_into_hand;
+using testing::hand_device_damping;
 
 // Passivity with a hand that reacts (scenes/bunny_hand_press.json: a sim-hand presses the stylus
 // 5 cm into the bunny and pulls it out, twice): through the proxy, whose spring is clamped to the
