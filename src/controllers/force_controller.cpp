@@ -177,6 +177,8 @@ void ForceController::bind(collette::CollisionWorld& world) {
 void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManager& manager) {
   bind(world);
   manager_ = &manager;
+  // a device without motors for it ignores a torque: none is computed, counted or shown
+  renders_torque_ = manager.device_info().dof_actuated == 6;
   force_connection_ = manager.force_on_haptic_tick().connect<&ForceController::on_force>(*this);
 }
 
@@ -480,8 +482,10 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
   forcecomp::Wrench w;
   w.force = spring * (proxy.position - world_from_handle_tool.position);
   if (proxy_state_.active > 0 && !compliances_.empty()) w.force = with_compliance(w.force, spring);
-  if (component_.options().mode == forcecomp::ForceMode::k6Dof)
-    w.torque = coupling_.angular_stiffness() *
+  // the torque spring that goes with it, in the solver's metric (K R^2 unless the scene sets one),
+  // so that one contact's torque is its r x F; within the rotational passivity bound
+  if (component_.options().mode == forcecomp::ForceMode::k6Dof && renders_torque_)
+    w.torque = coupling_.angular_stiffness_for(spring, proxy_->radius_m()) *
                forcecomp::rotation_vector(proxy.rotation * conjugate(world_from_handle_tool.rotation));
   return w;
 }

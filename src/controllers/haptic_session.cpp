@@ -765,7 +765,10 @@ void HapticSession::collect_tool_report(ToolRig& rig, bool stepped) {
 // thread has stopped (or in a stepped run, after its last step).
 void HapticSession::record_proxy_ends() {
   for (auto& rig : rigs_)
-    if (rig->proxy) rig->report.proxy_position = rig->proxy->pose().position;
+    if (rig->proxy) {
+      rig->report.proxy_position = rig->proxy->pose().position;
+      rig->report.proxy_rotation = rig->proxy->pose().rotation;
+    }
 }
 
 void HapticSession::collect_report(double seconds, bool stepped) {
@@ -821,6 +824,7 @@ nlohmann::json proxy_report_json(const ToolReport& r) {
           {"max_constraints", p.max_constraints},
           {"deepest_m", p.deepest_m},
           {"position", {r.proxy_position.x, r.proxy_position.y, r.proxy_position.z}},
+          {"rotation", {r.proxy_rotation.w, r.proxy_rotation.x, r.proxy_rotation.y, r.proxy_rotation.z}},
           {"solve_us", {{"p50", p.solve_time.p50_ns * 1e-3}, {"p99", p.solve_time.p99_ns * 1e-3},
                         {"max", p.solve_time.max_ns * 1e-3}}}};
 }

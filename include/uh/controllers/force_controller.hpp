@@ -202,6 +202,7 @@ class ForceController {
                   const forcecomp::BodyMotion& tool_motion);
 
   collette::ObjectId tool_;
+  bool renders_torque_ = true;  // the device actuates torque (bind() with a manager asks it)
   forcecomp::ForceComponent component_;
   WorkspaceMapping mapping_;
   ForceControllerOptions options_;
