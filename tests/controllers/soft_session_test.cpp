@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include "hand_energy_support.hpp"
@@ -86,6 +87,46 @@ TEST(SoftSession, TheBlockGivesUnderTheBallAndTakesWhatTheBallFelt) { expect_the
 
 TEST(SoftSession, OnThePenaltyPathTooTheBlockGivesAndTakesWhatTheBallFelt) {
   expect_the_block_gives(Path::kPenalty, "penalty");
+}
+
+// scenes/soft_blob.json as shipped (packed with fewer spheres, quicker, as deep): the stylus sweeps
+// the organ-like blob's top through the proxy for 3 s in simulated time; the blob gives under it
+// (its nodes go down), the loads of the last soft step sum to minus what the stylus felt the tick
+// before it, and the sweep puts no energy into the hand.
+TEST(SoftSession, TheStylusDentsTheBlobItSweeps) {
+  const auto file = std::filesystem::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "soft_blob.json";
+  std::ifstream in(file);
+  nlohmann::json j = nlohmann::json::parse(in);
+  j["objects"][0]["spheres"] = 1500;
+  j["tool"]["spheres"] = 500;
+  auto scene = parse_scene(j.dump(), file.string(), file.parent_path());
+  ASSERT_TRUE(scene.has_value()) << scene.error().message;
+  ASSERT_TRUE(scene->force.proxy.enabled) << "the default";
+  SessionOptions options;
+  options.cache_dir = testing::fresh_cache("soft-blob");
+  auto session = HapticSession::create(*scene, options);
+  ASSERT_TRUE(session.has_value()) << session.error().message;
+  std::vector<Vec3> forces;
+  auto seen = (*session)->on_haptic_tick().connect([&](const SessionState& s) { forces.push_back(s.force_world); });
+  auto ran = (*session)->run_stepped(3.0, 1);
+  ASSERT_TRUE(ran.has_value()) << ran.error().message;
+  const SoftSimulation* sim = (*session)->soft_simulation(0);
+  ASSERT_NE(sim, nullptr);
+  double sunk_m = 0.0;
+  const auto& rest = sim->body().mesh.nodes;
+  for (std::size_t n = 0; n < rest.size(); ++n) sunk_m = std::max(sunk_m, rest[n].z() - sim->fem().positions()[n].z());
+  double largest_n = 0.0;
+  for (const Vec3& f : forces) largest_n = std::max(largest_n, norm(f));
+  EXPECT_GT(largest_n, 0.1) << "the stylus touched the blob";
+  EXPECT_GT(sunk_m, 2e-4) << "the blob gave under it";
+  // the last soft step (tick 2990) spread what the stylus felt on the tick before it
+  Eigen::Vector3d loads = Eigen::Vector3d::Zero();
+  for (const auto& l : sim->loads()) loads += l;
+  const Vec3& felt = forces.at(2989);
+  EXPECT_LT((loads + Eigen::Vector3d(felt.x, felt.y, felt.z)).norm(), 1e-9 * (1.0 + norm(felt)));
+  EXPECT_LT((*session)->report().work_on_hand_j, 1e-4) << "passive";
+  std::printf("blob: largest force %.3f N, sank %.3f mm, work on the hand %.5f J\n", largest_n, sunk_m * 1e3,
+              (*session)->report().work_on_hand_j);
 }
 
 struct HandPress {
