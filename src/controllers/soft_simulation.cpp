@@ -93,7 +93,30 @@ Status SoftSimulation::step(double dt_s) {
   if (tree.node_count() != rest_tree_->node_count()) tree = *rest_tree_;
   tree.refit(spheres_);
   trees_.publish();
+  publish_surface();
   return Ok{};
+}
+
+void SoftSimulation::publish_surface() {
+  SoftSurface& surface = surfaces_.write_buffer();
+  // a slot's storage is sized the first time it comes round, as the trees' are
+  surface.xyz.resize(3 * surface_vertex_count());
+  soft::deform_surface(*body_, fem_.positions(), surface.xyz);
+  surface.step = ++steps_;
+  surfaces_.publish();
+}
+
+std::uint64_t SoftSimulation::read_surface(std::span<float> xyz) {
+  const std::lock_guard lock(surface_readers_);
+  surfaces_.update();
+  const SoftSurface& newest = surfaces_.read_buffer();
+  if (newest.step == 0) {  // no step yet: the rest surface
+    soft::deform_surface(*body_, body_->mesh.nodes, xyz);
+    return 0;
+  }
+  const std::size_t n = std::min(xyz.size() / 3 * 3, newest.xyz.size());
+  std::copy_n(newest.xyz.begin(), n, xyz.begin());
+  return newest.step;
 }
 
 Status SoftSimulation::start(double rate_hz) {

@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -40,6 +41,12 @@ struct SoftContacts {
   std::array<float, kCapacity> weights{};         ///< each pair's overlap volume
 };
 
+/// The drawn surface's deformed vertices as one step left them.
+struct SoftSurface {
+  std::vector<float> xyz;  ///< x, y, z per vertex of the body's surface [m, object frame]
+  std::uint64_t step = 0;  ///< the step that made them (1, 2, ...)
+};
+
 class SoftSimulation {
  public:
   /// The simulation of `body` (its rest model) whose rest tree is `rest_tree`, placed with
@@ -61,7 +68,16 @@ class SoftSimulation {
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
 
-  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree.
+  /// Vertices of the body's drawn surface (SoftBodyModel::surface).
+  std::size_t surface_vertex_count() const { return body_->surface.vertices.size(); }
+  /// Copies the newest published deformed surface into `xyz` (3 floats per vertex, as many as
+  /// fit; the rest pose before the first step) and returns the step that made it (0: at rest).
+  /// Any thread but the simulation's; readers take turns (a lock among readers: the simulation
+  /// thread never takes it, so it never waits).
+  std::uint64_t read_surface(std::span<float> xyz);
+
+  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree
+  /// and the deformed surface.
   Status step(double dt_s);
 
   /// Runs step() at `rate_hz` on its own thread until stop(). Controlling thread.
@@ -84,12 +100,16 @@ class SoftSimulation {
   SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body, std::shared_ptr<const collette::SphereTree> rest_tree,
                  soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools);
   void gather_loads();
+  void publish_surface();
 
   std::shared_ptr<const soft::SoftBodyModel> body_;
   std::shared_ptr<const collette::SphereTree> rest_tree_;
   soft::CorotationalFem fem_;
   Quat object_from_world_;
   LatestValue<collette::SphereTree> trees_;
+  LatestValue<SoftSurface> surfaces_;  // simulation -> readers of the drawn surface
+  std::mutex surface_readers_;         // one reader of surfaces_ at a time
+  std::uint64_t steps_ = 0;
   std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<Eigen::Vector3d> loads_;
