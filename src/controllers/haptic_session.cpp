@@ -602,6 +602,31 @@ Status HapticSession::stop() {
   return stopped_;
 }
 
+Result<const soft::SurfaceMesh*> HapticSession::soft_surface(std::size_t object) const {
+  if (object >= soft_.size())
+    return Error{fmt::format("no scene object {} (the scene has {})", object, soft_.size()), ErrorKind::kInvalid};
+  if (!soft_[object])
+    return Error{fmt::format("object '{}' is rigid: it has no deformed vertices", scene().objects[object].name),
+                 ErrorKind::kInvalid};
+  return &soft_[object]->body().surface;
+}
+
+Result<std::size_t> HapticSession::soft_vertex_count(std::size_t object) const {
+  auto surface = soft_surface(object);
+  if (!surface) return surface.error();
+  return (*surface)->vertices.size();
+}
+
+Result<std::uint64_t> HapticSession::soft_vertices(std::size_t object, std::span<float> xyz) {
+  auto count = soft_vertex_count(object);
+  if (!count) return count.error();
+  if (xyz.size() < 3 * *count)
+    return Error{fmt::format("object '{}' has {} deformed vertices: the buffer of {} floats holds fewer than {}",
+                             scene().objects[object].name, *count, xyz.size(), 3 * *count),
+                 ErrorKind::kInvalid};
+  return soft_[object]->read_surface(xyz);
+}
+
 void HapticSession::stop_soft() {
   for (auto& soft : soft_)
     if (soft) soft->stop();

@@ -24,6 +24,7 @@
 #include "uh/controllers/scene.hpp"
 #include "uh/controllers/session_model.hpp"
 #include "uh/controllers/soft_simulation.hpp"
+#include <span>
 #include "uh/core/delegator.hpp"
 #include "uh/core/event_counter.hpp"
 #include "uh/core/latest_value.hpp"
@@ -298,6 +299,18 @@ class HapticSession {
   const SoftSimulation* soft_simulation(std::size_t object) const {
     return object < soft_.size() ? soft_[object].get() : nullptr;
   }
+  /// Scene object `object`'s drawn surface at rest (its mesh refined, load_soft_surface): the
+  /// triangles of the deformed vertices. An error naming the object when it is rigid or there is
+  /// no such object.
+  Result<const soft::SurfaceMesh*> soft_surface(std::size_t object) const;
+  /// The vertices of that surface, as soft_surface().
+  Result<std::size_t> soft_vertex_count(std::size_t object) const;
+  /// Copies object `object`'s newest deformed surface into `xyz` (x, y, z floats per vertex, [m]
+  /// in the object's frame, as its mesh is) and returns the step that made it (0: at rest). An
+  /// error when the object is rigid or `xyz` holds fewer than 3 * soft_vertex_count() floats.
+  /// Any thread but the simulation's, while the session runs or not; never makes the simulation,
+  /// collision or haptic threads wait.
+  Result<std::uint64_t> soft_vertices(std::size_t object, std::span<float> xyz);
   /// The rate of every deformable object's simulation thread [Hz] (docs/deformables.md, "In a session").
   static constexpr double kSoftRateHz = 100.0;
 
