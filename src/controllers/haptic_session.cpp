@@ -574,6 +574,7 @@ Status HapticSession::stop() {
   collect_report(seconds, false);  // before the loops stop: their statistics describe the run itself
   for (auto& rig : rigs_) rig->manager->stop();
   stop_soft();
+  collect_soft_report();
   world_->stop();
   record_proxy_ends();
   // the haptic threads are joined and the devices got zero: this thread becomes the states' writer
@@ -630,6 +631,12 @@ Result<std::uint64_t> HapticSession::soft_vertices(std::size_t object, std::span
 void HapticSession::stop_soft() {
   for (auto& soft : soft_)
     if (soft) soft->stop();
+}
+
+void HapticSession::collect_soft_report() {
+  report_.soft.clear();
+  for (std::size_t i = 0; i < soft_.size(); ++i)
+    if (soft_[i]) report_.soft.push_back({.object = scene().objects[i].name, .samples = soft_[i]->record()});
 }
 
 Status HapticSession::soft_error() const {
@@ -710,6 +717,7 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   drain();
   collision_hz_ = haptic_hz_ / ticks_per_collision_step;
   collect_report(static_cast<double>(k) / haptic_hz_, true);
+  collect_soft_report();
   record_proxy_ends();
   publish_report();
   report_.stopped_early = k < ticks;

@@ -27,7 +27,9 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
       fem_(std::move(fem)),
       object_from_world_(conjugate(world_from_object.rotation)),
       loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
-      spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()) {
+      spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()),
+      down_in_object_(rotate(object_from_world_, Vec3{0.0, 0.0, -1.0})) {
+  record_.reserve(kRecordCapacity);
   for (std::size_t t = 0; t < tools; ++t) {
     contacts_.push_back(std::make_unique<LatestValue<SoftContacts>>());
     tool_forces_.push_back(std::make_unique<LatestValue<Vec3>>());
@@ -93,17 +95,32 @@ Status SoftSimulation::step(double dt_s) {
   if (tree.node_count() != rest_tree_->node_count()) tree = *rest_tree_;
   tree.refit(spheres_);
   trees_.publish();
-  publish_surface();
+  publish_surface(dt_s);
   return Ok{};
 }
 
-void SoftSimulation::publish_surface() {
+void SoftSimulation::publish_surface(double dt_s) {
   SoftSurface& surface = surfaces_.write_buffer();
   // a slot's storage is sized the first time it comes round, as the trees' are
   surface.xyz.resize(3 * surface_vertex_count());
   soft::deform_surface(*body_, fem_.positions(), surface.xyz);
   surface.step = ++steps_;
+  record_step(dt_s, surface.xyz);
   surfaces_.publish();
+}
+
+void SoftSimulation::record_step(double dt_s, std::span<const float> xyz) {
+  if (record_.size() == record_.capacity()) return;  // full: no allocation on this thread
+  const auto& rest = body_->surface.vertices;
+  double deepest = 0.0;
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    const Vec3 moved{static_cast<double>(xyz[3 * i]) - rest[i].x(), static_cast<double>(xyz[3 * i + 1]) - rest[i].y(),
+                     static_cast<double>(xyz[3 * i + 2]) - rest[i].z()};
+    deepest = std::max(deepest, dot(moved, down_in_object_));
+  }
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (const auto& l : loads_) total += l;
+  record_.push_back({.time_s = static_cast<double>(steps_) * dt_s, .indentation_m = deepest, .force_n = total.norm()});
 }
 
 std::uint64_t SoftSimulation::read_surface(std::span<float> xyz) {

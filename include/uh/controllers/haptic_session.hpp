@@ -149,6 +149,12 @@ struct SessionReport : ToolReport {
   std::uint64_t coherent_queries = 0;  ///< collision queries that reused their kept candidates
   std::vector<RateSample> collision_rates;
   std::vector<ToolReport> tools;  ///< per tool, in Scene::tools order
+  /// Per soft object (scene order): a sample per simulation step, its indentation and force.
+  struct SoftObjectReport {
+    std::string object;
+    std::vector<SoftSample> samples;
+  };
+  std::vector<SoftObjectReport> soft;
 };
 
 /// The newest state of one tool of a session, as its haptic thread sent it in its last tick (plain
@@ -343,6 +349,7 @@ class HapticSession {
                     std::int32_t pairs);
   bool any_fault() const;
   void stop_soft();
+  void collect_soft_report();  // once the simulations stopped
   Status soft_error() const;
   bool haptic_threads_running() const;
   bool soft_threads_running() const;

@@ -47,6 +47,13 @@ struct SoftSurface {
   std::uint64_t step = 0;  ///< the step that made them (1, 2, ...)
 };
 
+/// One step of a soft object as `uh run --plot` draws it: how deep it was pressed and how hard.
+struct SoftSample {
+  double time_s = 0.0;         ///< the simulation's time at the step's end [s]
+  double indentation_m = 0.0;  ///< the deepest downward (world -z) displacement of a surface vertex [m]
+  double force_n = 0.0;        ///< |sum of the step's loads|: what the tools pressed it with [N]
+};
+
 class SoftSimulation {
  public:
   /// The simulation of `body` (its rest model) whose rest tree is `rest_tree`, placed with
@@ -93,6 +100,10 @@ class SoftSimulation {
   const std::vector<Eigen::Vector3d>& loads() const { return loads_; }
   /// The last step's deformed leaf spheres [m, object frame]. Simulation thread (or after stop()).
   std::span<const Sphere> spheres() const { return spheres_; }
+  /// A sample per step (the first kRecordCapacity; allocated at create()). Simulation thread (or
+  /// after stop()).
+  const std::vector<SoftSample>& record() const { return record_; }
+  static constexpr std::size_t kRecordCapacity = 60000;  // ten minutes at 100 Hz
   const soft::CorotationalFem& fem() const { return fem_; }
   const soft::SoftBodyModel& body() const { return *body_; }
 
@@ -100,7 +111,8 @@ class SoftSimulation {
   SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body, std::shared_ptr<const collette::SphereTree> rest_tree,
                  soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools);
   void gather_loads();
-  void publish_surface();
+  void publish_surface(double dt_s);
+  void record_step(double dt_s, std::span<const float> xyz);
 
   std::shared_ptr<const soft::SoftBodyModel> body_;
   std::shared_ptr<const collette::SphereTree> rest_tree_;
@@ -114,6 +126,8 @@ class SoftSimulation {
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<Eigen::Vector3d> loads_;
   std::vector<Sphere> spheres_;
+  Vec3 down_in_object_;  // the world's -z in the object's frame
+  std::vector<SoftSample> record_;
   std::unique_ptr<FixedRateLoop> loop_;  // made by start()
   Status failure_ = Ok{};
 };
