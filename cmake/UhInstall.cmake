@@ -42,7 +42,7 @@ endif()
 # Scenes and meshes under share/unrealhaptics, in the repository's layout (a scene names its meshes
 # relative to itself): only the project's own public-domain meshes and the scenes that use nothing
 # else; the bunny scan and its scenes stay in the repository
-set(UH_SHARED_MESHES ball block plate slab stylus torus vase)
+set(UH_SHARED_MESHES ball ball_fine block plate slab stylus torus vase)
 set(UH_SHARED_SCENES materials materials_block materials_flat materials_stiff thin_wall)
 list(TRANSFORM UH_SHARED_MESHES REPLACE "(.+)" "${PROJECT_SOURCE_DIR}/assets/meshes/\\1.obj")
 list(TRANSFORM UH_SHARED_SCENES REPLACE "(.+)" "${PROJECT_SOURCE_DIR}/scenes/\\1.json")

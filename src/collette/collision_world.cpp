@@ -47,6 +47,7 @@ struct CollisionWorld::Object {
   const SphereTree* now = nullptr;  // the tree queried: `tree`, or the newest deformed one (collision thread)
   std::string name;
   double coverage = 1.0;
+  double extra_margin = 0.0;  // beyond the world's contact margin [m]
   bool is_static = false;
   LatestValue<Pose> pose_in;  // written by the object's mover, read by the collision step
   // collision thread
@@ -225,6 +226,9 @@ Result<ObjectId> CollisionWorld::add_object(CollisionObjectDef def) {
     return Error{fmt::format(
         "CollisionWorld::add_object: object '{}' does not fit: the world holds at most {} objects", def.name,
         options_.max_objects)};
+  if (!(def.extra_margin_m >= 0.0 && def.extra_margin_m < 1e3))
+    return Error{fmt::format("CollisionWorld::add_object: object '{}' has extra margin {} m; expected [0, 1000)",
+                             def.name, def.extra_margin_m)};
   if (def.deformed_trees != nullptr && def.is_static)
     return Error{fmt::format("CollisionWorld::add_object: object '{}' deforms: it cannot be static", def.name)};
   auto object = std::make_unique<Object>();
@@ -234,6 +238,7 @@ Result<ObjectId> CollisionWorld::add_object(CollisionObjectDef def) {
   object->deformed_trees = def.deformed_trees;
   object->name = std::move(def.name);
   object->coverage = def.coverage;
+  object->extra_margin = def.extra_margin_m;
   object->is_static = def.is_static;
   object->pose = def.world_from_object;
   object->has_pose = def.has_initial_pose;
@@ -271,7 +276,7 @@ Result<WatcherId> CollisionWorld::add_watcher(Object* a, Object* b) {
   watcher->b = b;
   if (options_.coherence_skin > 0.0 && a != nullptr)
     watcher->coherent_query = std::make_unique<VolumeQuery>(
-        VolumeQueryOptions{.contact_margin = static_cast<float>(std::max(0.0, options_.contact_margin)),
+        VolumeQueryOptions{.contact_margin = static_cast<float>(pair_margin(*a, *b)),
                            .coherence_skin = static_cast<float>(options_.coherence_skin)});
   Watcher* raw = watcher.get();
   if (auto sent = submit({.kind = Change::Kind::kAddWatcher, .watcher = raw}); !sent) return sent.error();
@@ -388,8 +393,12 @@ bool CollisionWorld::running() const { return loop_.running() || free_running_.l
 
 void CollisionWorld::step(double time_s) { run_step(time_s); }
 
+double CollisionWorld::pair_margin(const Object& a, const Object& b) const {
+  return std::max(0.0, options_.contact_margin) + a.extra_margin + b.extra_margin;
+}
+
 void CollisionWorld::update_broad_phase(Object& o) {
-  const Aabb box = aabb::of_sphere(o.centre_world(), o.radius());
+  const Aabb box = aabb::of_sphere(o.centre_world(), o.radius() + o.extra_margin);
   const double margin = o.is_static ? 0.0 : std::max(0.0, options_.broad_phase_margin);
   if (o.proxy == DynamicAabbTree::kNull)
     o.proxy = broad_phase_.create(box, margin, slot_of(o.id));
@@ -401,8 +410,10 @@ void CollisionWorld::query_pair(Watcher& watcher, ContactFrame& frame) {
   const Object& a = *watcher.a;
   const Object& b = *watcher.b;
   const double root_gap = norm(b.centre_world() - a.centre_world()) - a.radius() - b.radius();
-  if (root_gap < options_.contact_margin) {
+  const double margin = pair_margin(a, b);
+  if (root_gap < margin) {
     const auto query_start = std::chrono::steady_clock::now();
+    if (!watcher.coherent_query) volume_query_.set_contact_margin(static_cast<float>(margin));
     VolumeQuery& query = watcher.coherent_query ? *watcher.coherent_query : volume_query_;
     query.run(*a.now, *b.now, a.pose, b.pose, frame);
     if (query.result().reused_candidates) coherent_queries_.increment();
@@ -457,8 +468,10 @@ void CollisionWorld::query_tool(Watcher& watcher, ContactFrame& frame) {
   for (Object* o : candidates_) {
     if (!o->has_pose) continue;
     const double root_gap = norm(tool_centre - o->centre_world()) - o->radius() - tool.radius();
-    if (!(root_gap < margin)) continue;
+    const double object_margin = pair_margin(*o, tool);
+    if (!(root_gap < object_margin)) continue;
     const auto query_start = std::chrono::steady_clock::now();
+    volume_query_.set_contact_margin(static_cast<float>(object_margin));
     const ContactSection& s = volume_query_.append_section(*o->now, *tool.now, o->pose, tool.pose, frame);
     query_time_.record(elapsed_ns(query_start));
     queries_.increment();

@@ -14,7 +14,7 @@ namespace {
 
 CachedTree in_metres(const IstAsset& asset, double meters_per_unit) {
   return CachedTree{std::make_shared<const SphereTree>(scale_sphere_tree(asset.tree, meters_per_unit)),
-                    asset.meta.coverage};
+                    asset.meta.coverage, asset.meta.max_gap * meters_per_unit};
 }
 
 }  // namespace

@@ -177,6 +177,8 @@ void ForceController::bind(collette::CollisionWorld& world) {
 void ForceController::bind(collette::CollisionWorld& world, haptico::HapticManager& manager) {
   bind(world);
   manager_ = &manager;
+  // a device without motors for it ignores a torque: none is computed, counted or shown
+  renders_torque_ = manager.device_info().dof_actuated == 6;
   force_connection_ = manager.force_on_haptic_tick().connect<&ForceController::on_force>(*this);
 }
 
@@ -479,10 +481,32 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
                                                   : coupling_.stiffness();
   forcecomp::Wrench w;
   w.force = spring * (proxy.position - world_from_handle_tool.position);
-  if (component_.options().mode == forcecomp::ForceMode::k6Dof)
-    w.torque = coupling_.angular_stiffness() *
+  if (proxy_state_.active > 0 && !compliances_.empty()) w.force = with_compliance(w.force, spring);
+  // the torque spring that goes with it, in the solver's metric (K R^2 unless the scene sets one),
+  // so that one contact's torque is its r x F; within the rotational passivity bound
+  if (component_.options().mode == forcecomp::ForceMode::k6Dof && renders_torque_)
+    w.torque = coupling_.angular_stiffness_for(spring, proxy_->radius_m()) *
                forcecomp::rotation_vector(proxy.rotation * conjugate(world_from_handle_tool.rotation));
   return w;
+}
+
+// The proxy rests on soft objects where their last steps left them under the forces they took
+// (F_i, each with its share s_i and its compliance C_i at the contact): pressed with F, each gives
+// C_i (s_i F - F_i) more by its next step. The spring k to the proxy moved so gives
+// F = k e - k sum C_i (s_i F - F_i), that is F = (k e + k sum C_i F_i) / (1 + k sum C_i s_i): between
+// the steps the hand feels the spring in series with the object, k / (1 + k C), and at a step, the
+// object having moved as foreseen, the force does not jump (docs/deformables.md).
+Vec3 ForceController::with_compliance(const Vec3& spring_force, double spring) {
+  double give = 0.0;
+  Vec3 taken{};
+  for (LatestValue<ContactCompliance>* source : compliances_) {
+    source->update();
+    if (!source->has_value()) continue;
+    const ContactCompliance& c = source->read_buffer();
+    give += c.compliance_m_per_n * c.share;
+    taken += c.compliance_m_per_n * c.force_world;
+  }
+  return (spring_force + spring * taken) / (1.0 + spring * give);
 }
 
 void ForceController::finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,

@@ -34,6 +34,17 @@ double proxy_spring_n_m(const forcecomp::ForceParams& force, const forcecomp::Co
   return 2.0 * std::numbers::pi * radius * material.stiffness;
 }
 
+// Through the proxy a tool rests on an object's mesh, which lies up to the packing's surface gap G
+// above its spheres, and a tool sphere gets its surface row from a pair within the margin (step_m).
+// The world reports the object's pairs G - step_m / 2 farther, so that the row comes before the
+// tool reaches the mesh when it moves up to half a step per step; the full G would cover a whole
+// step, but the default session's queries took three times as long (docs/forcecomp.md).
+double proxy_surface_margin(const SessionModel& model, std::size_t object) {
+  const CompiledShape& o = model.objects[object];
+  if (!model.scene.force.proxy.enabled || !o.surface || o.soft) return 0.0;
+  return std::max(0.0, o.surface_gap_m - 0.5 * model.scene.force.proxy.step_m);
+}
+
 }  // namespace
 
 Scene with_session_options(const Scene& scene, const SessionOptions& options) {
@@ -178,7 +189,8 @@ Status HapticSession::add_objects(const SessionRunOptions& options) {
                                   .world_from_object = object.pose,
                                   .coverage = model_->objects[i].coverage,
                                   .name = object.name,
-                                  .deformed_trees = soft ? &soft->trees() : nullptr});
+                                  .deformed_trees = soft ? &soft->trees() : nullptr,
+                                  .extra_margin_m = proxy_surface_margin(*model_, i)});
     if (!id) return id.error();
     object_ids_.push_back(*id);
   }
@@ -297,6 +309,12 @@ Status HapticSession::wire_controllers(ToolRig& rig) {
                                         .tool_texture = material.tool_texture,
                                         // a soft object's rest surface is not where it is: its spheres are
                                         .surface = soft_[i] ? nullptr : model_->objects[i].surface});
+    // the proxy rests on a soft object's spheres within the margin: its loads go by nearness, and
+    // the spring to it is felt in series with the object's compliance there
+    if (rig.proxy && soft_[i]) {
+      soft_[i]->rest_on_proxy(t, std::max(force_options.proxy.smoothing_m, force_options.proxy.penetration_m));
+      rig.force_controller->feel_compliance_of(&soft_[i]->compliance(t));
+    }
   }
   if (rig.proxy) rig.proxy->bind();
   rig.bridging_controller = std::make_unique<BridgingController>(*world_, rig.tool_id, tool.workspace,
@@ -780,7 +798,10 @@ void HapticSession::collect_tool_report(ToolRig& rig, bool stepped) {
 // thread has stopped (or in a stepped run, after its last step).
 void HapticSession::record_proxy_ends() {
   for (auto& rig : rigs_)
-    if (rig->proxy) rig->report.proxy_position = rig->proxy->pose().position;
+    if (rig->proxy) {
+      rig->report.proxy_position = rig->proxy->pose().position;
+      rig->report.proxy_rotation = rig->proxy->pose().rotation;
+    }
 }
 
 void HapticSession::collect_report(double seconds, bool stepped) {
@@ -836,6 +857,7 @@ nlohmann::json proxy_report_json(const ToolReport& r) {
           {"max_constraints", p.max_constraints},
           {"deepest_m", p.deepest_m},
           {"position", {r.proxy_position.x, r.proxy_position.y, r.proxy_position.z}},
+          {"rotation", {r.proxy_rotation.w, r.proxy_rotation.x, r.proxy_rotation.y, r.proxy_rotation.z}},
           {"solve_us", {{"p50", p.solve_time.p50_ns * 1e-3}, {"p99", p.solve_time.p99_ns * 1e-3},
                         {"max", p.solve_time.max_ns * 1e-3}}}};
 }

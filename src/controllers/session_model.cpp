@@ -84,7 +84,11 @@ Status compile_objects(collette::IstCache& cache, const CompileOptions& options,
     if (!surface) return named(scene, part, surface.error());
     auto body = compile_soft_body(object, *tree, *surface, options);
     if (!body) return named(scene, part, body.error());
-    model.objects.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = *surface, .soft = *body});
+    model.objects.push_back({.tree = tree->tree,
+                             .coverage = tree->coverage,
+                             .surface = *surface,
+                             .surface_gap_m = tree->max_gap_m,
+                             .soft = *body});
     object.shape.tree = tree->tree;
     object.shape.coverage = tree->coverage;
   }
@@ -97,7 +101,7 @@ Status compile_tools(collette::IstCache& cache, const CompileOptions& options, S
     auto tree = tree_of(tool.shape, cache, options.progress);
     if (!tree) return named(scene, fmt::format("tool '{}'", tool.name), tree.error());
     // a tool's surface is not used: the proxy rests the tool's spheres on the objects' surfaces
-    model.tools.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = nullptr, .soft = nullptr});
+    model.tools.push_back({.tree = tree->tree, .coverage = tree->coverage, .surface = nullptr, .surface_gap_m = 0.0, .soft = nullptr});
     tool.shape.tree = tree->tree;
     tool.shape.coverage = tree->coverage;
     auto& row = model.materials.emplace_back();

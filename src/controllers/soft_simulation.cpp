@@ -1,11 +1,39 @@
 #include "uh/controllers/soft_simulation.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <utility>
 
 #include <fmt/format.h>
 
 namespace uh::controllers {
+namespace {
+
+// A pair at the poses of its query: its gap, centre distance less both radii [m] (< 0:
+// overlapping), and the unit normal from the object's sphere to the tool's.
+struct PairGeometry {
+  double gap = 0.0;
+  Vec3 normal{};
+};
+PairGeometry pair_geometry(const SpherePairContact& p, const ContactSection& s) {
+  const auto centre = [](const Sphere& x) {
+    return Vec3{static_cast<double>(x.x), static_cast<double>(x.y), static_cast<double>(x.z)};
+  };
+  const Vec3 a = transform_point(s.world_from_a, centre(p.sphere_a_local));
+  const Vec3 b = transform_point(s.world_from_b, centre(p.sphere_b_local));
+  const double distance = norm(b - a);
+  return {.gap = distance - static_cast<double>(p.sphere_a_local.radius) - static_cast<double>(p.sphere_b_local.radius),
+          .normal = distance > 0.0 ? (b - a) / distance : Vec3{}};
+}
+
+Vec3 unit_or_zero(const Vec3& v) { return norm(v) > 0.0 ? v / norm(v) : Vec3{}; }
+
+std::span<const SpherePairContact> section_pairs(const ContactFrame& frame, const ContactSection& s) {
+  return frame.pairs().subspan(static_cast<std::size_t>(s.first_pair), static_cast<std::size_t>(s.pair_count));
+}
+
+}  // namespace
 
 Result<std::unique_ptr<SoftSimulation>> SoftSimulation::create(std::shared_ptr<const soft::SoftBodyModel> body,
                                                                std::shared_ptr<const collette::SphereTree> rest_tree,
@@ -27,68 +55,156 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
       fem_(std::move(fem)),
       object_from_world_(conjugate(world_from_object.rotation)),
       loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
+      unit_loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
+      unit_moves_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()),
       down_in_object_(rotate(object_from_world_, Vec3{0.0, 0.0, -1.0})) {
   record_.reserve(kRecordCapacity);
   for (std::size_t t = 0; t < tools; ++t) {
     contacts_.push_back(std::make_unique<LatestValue<SoftContacts>>());
     tool_forces_.push_back(std::make_unique<LatestValue<Vec3>>());
+    compliances_.push_back(std::make_unique<LatestValue<ContactCompliance>>());
   }
+  proxy_smoothing_m_.assign(tools, 0.0);
+}
+
+void SoftSimulation::rest_on_proxy(std::size_t tool, double smoothing_m) {
+  proxy_smoothing_m_[tool] = std::max(smoothing_m, 1e-6);
 }
 
 void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame) {
   // another object's own frame says nothing of this one (a tool against everything says all)
   if (frame.object_a != object && frame.object_a != ContactFrame::kEveryObject) return;
-  std::span<const SpherePairContact> pairs;
-  double share = 0.0;
-  if (frame.object_a == object) {
-    pairs = frame.pairs();
-    share = 1.0;
-  } else if (frame.object_a == ContactFrame::kEveryObject) {
-    for (const ContactSection& s : frame.sections()) {
-      if (s.object_a != object) continue;
-      pairs = frame.pairs().subspan(static_cast<std::size_t>(s.first_pair), static_cast<std::size_t>(s.pair_count));
-      share = frame.total_volume > 0.0 ? s.total_volume / frame.total_volume : 0.0;
-    }
-  }
   SoftContacts& out = contacts_[tool]->write_buffer();
   out.count = 0;
-  out.share = share;
+  out.share = 0.0;
+  out.normal_world = {};
+  if (proxy_smoothing_m_[tool] > 0.0) {
+    weigh_by_nearness(proxy_smoothing_m_[tool], object, frame, out);
+    contacts_[tool]->publish();
+    return;
+  }
+  std::span<const SpherePairContact> pairs;
+  if (frame.object_a == object) {
+    pairs = frame.pairs();
+    out.share = 1.0;
+  } else {
+    for (const ContactSection& s : frame.sections()) {
+      if (s.object_a != object) continue;
+      pairs = section_pairs(frame, s);
+      out.share = frame.total_volume > 0.0 ? s.total_volume / frame.total_volume : 0.0;
+    }
+  }
+  Vec3 normal{};
   for (const SpherePairContact& p : pairs) {
     if (out.count == SoftContacts::kCapacity) break;
     if (!(p.volume > 0.f) || p.leaf_a < 0 || static_cast<std::size_t>(p.leaf_a) >= body_->spheres.size()) continue;
     out.leaves[static_cast<std::size_t>(out.count)] = p.leaf_a;
     out.weights[static_cast<std::size_t>(out.count)] = p.volume;
     ++out.count;
+    normal += static_cast<double>(p.volume) * Vec3{static_cast<double>(p.normal_world[0]),
+                                                   static_cast<double>(p.normal_world[1]),
+                                                   static_cast<double>(p.normal_world[2])};
   }
+  out.normal_world = unit_or_zero(normal);
   contacts_[tool]->publish();
+}
+
+// Through a proxy: the proxy rests on the soft minimum of its pairs' gaps (ToolProxy), whose
+// gradient gives each pair exp(-gap / e) over the sum, so each pair takes that share of the force
+// holding the proxy. The frame's pairs are those within the margin; a pair more than 7 e (1.4 mm
+// at e = 0.2 mm) farther than the nearest takes under 0.1 % of the nearest's and is left out, so
+// the buffer holds those that matter. The object's share is its pairs' weight over the frame's.
+void SoftSimulation::weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame,
+                                       SoftContacts& out) const {
+  constexpr double kLeftOut = 1e-3;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const ContactSection& s : frame.sections())
+    for (const SpherePairContact& p : section_pairs(frame, s)) nearest = std::min(nearest, pair_geometry(p, s).gap);
+  double all = 0.0, mine = 0.0;
+  Vec3 normal{};
+  for (const ContactSection& s : frame.sections()) {
+    const bool this_object = s.object_a == object;
+    for (const SpherePairContact& p : section_pairs(frame, s)) {
+      const PairGeometry pair = pair_geometry(p, s);
+      const double w = std::exp(-(pair.gap - nearest) / smoothing_m);
+      all += w;
+      if (!this_object) continue;
+      mine += w;
+      if (w < kLeftOut || out.count == SoftContacts::kCapacity || p.leaf_a < 0 ||
+          static_cast<std::size_t>(p.leaf_a) >= body_->spheres.size())
+        continue;
+      out.leaves[static_cast<std::size_t>(out.count)] = p.leaf_a;
+      out.weights[static_cast<std::size_t>(out.count)] = static_cast<float>(w);
+      ++out.count;
+      normal += w * pair.normal;
+    }
+  }
+  out.share = all > 0.0 ? mine / all : 0.0;
+  out.normal_world = unit_or_zero(normal);
 }
 
 void SoftSimulation::post_tool_force(std::size_t tool, const Vec3& force_world) { tool_forces_[tool]->write(force_world); }
 
+// `force_world` (a load on the object) over tool `tool`'s contact spheres by their weights, and
+// each sphere's part to its tetrahedron's nodes, added to `loads`; false when it has no contact.
+bool SoftSimulation::spread_tool_force(std::size_t tool, const Vec3& force_world,
+                                       std::vector<Eigen::Vector3d>& loads) const {
+  const SoftContacts& c = contacts_[tool]->read_buffer();
+  double total = 0.0;
+  for (std::int32_t i = 0; i < c.count; ++i) total += static_cast<double>(c.weights[static_cast<std::size_t>(i)]);
+  if (!(total > 0.0)) return false;
+  const Vec3 f = rotate(object_from_world_, force_world) / total;
+  const Eigen::Vector3d per_weight(f.x, f.y, f.z);
+  for (std::int32_t i = 0; i < c.count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    soft::spread_sphere_force(*body_, c.leaves[k], static_cast<double>(c.weights[k]) * per_weight, loads);
+  }
+  return true;
+}
+
 // Each tool's felt force, this object's share of it, back on the object's contact spheres with
-// the opposite sign, spread by their overlap volumes: the loads sum to minus what the tools felt.
+// the opposite sign (spread_tool_force): the loads sum to minus what the tools felt.
 void SoftSimulation::gather_loads() {
   std::fill(loads_.begin(), loads_.end(), Eigen::Vector3d::Zero());
   for (std::size_t t = 0; t < contacts_.size(); ++t) {
     contacts_[t]->update();
     tool_forces_[t]->update();
-    const SoftContacts& c = contacts_[t]->read_buffer();
-    double total = 0.0;
-    for (std::int32_t i = 0; i < c.count; ++i) total += static_cast<double>(c.weights[static_cast<std::size_t>(i)]);
-    if (!(total > 0.0) || !tool_forces_[t]->has_value()) continue;
-    const Vec3 f = rotate(object_from_world_, tool_forces_[t]->read_buffer()) * (-c.share / total);
-    const Eigen::Vector3d per_volume(f.x, f.y, f.z);
-    for (std::int32_t i = 0; i < c.count; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      soft::spread_sphere_force(*body_, c.leaves[k], static_cast<double>(c.weights[k]) * per_volume, loads_);
-    }
+    if (tool_forces_[t]->has_value())
+      spread_tool_force(t, tool_forces_[t]->read_buffer() * -contacts_[t]->read_buffer().share, loads_);
   }
+}
+
+// For each tool, the force this step took and how far its contact will move per newton more in the
+// next one: a unit load into the object along the contact's normal, spread as the step's loads,
+// through the step's system (CorotationalFem::step_response); the load-weighted mean of the moves
+// along it. Known from the first step in contact, before any force is felt, so the first touch
+// is soft too.
+Status SoftSimulation::publish_compliances() {
+  for (std::size_t t = 0; t < compliances_.size(); ++t) {
+    ContactCompliance& out = compliances_[t]->write_buffer();
+    out = {};
+    const SoftContacts& contacts = contacts_[t]->read_buffer();
+    std::fill(unit_loads_.begin(), unit_loads_.end(), Eigen::Vector3d::Zero());
+    if (contacts.share > 0.0 && spread_tool_force(t, contacts.normal_world * -1.0, unit_loads_)) {
+      if (Status s = fem_.step_response(unit_loads_, unit_moves_); !s) return s;
+      double compliance = 0.0;
+      for (std::size_t n = 0; n < unit_loads_.size(); ++n) compliance += unit_loads_[n].dot(unit_moves_[n]);
+      const Vec3 felt = tool_forces_[t]->has_value() ? tool_forces_[t]->read_buffer() : Vec3{};
+      out = {.force_world = felt * contacts.share,
+             .share = contacts.share,
+             // the haptic thread divides by 1 + k C: never negative, never a NaN
+             .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0};
+    }
+    compliances_[t]->publish();
+  }
+  return Ok{};
 }
 
 Status SoftSimulation::step(double dt_s) {
   gather_loads();
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
+  if (Status s = publish_compliances(); !s) return s;
   soft::deform_spheres(*body_, fem_.positions(), spheres_);
   collette::SphereTree& tree = trees_.write_buffer();
   // a slot the reader never handed back before holds no tree yet: it gets the rest tree once

@@ -179,8 +179,13 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
                                        .lever = (b - rb * n) - section.world_from_b.position,
                                        .gap = gap,
                                        .tag = tag};
-    if (contact.surface) add_to_surface(p.leaf_b, tag, b, rb);
-    else if (options_.smoothing_m > 0.0) add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m, c.tag);
+    if (contact.surface) {
+      add_to_surface(p.leaf_b, tag, b, rb);
+      // a pair farther than a step (reported for the mesh above the spheres) cannot bind
+      if (gap - options_.penetration_m > options_.step_m) continue;
+    } else if (options_.smoothing_m > 0.0) {
+      add_to_smooth(p.leaf_b, b, rb, n, gap - options_.penetration_m, c.tag);
+    }
     // beyond the capacity the nearest pairs are kept (a heap on the gap, largest on top); the step
     // shrinks to the smallest gap left out
     const auto by_gap = [](const forcecomp::ProxyConstraint& x, const forcecomp::ProxyConstraint& y) {

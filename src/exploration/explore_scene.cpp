@@ -23,11 +23,10 @@ using controllers::SessionOptions;
 
 // The scene the hand explores `object` in, compiled once: the object alone with the scene's first
 // tool on the explorer's device, in the device frame = world, with the session's overrides. The
-// model holds both shapes' trees (the planner reads them before the session exists). Not the
-// object's mesh surface: the proxy rests on the spheres. On a fine mesh the surface reads the same
-// friction (materials_packed.json: 0.601 / 0.400 for 0.6 / 0.4) and finds the flat slab's grating
-// the spheres alone miss, but on a coarse one its facets read as texture and stiffness (the 1 m
-// icospheres of materials.json); docs/forcecomp.md, "Not yet".
+// model holds both shapes' trees (the planner reads them before the session exists) and the
+// object's mesh surface, which the proxy rests on as in any session: a packed face reads flat, not
+// as the packing's grain. A mesh's own facets are felt as they are: a round object meant to feel
+// smooth needs faces that meet at a degree or two (assets/meshes/ball_fine.obj).
 Result<std::shared_ptr<const SessionModel>> compile_object_scene(const Scene& scene, const SceneObject& object,
                                                                  const SessionOptions& so) {
   Scene alone = scene;
@@ -38,7 +37,7 @@ Result<std::shared_ptr<const SessionModel>> compile_object_scene(const Scene& sc
   alone.tool().workspace = {};  // the device frame is the world frame
   collette::IstCache cache(so.cache_dir);
   return controllers::compile(controllers::with_session_options(alone, so), cache,
-                              {.surfaces = false, .progress = so.build_progress});
+                              {.progress = so.build_progress});
 }
 
 // The object of `model` explored: the plan, the hand, the session run in simulated time, the trace
@@ -46,7 +45,8 @@ Result<ObjectExploration> explore_object(const Scene& scene, const std::shared_p
                                          const ExploreOptions& options, const SessionOptions& so) {
   const Scene& alone = model->scene;
   const SceneObject& object = alone.objects[0];
-  auto plan = plan_exploration(*model->objects[0].tree, object.pose, *model->tools[0].tree, options);
+  const double surface_gap_m = model->objects[0].surface ? model->objects[0].surface_gap_m : 0.0;
+  auto plan = plan_exploration(*model->objects[0].tree, object.pose, *model->tools[0].tree, options, surface_gap_m);
   if (!plan) return Error{fmt::format("{}: object '{}': {}", scene.source, object.name, plan.error().message)};
   const double haptic_hz = *so.haptic_hz;
   const auto capacity = static_cast<std::size_t>(options.max_seconds * haptic_hz) + 16;

@@ -66,7 +66,7 @@ Jitter jitter_of(const ExploreOptions& options) {
 
 // down onto the top, at the footprint's middle moved by the site's offset and the seed
 ExplorePlan plan_top(const WorldSpheres& w, const Vec3& middle, const collette::SphereTree& tool,
-                     const ExploreOptions& options, const Jitter& jitter) {
+                     const ExploreOptions& options, const Jitter& jitter, double clearance_m) {
   ExplorePlan plan;
   plan.axis_point = middle;
   const Vec3 target{middle.x + options.site.offset_m[0] + jitter.a, middle.y + options.site.offset_m[1] + jitter.b,
@@ -87,7 +87,7 @@ ExplorePlan plan_top(const WorldSpheres& w, const Vec3& middle, const collette::
     }
   }
   if (top < -1e299) top = w.hi.z;
-  plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + 0.003 - tip.z};
+  plan.start = Vec3{target.x - tip.x, target.y - tip.y, top + clearance_m - tip.z};
   plan.axes[0] = {std::cos(jitter.turn), std::sin(jitter.turn), 0.0};
   plan.axes[1] = {-std::sin(jitter.turn), std::cos(jitter.turn), 0.0};
   return plan;
@@ -95,7 +95,7 @@ ExplorePlan plan_top(const WorldSpheres& w, const Vec3& middle, const collette::
 
 // side: level towards the centre line from the site's azimuth, at its height (both moved by the seed)
 Result<ExplorePlan> plan_side(const WorldSpheres& w, const Vec3& middle, const collette::SphereTree& tool,
-                              const ExploreOptions& options, const Jitter& jitter) {
+                              const ExploreOptions& options, const Jitter& jitter, double clearance_m) {
   ExplorePlan plan;
   plan.axis_point = middle;
   const double azimuth = options.site.azimuth_rad + jitter.a / 0.05;  // up to 3 mm along a 5 cm radius
@@ -120,7 +120,7 @@ Result<ExplorePlan> plan_side(const WorldSpheres& w, const Vec3& middle, const c
   }
   if (outer < -1e299) return Error{fmt::format("nothing of the object is at height {:.4f} m", z)};
   const Vec3 surface{middle.x + outer * out.x, middle.y + outer * out.y, z};
-  plan.start = surface + 0.003 * out - tip;
+  plan.start = surface + clearance_m * out - tip;
   plan.axes[0] = {0, 0, 1};
   plan.axes[1] = {-out.y, out.x, 0.0};
   return plan;
@@ -129,14 +129,17 @@ Result<ExplorePlan> plan_side(const WorldSpheres& w, const Vec3& middle, const c
 }  // namespace
 
 Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const Pose& world_from_object,
-                                     const collette::SphereTree& tool, const ExploreOptions& options) {
+                                     const collette::SphereTree& tool, const ExploreOptions& options,
+                                     double surface_gap_m) {
   const auto leaves = object.leaves();
   if (leaves.empty()) return Error{"the object has no spheres"};
   const WorldSpheres w = world_spheres(leaves, world_from_object);
   const Jitter jitter = jitter_of(options);
   const Vec3 middle{0.5 * (w.lo.x + w.hi.x), 0.5 * (w.lo.y + w.hi.y), w.lo.z};
-  if (options.site.from == ExploreSite::From::kTop) return plan_top(w, middle, tool, options, jitter);
-  return plan_side(w, middle, tool, options, jitter);
+  // 3 mm off the spheres, and off the mesh surface the proxy rests on, up to the gap above them
+  const double clearance_m = 0.003 + surface_gap_m;
+  if (options.site.from == ExploreSite::From::kTop) return plan_top(w, middle, tool, options, jitter, clearance_m);
+  return plan_side(w, middle, tool, options, jitter, clearance_m);
 }
 
 double leg_length(const ExploreOptions& o, std::int32_t leg) {

@@ -19,9 +19,11 @@ struct ExplorePlan {
 };
 
 // The start 3 mm off the object where the site says (the seed moves it by up to 3 mm across the
-// approach), the approach direction and the stroke axes
+// approach), the approach direction and the stroke axes; `surface_gap_m` more where the tool will
+// rest on a mesh surface up to that far above the object's spheres
 Result<ExplorePlan> plan_exploration(const collette::SphereTree& object, const Pose& world_from_object,
-                                     const collette::SphereTree& tool, const ExploreOptions& options);
+                                     const collette::SphereTree& tool, const ExploreOptions& options,
+                                     double surface_gap_m);
 
 // the length of stroke `leg` (0, 1 along e1; 2, 3 along e2) [m]
 double leg_length(const ExploreOptions& o, std::int32_t leg);

@@ -34,6 +34,7 @@ Slide slide_of(const ExploreTrace& trace, const std::vector<std::size_t>& idx) {
     s.normal_n.push_back(pressing);
     s.friction_ratio.push_back(-along / pressing);
     s.position.push_back(x[idx[j]].position);
+    s.force.push_back(f);
   }
   return s;
 }

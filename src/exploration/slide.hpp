@@ -18,6 +18,7 @@ struct Slide {
   std::vector<double> normal_n;
   std::vector<double> friction_ratio;
   std::vector<Vec3> position;
+  std::vector<Vec3> force;  // the force felt [N]
 };
 
 // the stretch of the samples `idx` of the trace (empty under 8 samples)

@@ -25,11 +25,17 @@ Vec3 rotation_vector(const Quat& q_in) {
 VirtualCoupling::VirtualCoupling(const VirtualCouplingOptions& options) : options_(options) {
   const double margin = std::clamp(options.passivity_margin, 0.0, 1.0);
   const double k_max = margin * max_passive_stiffness(options.device_damping, options.period_s, options.damping);
-  const double kr_max =
+  angular_bound_ =
       margin * max_passive_stiffness(options.device_angular_damping, options.period_s, options.angular_damping);
+  const double angular = options.angular_stiffness.value_or(0.0);
   stiffness_ = std::clamp(options.stiffness, 0.0, k_max);
-  angular_stiffness_ = std::clamp(options.angular_stiffness, 0.0, kr_max);
-  stiffness_limited_ = options.stiffness > k_max || options.angular_stiffness > kr_max;
+  angular_stiffness_ = std::clamp(angular, 0.0, angular_bound_);
+  stiffness_limited_ = options.stiffness > k_max || angular > angular_bound_;
+}
+
+double VirtualCoupling::angular_stiffness_for(double linear_n_m, double extent_m) const {
+  const double wanted = options_.angular_stiffness.value_or(linear_n_m * extent_m * extent_m);
+  return std::isfinite(wanted) ? std::clamp(wanted, 0.0, angular_bound_) : 0.0;
 }
 
 void VirtualCoupling::reset(const Pose& world_from_device) {

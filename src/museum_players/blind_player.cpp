@@ -277,8 +277,8 @@ Result<PieceSurvey> survey_piece(const controllers::SceneObject& piece, const Su
   if (!tool_tree) return tool_tree.error();
   const auto tip = std::make_shared<const collette::SphereTree>(std::move(*tool_tree));
   controllers::Scene scene = museum_artifacts::table_scene(piece, tip, options.haptic_hz);
-  // the piece's tree compiled once; each site's exploration reuses it (and leaves the mesh surface
-  // out, exploration::explore_scene)
+  // the piece's tree compiled once; each site's exploration reuses it (its proxy rests on the
+  // piece's mesh surface, loaded there, as the station's does)
   collette::IstCache cache(cache_dir);
   auto model = controllers::compile(scene, cache, {.surfaces = false});
   if (!model) return Error{fmt::format("{}: {}", piece.name, model.error().message)};

@@ -325,7 +325,12 @@ Status read_force_options(const FieldReader& r, const json& j, const std::string
     UH_CHECK(r.number(*it, p, "stiffness", c.stiffness));
     UH_CHECK(r.number(*it, p, "damping", c.damping));
     UH_CHECK(r.number(*it, p, "device_damping", c.device_damping));
-    UH_CHECK(r.number(*it, p, "angular_stiffness", c.angular_stiffness));
+    // absent: derived from the linear spring and the tool's extent (VirtualCouplingOptions)
+    if (it->contains("angular_stiffness")) {
+      double angular = 0.0;
+      UH_CHECK(r.number(*it, p, "angular_stiffness", angular));
+      c.angular_stiffness = angular;
+    }
     UH_CHECK(r.number(*it, p, "angular_damping", c.angular_damping));
     UH_CHECK(r.number(*it, p, "device_angular_damping", c.device_angular_damping));
     UH_CHECK(r.number(*it, p, "passivity_margin", c.passivity_margin));

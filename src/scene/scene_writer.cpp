@@ -106,7 +106,7 @@ json force_options_json(const Scene& scene) {
   const ForceControllerOptions& o = scene.force;
   const auto& c = o.coupling;
   const auto& x = o.proxy;
-  return {{"multi_rate", o.multi_rate},
+  json j = {{"multi_rate", o.multi_rate},
           {"tick_force", o.tick_force == TickForce::kExact ? "exact" : "model"},
           {"safety",
            {{"max_force_n", scene.safety_limits.max_force_n},
@@ -120,7 +120,6 @@ json force_options_json(const Scene& scene) {
             {"stiffness", c.stiffness},
             {"damping", c.damping},
             {"device_damping", c.device_damping},
-            {"angular_stiffness", c.angular_stiffness},
             {"angular_damping", c.angular_damping},
             {"device_angular_damping", c.device_angular_damping},
             {"passivity_margin", c.passivity_margin},
@@ -132,6 +131,9 @@ json force_options_json(const Scene& scene) {
             {"penetration_m", x.penetration_m},
             {"max_constraints", x.max_constraints},
             {"smoothing_m", x.smoothing_m}}}};
+  // unset: derived from the linear spring and the tool's extent, as when read back
+  if (c.angular_stiffness) j["coupling"]["angular_stiffness"] = *c.angular_stiffness;
+  return j;
 }
 
 }  // namespace

@@ -127,7 +127,7 @@ Status validate_coupling(const forcecomp::VirtualCouplingOptions& c) {
   UH_VALIDATE(in_range(join(p, "stiffness"), c.stiffness, 0.0, 1e7));
   UH_VALIDATE(in_range(join(p, "damping"), c.damping, 0.0, 1e5));
   UH_VALIDATE(in_range(join(p, "device_damping"), c.device_damping, 0.0, 1e5));
-  UH_VALIDATE(in_range(join(p, "angular_stiffness"), c.angular_stiffness, 0.0, 1e5));
+  if (c.angular_stiffness) UH_VALIDATE(in_range(join(p, "angular_stiffness"), *c.angular_stiffness, 0.0, 1e5));
   UH_VALIDATE(in_range(join(p, "angular_damping"), c.angular_damping, 0.0, 1e5));
   UH_VALIDATE(in_range(join(p, "device_angular_damping"), c.device_angular_damping, 0.0, 1e5));
   UH_VALIDATE(in_range(join(p, "passivity_margin"), c.passivity_margin, 1e-3, 1.0));

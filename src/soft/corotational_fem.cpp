@@ -540,6 +540,25 @@ Status CorotationalFem::step(double dt_s, const std::vector<Eigen::Vector3d>& ex
   return Ok{};
 }
 
+Status CorotationalFem::step_response(const std::vector<Eigen::Vector3d>& loads, std::vector<Eigen::Vector3d>& moves) {
+  if (!factorised_) {
+    return Error{"soft::CorotationalFem::step_response: no step's system is factorised yet", ErrorKind::kInvalid};
+  }
+  if (auto valid = check_loads(loads); !valid) return valid;
+  response_loads_.resize(rhs_.size());
+  for (std::size_t node = 0; node < positions_.size(); ++node) {
+    const std::int32_t f = free_index_[node];
+    if (f >= 0) response_loads_.segment<3>(3 * f) = loads[node];
+  }
+  precondition(response_loads_, response_);
+  moves.resize(positions_.size());
+  for (std::size_t node = 0; node < positions_.size(); ++node) {
+    const std::int32_t f = free_index_[node];
+    moves[node] = f < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(response_.segment<3>(3 * f));
+  }
+  return Ok{};
+}
+
 Result<int> CorotationalFem::solve_static(const std::vector<Eigen::Vector3d>& external_forces, int max_iterations,
                                           double tolerance_m) {
   return solve_static(external_forces, ContactModel{}, max_iterations, tolerance_m);

@@ -18,6 +18,8 @@
 #include <string>
 #include <sstream>
 
+#include "hand_energy_support.hpp"
+#include "proxy_test_support.hpp"
 #include "scene_test_support.hpp"
 #include "uh/collette/collision_world.hpp"
 #include "uh/controllers/haptic_session.hpp"
@@ -30,47 +32,11 @@
 namespace uh::controllers {
 namespace {
 
-collette::TriangleMesh box_mesh(const Vec3& size) {
-  collette::TriangleMesh m;
-  m.source_name = "box";
-  for (const Vec3& v : std::initializer_list<Vec3>{
-           {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}})
-    m.vertices.push_back(Vec3{(v.x - 0.5) * size.x, (v.y - 0.5) * size.y, (v.z - 0.5) * size.z});
-  m.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                 {3, 7, 6}, {3, 6, 2}, {0, 4, 7}, {0, 7, 3}, {1, 2, 6}, {1, 6, 5}};
-  return m;
-}
-
-struct Packed {
-  std::shared_ptr<const collette::SphereTree> tree;
-  double max_gap = 0.0;  // the packing's largest distance from the mesh surface to its spheres [m]
-};
-
-Packed pack(const collette::TriangleMesh& mesh, std::int64_t spheres) {
-  auto valid = collette::validate_mesh(mesh);
-  EXPECT_TRUE(valid) << valid.error().message;
-  auto packing = collette::pack_spheres(*valid, {.target_sphere_count = spheres});
-  EXPECT_TRUE(packing) << packing.error().message;
-  auto tree = collette::build_sphere_tree(packing->spheres);
-  EXPECT_TRUE(tree) << tree.error().message;
-  return {std::make_shared<const collette::SphereTree>(std::move(tree).value()), packing->report.max_gap};
-}
-
-Vec3 centre_of(const Sphere& s) { return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)}; }
-
-// The deepest overlap of any tool sphere with any plate sphere, by brute force [m].
-double deepest_overlap(const collette::SphereTree& plate, const Pose& world_from_plate,
-                       const collette::SphereTree& tool, const Pose& world_from_tool) {
-  double deepest = 0.0;
-  for (const Sphere& b : tool.leaves()) {
-    const Vec3 cb = transform_point(world_from_tool, centre_of(b));
-    for (const Sphere& a : plate.leaves()) {
-      const Vec3 ca = transform_point(world_from_plate, centre_of(a));
-      deepest = std::max(deepest, static_cast<double>(a.radius + b.radius) - norm(cb - ca));
-    }
-  }
-  return deepest;
-}
+using testing::box_mesh;
+using testing::centre_of;
+using testing::deepest_overlap;
+using testing::pack;
+using testing::Packed;
 
 struct WallRun {
   double closest_m = 1e9;     // nearest the ball's centre came to the plate's mid-plane (signed, + on its side)
@@ -472,20 +438,8 @@ TEST(ToolProxy, TheThinWallSceneHoldsTheHandWhereThePenaltyPathLetsItThrough) {
   std::filesystem::remove_all(cache);
 }
 
-// The hand device's own damping [N s/m], as its scene's sim-hand config sets it: the real one,
-// not what the coupling is told.
-double hand_device_damping(const Scene& scene) {
-  const auto damping = scene.tool().device.config.number("device_damping", 0.0);
-  EXPECT_TRUE(damping) << damping.error().message;
-  return damping ? *damping : 0.0;
-}
-
-// The energy that reaches the hand through the handle over the run [J]: the motors' work less what
-// the device's mechanism dissipates meanwhile (its damping b times the squared speed's integral
-// over the ticks in contact, counted low; free motion's is left out).
-double energy_into_hand(const SessionReport& r, double device_damping) {
-  return r.work_on_hand_j - device_damping * r.contact_squared_speed_integral;
-}
+using testing::energy_into_hand;
+using testing::hand_device_damping;
 
 // Passivity with a hand that reacts (scenes/bunny_hand_press.json: a sim-hand presses the stylus
 // 5 cm into the bunny and pulls it out, twice): through the proxy, whose spring is clamped to the

@@ -21,15 +21,33 @@ double largest_difference(const std::vector<Eigen::Vector3d>& a, const std::vect
   return largest;
 }
 
+// A box lattice from the origin to `max` of `cells`, and the nodes of its base (held)
+struct HeldBox {
+  TetMesh mesh;
+  std::vector<std::int32_t> base;
+};
+HeldBox held_box(const Eigen::Vector3d& max, const Eigen::Vector3i& cells) {
+  auto mesh = build_box_lattice(Eigen::Vector3d::Zero(), max, cells);
+  EXPECT_TRUE(mesh);
+  if (!mesh) return {};
+  auto base = nodes_in_box(*mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d(max.x(), max.y(), 0.0));
+  return {std::move(*mesh), std::move(base)};
+}
+
+// a soft solid (E [Pa]), lightly damped
+ElasticMaterial soft_material(double young_modulus_pa) {
+  return {.young_modulus_pa = young_modulus_pa, .poisson_ratio = 0.4, .density_kg_m3 = 1000.0,
+          .stiffness_damping_s = 0.002};
+}
+
 TEST(SoftSolver, IteratedStepMatchesDirectSolve) {
   // a soft 6 x 6 x 12 cm column held at its base, its top swung sideways by a load that bends it
   // by tens of degrees, so the rotations drift far from those of the preconditioner
-  const Eigen::Vector3d min(0.0, 0.0, 0.0), max(0.06, 0.06, 0.12);
-  auto mesh = build_box_lattice(min, max, {5, 5, 10});
-  ASSERT_TRUE(mesh);
-  const auto base = nodes_in_box(*mesh, min, Eigen::Vector3d(max.x(), max.y(), 0.0));
-  const ElasticMaterial material{.young_modulus_pa = 2.0e4, .poisson_ratio = 0.4, .density_kg_m3 = 1000.0,
-                                 .stiffness_damping_s = 0.002};
+  const Eigen::Vector3d max(0.06, 0.06, 0.12);
+  const HeldBox box = held_box(max, Eigen::Vector3i(5, 5, 10));
+  const TetMesh* mesh = &box.mesh;
+  const auto& base = box.base;
+  const ElasticMaterial material = soft_material(2.0e4);
   const SolverOptions iterated{};
   auto fast = CorotationalFem::create(*mesh, material, base, iterated);
   auto direct = CorotationalFem::create(*mesh, material, base, {.direct = true});
@@ -71,6 +89,49 @@ TEST(SoftSolver, IteratedStepMatchesDirectSolve) {
   EXPECT_LT(worst, 1e-5);
   // the iterations did the work: most steps were not factorised
   EXPECT_LT(fast->factorisations(), kSteps / 10);
+}
+
+// step_response (the compliance a contact feels within one step, by the kept factorisation) against
+// the difference of two steps from the same state, one with a load pressed more: a soft block held
+// at its base, pressed on a patch of its top and then pressed 0.1 N more there.
+TEST(SoftSolver, StepResponseIsTheNextStepsMovePerLoad) {
+  const HeldBox box = held_box(Eigen::Vector3d(0.08, 0.08, 0.04), Eigen::Vector3i(8, 8, 4));
+  // solved directly, so that the difference of the two steps is exact (the iterations stop at a
+  // residual of the whole step's size) and the kept factorisation is the current system's
+  auto pressed = CorotationalFem::create(box.mesh, soft_material(5.0e4), box.base, {.direct = true});
+  auto more = CorotationalFem::create(box.mesh, soft_material(5.0e4), box.base, {.direct = true});
+  ASSERT_TRUE(pressed && more);
+  std::vector<Eigen::Vector3d> loads(box.mesh.nodes.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> moves;
+  EXPECT_FALSE(pressed->step_response(loads, moves)) << "no step's system is factorised yet";
+  const auto patch = nodes_in_box(box.mesh, Eigen::Vector3d(0.03, 0.03, 0.04), Eigen::Vector3d(0.05, 0.05, 0.04));
+  ASSERT_GT(patch.size(), 4u);
+  std::vector<Eigen::Vector3d> extra(box.mesh.nodes.size(), Eigen::Vector3d::Zero());
+  for (const std::int32_t node : patch) {
+    loads[static_cast<std::size_t>(node)] = Eigen::Vector3d(0.3, 0.0, -2.0) / static_cast<double>(patch.size());
+    extra[static_cast<std::size_t>(node)] = Eigen::Vector3d(0.0, 0.0, -0.1) / static_cast<double>(patch.size());
+  }
+  constexpr double kDt = 0.01;
+  for (int step = 0; step < 20; ++step) ASSERT_TRUE(pressed->step(kDt, loads));
+  ASSERT_TRUE(pressed->step_response(extra, moves));
+  ASSERT_TRUE(more->set_state(pressed->positions(), pressed->velocities()));
+  std::vector<Eigen::Vector3d> more_loads = loads;
+  for (std::size_t n = 0; n < loads.size(); ++n) more_loads[n] += extra[n];
+  ASSERT_TRUE(pressed->step(kDt, loads));
+  ASSERT_TRUE(more->step(kDt, more_loads));
+  double largest = 0.0, error = 0.0, work = 0.0;
+  for (std::size_t n = 0; n < loads.size(); ++n) {
+    const Eigen::Vector3d difference = more->positions()[n] - pressed->positions()[n];
+    largest = std::max(largest, difference.norm());
+    error = std::max(error, (moves[n] - difference).norm());
+    work += extra[n].dot(moves[n]);
+  }
+  std::printf("0.1 N more moves the patch %.3f mm in a step; step_response within %.1e of it (of the largest "
+              "move); compliance %.2f mm/N\n",
+              1e3 * largest, error / largest, 1e3 * work / 0.01);
+  EXPECT_GT(largest, 1e-6);
+  EXPECT_LT(error, 1e-4 * largest);
+  EXPECT_GT(work, 0.0);
 }
 
 TEST(SoftSolver, RejectsBadOptions) {

@@ -111,6 +111,10 @@ struct CollisionObjectDef {
   /// of `tree` (its rest shape, the same topology). Null for a rigid object. Owned by the caller,
   /// alive while the object is registered; the collision thread is its only reader. Not static.
   LatestValue<SphereTree>* deformed_trees = nullptr;
+  /// Pairs with this object are reported this much farther than the world's contact_margin [m],
+  /// >= 0: a tool resting on the object's mesh surface through a proxy hears of its spheres, which
+  /// lie up to the packing's surface gap below the mesh, in time to keep off the mesh.
+  double extra_margin_m = 0.0;
 };
 
 /// Statistics of the collision thread since start(). Plain data.
@@ -243,6 +247,8 @@ class CollisionWorld {
   };
 
   Object* find_object(ObjectId id) const;
+  // the contact margin of a pair of objects: the world's and each one's extra margin [m]
+  double pair_margin(const Object& a, const Object& b) const;
   Watcher* find_watcher(WatcherId id) const;
   Status stale_object_error(const char* what, ObjectId id) const;
   Status submit(const Change& change);

@@ -22,6 +22,8 @@ namespace uh::collette {
 struct CachedTree {
   std::shared_ptr<const SphereTree> tree;
   double coverage = 1.0;
+  /// The packing's largest gap below the mesh surface (IstMetadata::max_gap) [m]; 0 when unknown.
+  double max_gap_m = 0.0;
 };
 
 /// What a mesh is packed with (the key of its cached build, with the mesh file's hash).

@@ -169,6 +169,13 @@ class VolumeQuery {
   /// The overlapping pairs stored by the last run (empty unless collect_pairs), A frame.
   std::span<const PairOverlap> pairs() const { return {pairs_.data(), static_cast<std::size_t>(result_.pair_count)}; }
   const VolumeQueryOptions& options() const { return options_; }
+  /// Sets options().contact_margin for the next runs (a world whose objects have their own
+  /// margins); the kept coherence candidates are forgotten when it changes.
+  void set_contact_margin(float margin) {
+    if (margin == options_.contact_margin) return;
+    options_.contact_margin = margin;
+    reset_coherence();
+  }
   /// The fast path's kernel width, chosen at construction: 16 (AVX-512: options().use_avx2,
   /// use_avx512 and the CPU has it and is AMD's, or force_avx512), 8 (AVX2: use_avx2 and the CPU
   /// has it) or 4 (the baseline).

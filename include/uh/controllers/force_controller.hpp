@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "uh/collette/collision_world.hpp"
+#include "uh/controllers/contact_compliance.hpp"
 #include "uh/controllers/tool_proxy.hpp"
 #include "uh/controllers/workspace_mapping.hpp"
 #include "uh/core/contact.hpp"
@@ -112,6 +113,10 @@ class ForceController {
   /// Renders the spring to this tool's proxy instead of penalty forces (the proxy outlives the
   /// controller's ticks). Controlling thread, before bind().
   void render_through(ToolProxy* proxy) { proxy_ = proxy; }
+  /// With a proxy: the proxy rests on a soft object that gives way; `source` (its simulation's,
+  /// read only by this tool's haptic thread) tells how far, so that between the object's steps the
+  /// spring is felt in series with its compliance (with_compliance). Controlling thread, before bind().
+  void feel_compliance_of(LatestValue<ContactCompliance>* source) { compliances_.push_back(source); }
   /// With a proxy: the proxy the last tick rendered against (slid towards the handle). Haptic thread.
   const Pose& rendered_proxy() const { return rendered_proxy_; }
   /// The coupling (null without one); the BridgingController reads its proxy pose.
@@ -188,6 +193,7 @@ class ForceController {
   // proxy mode: the spring between the handle and the proxy slid towards it; sets the data's time
   // and the constraints holding the proxy
   forcecomp::Wrench proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s, std::int32_t& holding);
+  Vec3 with_compliance(const Vec3& spring_force, double spring);
   // the end of every tick: statistics, the safety stage, the device frame
   void finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,
                    double oldest_data_s, std::int32_t pairs, haptico::DeviceCommand& command);
@@ -196,6 +202,7 @@ class ForceController {
                   const forcecomp::BodyMotion& tool_motion);
 
   collette::ObjectId tool_;
+  bool renders_torque_ = true;  // the device actuates torque (bind() with a manager asks it)
   forcecomp::ForceComponent component_;
   WorkspaceMapping mapping_;
   ForceControllerOptions options_;
@@ -213,6 +220,7 @@ class ForceController {
   Pose rendered_proxy_{};         // haptic thread: it, slid towards the handle
   bool have_proxy_state_ = false;
   double contact_spring_n_m_ = 0.0;  // haptic thread: the last holding contact's ProxyContact::stiffness_n_m
+  std::vector<LatestValue<ContactCompliance>*> compliances_;  // soft objects the proxy may rest on
 
   // haptic thread state
   double last_tick_s_ = 0.0;

@@ -125,6 +125,7 @@ struct ToolReport {
   bool proxy = false;
   ToolProxyStats proxy_stats{};
   Vec3 proxy_position{};  ///< where the proxy ended [m, world frame]
+  Quat proxy_rotation{};  ///< how it was turned then (world frame)
   std::vector<TimelineSample> timeline;
 };
 

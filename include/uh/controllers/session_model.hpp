@@ -27,6 +27,8 @@ struct CompiledShape {
   std::shared_ptr<const collette::SphereTree> tree;
   double coverage = 1.0;  ///< sphere volume / mesh volume, (0, 1]
   std::shared_ptr<const collette::MeshInside> surface;  ///< null without a mesh file
+  /// How far the packing lies below `surface` at most (the tree's max_gap) [m]; 0 when unknown.
+  double surface_gap_m = 0.0;
   /// A deformable object's rest model (`objects[].deformable`): its lattice around the tree's
   /// packing, the held nodes, the leaves embedded; null for a rigid object and for tools.
   std::shared_ptr<const soft::SoftBodyModel> soft;

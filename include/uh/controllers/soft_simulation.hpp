@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "uh/collette/sphere_tree.hpp"
+#include "uh/controllers/contact_compliance.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/fixed_rate_loop.hpp"
 #include "uh/core/latest_value.hpp"
@@ -38,7 +39,10 @@ struct SoftContacts {
   /// This object's share of the tool's contact (its section's volume over the frame's), [0, 1].
   double share = 0.0;
   std::array<std::int32_t, kCapacity> leaves{};  ///< the object's leaf spheres in contact
-  std::array<float, kCapacity> weights{};         ///< each pair's overlap volume
+  /// each pair's weight: its overlap volume, or through a proxy its nearness (rest_on_proxy)
+  std::array<float, kCapacity> weights{};
+  /// the pairs' weighted mean normal, pushing the tool out of the object [unit, world]; zero: none
+  Vec3 normal_world{};
 };
 
 /// The drawn surface's deformed vertices as one step left them.
@@ -66,14 +70,23 @@ class SoftSimulation {
   /// The trees the collision thread queries (its only reader).
   LatestValue<collette::SphereTree>& trees() { return trees_; }
 
+  /// Tool `tool` is a proxy (ToolProxy), which rests on the object's spheres within the margin
+  /// rather than in them, so its pairs have no overlap volume: each pair is weighed by its nearness
+  /// instead, exp(-(gap - smallest gap) / `smoothing_m`), the share of the proxy's soft-minimum row
+  /// (forcecomp: the soft minimum's gradient) that the pair takes. Setup only, before the threads.
+  void rest_on_proxy(std::size_t tool, double smoothing_m);
+
   /// Collision thread: the pairs of `frame`'s that touch this object (object `object`, on side A
   /// of a pair as the session watches it) become tool `tool`'s newest contacts; a frame of another
   /// object's watcher is ignored. A tool-against-everything frame gives the object's share of the
-  /// tool's contact volume; a frame of this object alone gives it all of the tool's force.
-  /// Real-time safe.
+  /// tool's contact (of its pairs' weights); a frame of this object alone gives it all of the
+  /// tool's force. Real-time safe.
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
+  /// What each step tells tool `tool`'s haptic thread (its only reader) of the contact: the force
+  /// the step took and the object's compliance there (ForceController::feel_compliance_of).
+  LatestValue<ContactCompliance>& compliance(std::size_t tool) { return *compliances_[tool]; }
 
   /// Vertices of the body's drawn surface (SoftBodyModel::surface).
   std::size_t surface_vertex_count() const { return body_->surface.vertices.size(); }
@@ -111,6 +124,9 @@ class SoftSimulation {
   SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body, std::shared_ptr<const collette::SphereTree> rest_tree,
                  soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools);
   void gather_loads();
+  bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
+  Status publish_compliances();
+  void weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame, SoftContacts& out) const;
   void publish_surface(double dt_s);
   void record_step(double dt_s, std::span<const float> xyz);
 
@@ -124,7 +140,10 @@ class SoftSimulation {
   std::uint64_t steps_ = 0;
   std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
+  std::vector<double> proxy_smoothing_m_;  // per tool: 0 weighs pairs by overlap, > 0 by nearness
+  std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: simulation -> haptic
   std::vector<Eigen::Vector3d> loads_;
+  std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of publish_compliances
   std::vector<Sphere> spheres_;
   Vec3 down_in_object_;  // the world's -z in the object's frame
   std::vector<SoftSample> record_;

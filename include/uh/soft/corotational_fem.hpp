@@ -88,6 +88,14 @@ class CorotationalFem {
   Result<int> solve_static(const std::vector<Eigen::Vector3d>& external_forces, const ContactModel& contacts,
                            int max_iterations = 50, double tolerance_m = 1e-12);
 
+  /// The move the next step would add per `loads` [N, one per node, object frame; fixed nodes'
+  /// ignored] into `moves` [m, one per node, zero on fixed nodes]: the step's system
+  /// (M (1/h^2 + alpha/h) + K' (1 + beta/h)) solved by its kept factorisation (single precision,
+  /// of the rotations last factorised, the h of the last step): the object's compliance within one
+  /// step, as a contact sees it. Fails before the first step or on loads that are not one finite
+  /// vector per node.
+  Status step_response(const std::vector<Eigen::Vector3d>& loads, std::vector<Eigen::Vector3d>& moves);
+
   /// Sets every node's position [m] and velocity [m/s] (one finite vector per node each): an
   /// initial shape and motion. Fixed nodes stay held where `hold` put them (their rest position).
   Status set_state(std::vector<Eigen::Vector3d> positions, std::vector<Eigen::Vector3d> velocities);
@@ -165,6 +173,7 @@ class CorotationalFem {
   Eigen::VectorXd rhs_;
   Eigen::VectorXd increment_;
   Eigen::VectorXd residual_, preconditioned_, direction_, product_;  // scratch of the iterations
+  Eigen::VectorXd response_loads_, response_;                        // scratch of step_response
   // the preconditioner: a single-precision copy of the factorisation L D L^T = A in 3 x 3 blocks
   // (a fraction of the memory traffic of its solves, which dominate a step; the iterations stay
   // in double precision): per node column J, the strict lower part of its diagonal block and the

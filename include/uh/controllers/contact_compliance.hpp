@@ -1,0 +1,22 @@
+#pragma once
+/// \file
+/// ContactCompliance: what a soft object's simulation tells a tool's haptic thread about the
+/// contact it gives way under (issue 26; docs/deformables.md, "What the hand feels"). Plain data,
+/// handed over in a LatestValue (simulation thread -> the tool's haptic thread).
+
+#include "uh/core/math.hpp"
+
+namespace uh::controllers {
+
+struct ContactCompliance {
+  /// The part of the tool's felt force [N, world] the object's last step took as its loads (the
+  /// object's share of it): where the object now is, in the tree its step published, is its
+  /// response to this force.
+  Vec3 force_world{};
+  double share = 0.0;  ///< the object's share of the tool's contact, [0, 1]
+  /// How far the contact moves per newton more within the next step, along the force [m/N] (0:
+  /// unknown, or no contact).
+  double compliance_m_per_n = 0.0;
+};
+
+}  // namespace uh::controllers
