@@ -520,6 +520,25 @@ class Session {
     return json_loads(json);
   }
 
+  // a soft object's deformed surface: (N, 3) float32 vertices [m, object frame], newest step
+  py::array_t<float> deformed_vertices(int object) const {
+    int32_t n = 0;
+    check(uh_session_soft_vertex_count(session_, object, &n));
+    py::array_t<float> xyz({static_cast<py::ssize_t>(n), py::ssize_t{3}});
+    float* data = xyz.mutable_data();
+    call_released([&] { return uh_session_soft_vertices(session_, object, data, n, nullptr); });
+    return xyz;
+  }
+
+  // its triangles: (M, 3) int32 indices into deformed_vertices' rows
+  py::array_t<std::int32_t> soft_triangles(int object) const {
+    int32_t n = 0;
+    check(uh_session_soft_triangle_count(session_, object, &n));
+    py::array_t<std::int32_t> indices({static_cast<py::ssize_t>(n), py::ssize_t{3}});
+    check(uh_session_soft_triangles(session_, object, indices.mutable_data(), n));
+    return indices;
+  }
+
   std::vector<std::string> tool_names() const { return names(uh_session_tool_count, uh_session_tool_name); }
   std::vector<std::string> object_names() const {
     return names(uh_session_object_count, uh_session_object_name);
@@ -684,6 +703,11 @@ PYBIND11_MODULE(unrealhaptics, m) {
            "Runs deterministically on this thread in simulated time; returns the report.")
       .def("report", &Session::report)
       .def_property_readonly("object_names", &Session::object_names)
+      .def("deformed_vertices", &Session::deformed_vertices, py::arg("object"),
+           "A soft object's deformed surface (its mesh, refined) as the newest simulation step left it: "
+           "an (N, 3) float32 array [m, the object's frame]. UhError for a rigid object.")
+      .def("soft_triangles", &Session::soft_triangles, py::arg("object"),
+           "The triangles of a soft object's deformed surface: (M, 3) int32 rows of deformed_vertices.")
       .def_property_readonly("tool_names", &Session::tool_names, "The scene's tools, each on its own device.")
       .def("close", &Session::close, "Stops and frees the session. Idempotent.")
       .def(

@@ -27,6 +27,8 @@ struct Panel {
   std::vector<std::array<double, 3>> colours;
   std::vector<std::string> labels;
   double target = -1.0;  // a dashed reference line (e.g. the target rate), < 0 for none
+  std::string x_unit = "time [s]";
+  double x_max = -1.0;  // the x axis' end; < 0: the plot's time span
 };
 
 // A "nice" step for about `count` grid lines over `range`.
@@ -38,7 +40,8 @@ double nice_step(double range, int count) {
   return 10.0 * power;
 }
 
-void draw_panel(cairo_t* cr, const Panel& p, double x0, double y0, double w, double h, double t_max) {
+void draw_panel(cairo_t* cr, const Panel& p, double x0, double y0, double w, double h, double time_span) {
+  const double t_max = p.x_max > 0.0 ? p.x_max : time_span;
   double v_max = p.target > 0 ? p.target * 1.1 : 0.0;
   for (const auto& s : p.series)
     for (double v : s.v) v_max = std::max(v_max, v);
@@ -75,8 +78,8 @@ void draw_panel(cairo_t* cr, const Panel& p, double x0, double y0, double w, dou
     cairo_move_to(cr, X(t) - 3.0 * static_cast<double>(label.size()), bottom + 16);
     cairo_show_text(cr, label.c_str());
   }
-  cairo_move_to(cr, right - 40, bottom + 28);
-  cairo_show_text(cr, "time [s]");
+  cairo_move_to(cr, right - 6.0 * static_cast<double>(p.x_unit.size()), bottom + 28);
+  cairo_show_text(cr, p.x_unit.c_str());
   cairo_save(cr);
   cairo_move_to(cr, x0 + 14, (top + bottom) / 2 + 20);
   cairo_rotate(cr, -kPi / 2);
@@ -155,6 +158,23 @@ Status write_panels(const std::vector<Panel>& panels, double t_max, const std::f
   return write_file_atomically(png, bytes);
 }
 
+// A soft object's force against its indentation over its steps (at most ~4000 of them, evenly
+// picked): pressing and releasing draw the object's force-indentation curve.
+Panel indentation_panel(const controllers::SessionReport::SoftObjectReport& soft) {
+  Series curve;
+  double deepest = 0.0;
+  const std::size_t stride = std::max<std::size_t>(1, soft.samples.size() / 4000);
+  for (std::size_t i = 0; i < soft.samples.size(); i += stride) {
+    curve.t.push_back(soft.samples[i].indentation_m * 1e3);
+    curve.v.push_back(soft.samples[i].force_n);
+    deepest = std::max(deepest, curve.t.back());
+  }
+  return Panel{.title = fmt::format("Soft object '{}': force against indentation (deepest {:.2f} mm)", soft.object, deepest),
+               .unit = "|F| [N]", .series = {curve}, .colours = {{0.55, 0.25, 0.65}},
+               .labels = {"a point per simulation step"},
+               .x_unit = "indentation [mm]", .x_max = deepest > 0.0 ? deepest * 1.05 : 1.0};
+}
+
 }  // namespace
 
 Status write_session_plot(const controllers::SessionReport& report, const std::filesystem::path& png) {
@@ -182,7 +202,9 @@ Status write_session_plot(const controllers::SessionReport& report, const std::f
                   .labels = {"collision steps / s (100 ms windows)"},
                   .target = report.collision_target_hz > 0 ? report.collision_target_hz : -1.0};
 
-  return write_panels({force, torque, collision}, t_max, png);
+  std::vector<Panel> panels{force, torque, collision};
+  for (const auto& soft : report.soft) panels.push_back(indentation_panel(soft));
+  return write_panels(panels, t_max, png);
 }
 
 Status write_exploration_plot(const std::string& scene,

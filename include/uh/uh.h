@@ -446,6 +446,21 @@ UH_API uh_status uh_session_report_json(uh_session_id s, const char** out);
 UH_API uh_status uh_session_object_count(uh_session_id s, int32_t* out);
 UH_API uh_status uh_session_object_name(uh_session_id s, int32_t object, const char** out);
 
+/* Soft objects (scene `deformable`, docs/deformables.md): object `object`'s deformed surface, its
+ * mesh refined so a dent shows. The vertex count, and the newest deformed vertices copied into
+ * `xyz` (room for `capacity` vertices: 3 * capacity floats, x, y, z in metres in the object's
+ * frame, as its mesh); `step`, when not NULL, gets the simulation step that made them (0: at
+ * rest), so a caller sees whether they changed. The triangles (3 vertex indices each, counter-
+ * clockwise from outside) never change: their count, and `indices` with room for `capacity`
+ * triangles. Any thread, while the session runs or not; the simulation and haptic threads never
+ * wait for it. UH_ERROR_INVALID_ARGUMENT for a rigid object or a buffer too small (the message
+ * gives the count needed). */
+UH_API uh_status uh_session_soft_vertex_count(uh_session_id s, int32_t object, int32_t* out);
+UH_API uh_status uh_session_soft_vertices(uh_session_id s, int32_t object, float* xyz, int32_t capacity,
+                                          uint64_t* step);
+UH_API uh_status uh_session_soft_triangle_count(uh_session_id s, int32_t object, int32_t* out);
+UH_API uh_status uh_session_soft_triangles(uh_session_id s, int32_t object, int32_t* indices, int32_t capacity);
+
 /* Stops the session if it runs and destroys it. Zero, a stale id or a second destroy: nothing. */
 UH_API void uh_session_destroy(uh_session_id s);
 

@@ -152,6 +152,26 @@ uh_status name_at(const char* fn, uh_session_id s, std::vector<std::string> Sess
   });
 }
 
+// The uh_session_soft_* functions: `body(box, surface)` for a soft object, with `out` (named
+// `out_name`) not NULL.
+template <typename Out, typename Body>
+uh_status with_soft_surface(const char* fn, uh_session_id s, int32_t object, Out* out, const char* out_name,
+                            Body&& body) {
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, out_name);
+    auto surface = box.session->soft_surface(object < 0 ? box.object_names.size() : static_cast<std::size_t>(object));
+    if (!surface) return fail(UH_ERROR_INVALID_ARGUMENT, fmt::format("{}: {}", fn, surface.error().message));
+    return body(box, **surface);
+  });
+}
+
+// a caller's buffer with room for `capacity` items where `needed` are to go
+uh_status check_capacity(const char* fn, const char* buffer, const char* items, int32_t capacity, std::size_t needed) {
+  if (capacity >= 0 && static_cast<std::size_t>(capacity) >= needed) return UH_OK;
+  return fail(UH_ERROR_INVALID_ARGUMENT,
+              fmt::format("{}: {} has room for {} {}, the object has {}", fn, buffer, capacity, items, needed));
+}
+
 uh_status finish(SessionBox& box, const Status& result) {
   box.stopped = true;
   box.report_json = controllers::session_report_json(box.session->report());
@@ -329,6 +349,44 @@ uh_status uh_session_object_count(uh_session_id s, int32_t* out) {
 
 uh_status uh_session_object_name(uh_session_id s, int32_t object, const char** out) {
   return name_at(__func__, s, &SessionBox::object_names, "object", object, out);
+}
+
+uh_status uh_session_soft_vertex_count(uh_session_id s, int32_t object, int32_t* out) {
+  const char* const fn = __func__;
+  return with_soft_surface(fn, s, object, out, "out", [&](SessionBox&, const soft::SurfaceMesh& surface) -> uh_status {
+    *out = static_cast<int32_t>(surface.vertices.size());
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_soft_vertices(uh_session_id s, int32_t object, float* xyz, int32_t capacity, uint64_t* step) {
+  const char* const fn = __func__;
+  return with_soft_surface(fn, s, object, xyz, "xyz", [&](SessionBox& box, const soft::SurfaceMesh& surface) -> uh_status {
+    if (auto c = check_capacity(fn, "xyz", "vertices", capacity, surface.vertices.size()); c != UH_OK) return c;
+    auto made = box.session->soft_vertices(static_cast<std::size_t>(object),
+                                           std::span<float>(xyz, 3 * static_cast<std::size_t>(capacity)));
+    if (!made) return fail(made.error(), UH_ERROR_INVALID_ARGUMENT);
+    if (step != nullptr) *step = *made;
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_soft_triangle_count(uh_session_id s, int32_t object, int32_t* out) {
+  const char* const fn = __func__;
+  return with_soft_surface(fn, s, object, out, "out", [&](SessionBox&, const soft::SurfaceMesh& surface) -> uh_status {
+    *out = static_cast<int32_t>(surface.triangles.size());
+    return UH_OK;
+  });
+}
+
+uh_status uh_session_soft_triangles(uh_session_id s, int32_t object, int32_t* indices, int32_t capacity) {
+  const char* const fn = __func__;
+  return with_soft_surface(fn, s, object, indices, "indices", [&](SessionBox&, const soft::SurfaceMesh& surface) -> uh_status {
+    if (auto c = check_capacity(fn, "indices", "triangles", capacity, surface.triangles.size()); c != UH_OK) return c;
+    for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+      for (std::size_t k = 0; k < 3; ++k) indices[3 * t + k] = surface.triangles[t][k];
+    return UH_OK;
+  });
 }
 
 void uh_session_destroy(uh_session_id s) {

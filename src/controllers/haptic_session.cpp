@@ -592,6 +592,7 @@ Status HapticSession::stop() {
   collect_report(seconds, false);  // before the loops stop: their statistics describe the run itself
   for (auto& rig : rigs_) rig->manager->stop();
   stop_soft();
+  collect_soft_report();
   world_->stop();
   record_proxy_ends();
   // the haptic threads are joined and the devices got zero: this thread becomes the states' writer
@@ -620,9 +621,40 @@ Status HapticSession::stop() {
   return stopped_;
 }
 
+Result<const soft::SurfaceMesh*> HapticSession::soft_surface(std::size_t object) const {
+  if (object >= soft_.size())
+    return Error{fmt::format("no scene object {} (the scene has {})", object, soft_.size()), ErrorKind::kInvalid};
+  if (!soft_[object])
+    return Error{fmt::format("object '{}' is rigid: it has no deformed vertices", scene().objects[object].name),
+                 ErrorKind::kInvalid};
+  return &soft_[object]->body().surface;
+}
+
+Result<std::size_t> HapticSession::soft_vertex_count(std::size_t object) const {
+  auto surface = soft_surface(object);
+  if (!surface) return surface.error();
+  return (*surface)->vertices.size();
+}
+
+Result<std::uint64_t> HapticSession::soft_vertices(std::size_t object, std::span<float> xyz) {
+  auto count = soft_vertex_count(object);
+  if (!count) return count.error();
+  if (xyz.size() < 3 * *count)
+    return Error{fmt::format("object '{}' has {} deformed vertices: the buffer of {} floats holds fewer than {}",
+                             scene().objects[object].name, *count, xyz.size(), 3 * *count),
+                 ErrorKind::kInvalid};
+  return soft_[object]->read_surface(xyz);
+}
+
 void HapticSession::stop_soft() {
   for (auto& soft : soft_)
     if (soft) soft->stop();
+}
+
+void HapticSession::collect_soft_report() {
+  report_.soft.clear();
+  for (std::size_t i = 0; i < soft_.size(); ++i)
+    if (soft_[i]) report_.soft.push_back({.object = scene().objects[i].name, .samples = soft_[i]->record()});
 }
 
 Status HapticSession::soft_error() const {
@@ -703,6 +735,7 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
   drain();
   collision_hz_ = haptic_hz_ / ticks_per_collision_step;
   collect_report(static_cast<double>(k) / haptic_hz_, true);
+  collect_soft_report();
   record_proxy_ends();
   publish_report();
   report_.stopped_early = k < ticks;

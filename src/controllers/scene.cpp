@@ -32,4 +32,12 @@ Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const Sce
   return std::make_shared<const collette::MeshInside>(*mesh);
 }
 
+Result<soft::SurfaceMesh> load_soft_surface(const SceneShape& shape) {
+  if (shape.mesh.empty()) return soft::SurfaceMesh{};
+  auto mesh = collette::load_mesh(shape.mesh);
+  if (!mesh) return mesh.error();
+  for (Vec3& v : mesh->vertices) v = v * shape.meters_per_unit;
+  return soft::refine_surface(mesh->vertices, mesh->triangles);
+}
+
 }  // namespace uh::controllers

@@ -63,7 +63,11 @@ Result<std::shared_ptr<const soft::SoftBodyModel>> compile_soft_body(const Scene
   const std::string stage = fmt::format("meshing the volume of '{}'", object.name);
   if (options.progress) options.progress(stage, 0.0);
   const auto inside = [&](const Eigen::Vector3d& p) { return surface->contains({p.x(), p.y(), p.z()}); };
-  auto body = soft::build_soft_body(inside, tree.tree->leaves(), soft_params(*object.deformable));
+  auto drawn = load_soft_surface(object.shape);
+  if (!drawn) return drawn.error();
+  soft::SoftBodyParams params = soft_params(*object.deformable);
+  params.surface = std::move(*drawn);
+  auto body = soft::build_soft_body(inside, tree.tree->leaves(), params);
   if (!body) return body.error();
   if (options.progress) options.progress(stage, 1.0);
   return std::make_shared<const soft::SoftBodyModel>(std::move(*body));

@@ -57,7 +57,9 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
       loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       unit_loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       unit_moves_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
-      spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()) {
+      spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()),
+      down_in_object_(rotate(object_from_world_, Vec3{0.0, 0.0, -1.0})) {
+  record_.reserve(kRecordCapacity);
   for (std::size_t t = 0; t < tools; ++t) {
     contacts_.push_back(std::make_unique<LatestValue<SoftContacts>>());
     tool_forces_.push_back(std::make_unique<LatestValue<Vec3>>());
@@ -209,7 +211,45 @@ Status SoftSimulation::step(double dt_s) {
   if (tree.node_count() != rest_tree_->node_count()) tree = *rest_tree_;
   tree.refit(spheres_);
   trees_.publish();
+  publish_surface(dt_s);
   return Ok{};
+}
+
+void SoftSimulation::publish_surface(double dt_s) {
+  SoftSurface& surface = surfaces_.write_buffer();
+  // a slot's storage is sized the first time it comes round, as the trees' are
+  surface.xyz.resize(3 * surface_vertex_count());
+  soft::deform_surface(*body_, fem_.positions(), surface.xyz);
+  surface.step = ++steps_;
+  record_step(dt_s, surface.xyz);
+  surfaces_.publish();
+}
+
+void SoftSimulation::record_step(double dt_s, std::span<const float> xyz) {
+  if (record_.size() == record_.capacity()) return;  // full: no allocation on this thread
+  const auto& rest = body_->surface.vertices;
+  double deepest = 0.0;
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    const Vec3 moved{static_cast<double>(xyz[3 * i]) - rest[i].x(), static_cast<double>(xyz[3 * i + 1]) - rest[i].y(),
+                     static_cast<double>(xyz[3 * i + 2]) - rest[i].z()};
+    deepest = std::max(deepest, dot(moved, down_in_object_));
+  }
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (const auto& l : loads_) total += l;
+  record_.push_back({.time_s = static_cast<double>(steps_) * dt_s, .indentation_m = deepest, .force_n = total.norm()});
+}
+
+std::uint64_t SoftSimulation::read_surface(std::span<float> xyz) {
+  const std::lock_guard lock(surface_readers_);
+  surfaces_.update();
+  const SoftSurface& newest = surfaces_.read_buffer();
+  if (newest.step == 0) {  // no step yet: the rest surface
+    soft::deform_surface(*body_, body_->mesh.nodes, xyz);
+    return 0;
+  }
+  const std::size_t n = std::min(xyz.size() / 3 * 3, newest.xyz.size());
+  std::copy_n(newest.xyz.begin(), n, xyz.begin());
+  return newest.step;
 }
 
 Status SoftSimulation::start(double rate_hz) {

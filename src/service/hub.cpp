@@ -534,7 +534,35 @@ void Hub::send_state(ClientId id) {
   if (!slot_ || slot_->phase != Phase::kRunning) return;
   const auto it = clients_.find(id);
   if (it == clients_.end()) return;
-  it->second.peer->send(reply("state", nullptr, session_state_json(*slot_->session)), true);
+  json state = session_state_json(*slot_->session);
+  add_deformed(it->second, state);
+  it->second.peer->send(reply("state", nullptr, std::move(state)), true);
+}
+
+void Hub::add_deformed(Client& c, json& state) {
+  controllers::HapticSession& session = *slot_->session;
+  const std::size_t objects = session.scene().objects.size();
+  const double now = steady_seconds();
+  if (objects == 0 || now - c.deformed_sent_s < 1.0 / kDeformedRateHz) return;
+  c.deformed_steps.resize(objects, 0);
+  json deformed = json::array();
+  std::size_t room = kMaxDeformedVertices;
+  for (std::size_t k = 0; k < objects; ++k) {
+    const std::size_t i = (c.next_deformed + k) % objects;
+    if (session.soft_simulation(i) == nullptr) continue;
+    const auto count = session.soft_vertex_count(i);
+    if (!count || *count > room) continue;
+    deformed_scratch_.resize(3 * *count);
+    const auto step = session.soft_vertices(i, deformed_scratch_);
+    if (!step || *step == c.deformed_steps[i]) continue;
+    c.deformed_steps[i] = *step;
+    room -= *count;
+    deformed.push_back(deformed_json(session.scene().objects[i].name, *step, deformed_scratch_));
+  }
+  c.next_deformed = (c.next_deformed + 1) % objects;
+  if (deformed.empty()) return;
+  c.deformed_sent_s = now;
+  state["deformed"] = std::move(deformed);
 }
 
 void Hub::poll_events() {

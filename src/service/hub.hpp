@@ -80,6 +80,10 @@ class Hub final : public Endpoint {
       std::optional<AddObject> add;
     };
     std::optional<PendingMesh> pending_mesh;
+    // the soft objects' surfaces sent in its states: when last, and each object's step
+    double deformed_sent_s = 0.0;
+    std::vector<std::uint64_t> deformed_steps;
+    std::size_t next_deformed = 0;  // the object looked at first next time (a fair turn)
   };
   enum class Phase : std::uint8_t { kOpen, kStarting, kRunning };
   static constexpr ClientId kHost = 0;
@@ -130,6 +134,8 @@ class Hub final : public Endpoint {
   void close_slot();
   void broadcast_session(std::string_view status);
   void send_state(ClientId id);
+  // the soft objects' surfaces a newer step made since `c`'s last, within the protocol's bounds
+  void add_deformed(Client& c, json& state);
   void poll_events();
   void send_to(ClientId id, std::string text);
 
@@ -145,6 +151,7 @@ class Hub final : public Endpoint {
   std::jthread mesher_;   // the one inline mesh checked and written at a time
   bool meshing_ = false;  // mesher_ works (network thread)
   bool shut_down_ = false;
+  std::vector<float> deformed_scratch_;  // a soft object's vertices on their way into a state
 };
 
 }  // namespace uh::service

@@ -312,6 +312,14 @@ ParsedRequest parse_request(std::string_view text) {
   return out;
 }
 
+json deformed_json(std::string_view object, std::uint64_t step, std::span<const float> xyz) {
+  json vertices = json::array();
+  auto& array = vertices.get_ref<json::array_t&>();
+  array.reserve(xyz.size());
+  for (const float v : xyz) array.emplace_back(static_cast<std::int64_t>(std::lround(static_cast<double>(v) / kDeformedUnitM)));
+  return {{"object", std::string(object)}, {"step", step}, {"unit_m", kDeformedUnitM}, {"vertices", std::move(vertices)}};
+}
+
 std::string reply(std::string_view type, const json& id, json fields) {
   json out = json::object();
   out["type"] = std::string(type);

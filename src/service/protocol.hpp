@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -28,6 +29,14 @@ inline constexpr std::size_t kMaxMeshBinaryBytes = std::size_t{64} << 20;
 inline constexpr double kMinStateRateHz = 1.0;
 inline constexpr double kMaxStateRateHz = 1000.0;
 inline constexpr double kDefaultStateRateHz = 60.0;
+
+/// A soft object's deformed surface rides along in `state` (`deformed`, docs/protocol.md): at most
+/// this often per client [Hz], only when a newer simulation step made it, and no more vertices per
+/// message than kMaxDeformedVertices (7 bytes or fewer each, so a state stays well under a
+/// megabyte); an object with more is drawn at rest. Coordinates are integers of kDeformedUnitM.
+inline constexpr double kDeformedRateHz = 30.0;
+inline constexpr std::size_t kMaxDeformedVertices = 32768;
+inline constexpr double kDeformedUnitM = 1e-5;
 
 struct Hello {
   int protocol = 0;
@@ -99,6 +108,10 @@ struct ParsedRequest {
   /// to it and is consumed with it (dropped when the request was refused).
   bool announces_binary = false;
 };
+
+/// One entry of `state.deformed`: object `object`'s vertices `xyz` (x, y, z per vertex, metres in
+/// the object's frame, in the order of its `get_mesh` reply) as made by simulation step `step`.
+json deformed_json(std::string_view object, std::uint64_t step, std::span<const float> xyz);
 
 /// Parses one text message. Never throws.
 ParsedRequest parse_request(std::string_view text);

@@ -231,15 +231,37 @@ json describe_scene(const controllers::Scene& scene) {
           {"collision_hz", scene.collision_hz}};
 }
 
+namespace {
+
+// a soft object's drawn surface (its mesh refined), in the order of its deformed vertices
+Result<json> soft_mesh(const controllers::SceneShape& shape, const std::string& name) {
+  auto surface = controllers::load_soft_surface(shape);
+  if (!surface) return surface.error();
+  collette::TriangleMesh mesh;
+  for (const auto& v : surface->vertices) mesh.vertices.push_back({v.x(), v.y(), v.z()});
+  mesh.triangles = surface->triangles;
+  json out = collette::mesh_json(mesh, 1.0);
+  out["object"] = name;
+  out["soft"] = true;
+  return out;
+}
+
+}  // namespace
+
 Result<json> scene_mesh(const controllers::Scene& scene, const std::string& name) {
   const controllers::SceneShape* shape = nullptr;
+  bool soft = false;
   for (const auto& o : scene.objects)
-    if (o.name == name) shape = &o.shape;
+    if (o.name == name) {
+      shape = &o.shape;
+      soft = o.deformable.has_value();
+    }
   for (const auto& tool : scene.tools)
     if (tool.name == name) shape = &tool.shape;
   if (shape == nullptr) return Error{fmt::format("no object or tool is named '{}'", name)};
   if (shape->mesh.empty())
     return Error{fmt::format("'{}' was given as a .ist file, which holds no mesh", name)};
+  if (soft) return soft_mesh(*shape, name);
   auto mesh = collette::load_mesh(shape->mesh);
   if (!mesh) return mesh.error();
   json out = collette::mesh_json(*mesh, shape->meters_per_unit);

@@ -63,15 +63,20 @@ class TetLocator {
     double best_min = -1e-9;
     const Eigen::Vector3i c = cell_of(p);
     for (std::int32_t t : buckets_[bucket(c.x(), c.y(), c.z())]) {
-      const Eigen::Vector3d b =
-          rest_inverse_[static_cast<std::size_t>(t)] * (p - mesh_.nodes[static_cast<std::size_t>(mesh_.tets[static_cast<std::size_t>(t)][0])]);
-      const Eigen::Vector4d w(1.0 - b.sum(), b.x(), b.y(), b.z());
+      const Eigen::Vector4d w = weights_in(t, p);
       if (w.minCoeff() < best_min) continue;
       best_min = w.minCoeff();
       const Eigen::Vector4d clamped = w.cwiseMax(0.0);
       best = EmbeddedSphere{.tet = t, .weights = clamped / clamped.sum(), .rest_radius = 0.0};
     }
     return best;
+  }
+
+  // p's barycentric weights in tetrahedron t, negative outside it
+  Eigen::Vector4d weights_in(std::int32_t t, const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d b =
+        rest_inverse_[static_cast<std::size_t>(t)] * (p - mesh_.nodes[static_cast<std::size_t>(mesh_.tets[static_cast<std::size_t>(t)][0])]);
+    return {1.0 - b.sum(), b.x(), b.y(), b.z()};
   }
 
  private:
@@ -97,8 +102,7 @@ Eigen::Vector3d centre_of(const Sphere& s) {
   return {static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
 }
 
-Status embed_leaves(std::span<const Sphere> leaves, SoftBodyModel& body) {
-  const TetLocator locator(body.mesh, body.rest_inverse);
+Status embed_leaves(const TetLocator& locator, std::span<const Sphere> leaves, SoftBodyModel& body) {
   body.spheres.reserve(leaves.size());
   for (std::size_t i = 0; i < leaves.size(); ++i) {
     auto embedded = locator.locate(centre_of(leaves[i]));
@@ -109,6 +113,42 @@ Status embed_leaves(std::span<const Sphere> leaves, SoftBodyModel& body) {
     body.spheres.push_back(*embedded);
   }
   return Ok{};
+}
+
+bool in_box(const Box& box, const Eigen::Vector3d& p) {
+  return (p.array() >= box.min.array()).all() && (p.array() <= box.max.array()).all();
+}
+
+// the tetrahedron whose centroid is nearest p: brute force, for the few vertices outside the
+// lattice (all its tetrahedra have the same size and shape, so the nearest centroid is the
+// nearest element)
+std::int32_t nearest_tet(const TetMesh& mesh, const Eigen::Vector3d& p) {
+  std::int32_t nearest = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (std::int32_t n : mesh.tets[t]) centroid += 0.25 * mesh.nodes[static_cast<std::size_t>(n)];
+    if (const double d = (centroid - p).squaredNorm(); d < best) {
+      best = d;
+      nearest = static_cast<std::int32_t>(t);
+    }
+  }
+  return nearest;
+}
+
+// each surface vertex in its tetrahedron with weights that give its rest position exactly
+// (extrapolated outside the lattice), or held in the fixed box
+void embed_surface(const TetLocator& locator, const std::optional<Box>& fixed, SoftBodyModel& body) {
+  body.surface_embedding.reserve(body.surface.vertices.size());
+  for (const Eigen::Vector3d& v : body.surface.vertices) {
+    EmbeddedVertex e;
+    if (!fixed || !in_box(*fixed, v)) {
+      const auto inside = locator.locate(v);
+      e.tet = inside ? inside->tet : nearest_tet(body.mesh, v);
+      e.weights = locator.weights_in(e.tet, v);
+    }
+    body.surface_embedding.push_back(e);
+  }
 }
 
 }  // namespace
@@ -147,7 +187,10 @@ Result<SoftBodyModel> build_soft_body(const InsidePredicate& inside, std::span<c
       return Error{"soft::build_soft_body: the fixed box holds no node of the lattice (the box is in metres, object frame)",
                    ErrorKind::kInvalid};
   }
-  if (Status s = embed_leaves(leaves, body); !s) return s.error();
+  const TetLocator locator(body.mesh, body.rest_inverse);
+  if (Status s = embed_leaves(locator, leaves, body); !s) return s.error();
+  body.surface = params.surface;
+  embed_surface(locator, params.fixed, body);
   return body;
 }
 
@@ -165,6 +208,20 @@ void deform_spheres(const SoftBodyModel& body, const std::vector<Eigen::Vector3d
     const double stretch = f.determinant() > 0.0 ? std::max(sigma.minCoeff(), kMinSphereStretch) : kMinSphereStretch;
     out[i] = Sphere{static_cast<float>(centre.x()), static_cast<float>(centre.y()), static_cast<float>(centre.z()),
                     static_cast<float>(e.rest_radius * stretch)};
+  }
+}
+
+void deform_surface(const SoftBodyModel& body, const std::vector<Eigen::Vector3d>& positions, std::span<float> xyz) {
+  const std::size_t n = std::min(xyz.size() / 3, body.surface_embedding.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const EmbeddedVertex& e = body.surface_embedding[i];
+    Eigen::Vector3d p = body.surface.vertices[i];
+    if (e.tet != EmbeddedVertex::kHeldVertex) {
+      const auto& t = body.mesh.tets[static_cast<std::size_t>(e.tet)];
+      p.setZero();
+      for (int k = 0; k < 4; ++k) p += e.weights[k] * node_of(positions, t[static_cast<std::size_t>(k)]);
+    }
+    for (int axis = 0; axis < 3; ++axis) xyz[3 * i + static_cast<std::size_t>(axis)] = static_cast<float>(p[axis]);
   }
 }
 

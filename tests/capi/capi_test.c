@@ -829,6 +829,62 @@ static void test_proxy_choice(void) {
   uh_scene_destroy(scene);
 }
 
+/* scenes/soft_block.json's block read through the C API: at rest, then pressed by its ball in a
+ * stepped run, the vertices of its top under the ball have gone down; a rigid object and a short
+ * buffer are refused with messages that say why. */
+static void test_soft_vertices(void) {
+  uh_session_id s = {0};
+  uh_scene_id scene = small_scene();
+  uh_session_def def = uh_default_session_def();
+  int32_t vertices = 0, triangles = 0, i, under = 0;
+  uint64_t step = 99;
+  float *rest, *pressed;
+  int32_t* indices;
+  double deepest = 0.0;
+  REQUIRE_OK(uh_session_open(UH_TEST_SCENES_DIR "/soft_block.json", &s));
+  REQUIRE_OK(uh_session_soft_vertex_count(s, 0, &vertices));
+  REQUIRE_OK(uh_session_soft_triangle_count(s, 0, &triangles));
+  CHECK(vertices > 1000 && triangles > 2000); /* the 12 triangles of block.obj, refined */
+  rest = malloc(sizeof(float) * 3 * (size_t)vertices);
+  pressed = malloc(sizeof(float) * 3 * (size_t)vertices);
+  indices = malloc(sizeof(int32_t) * 3 * (size_t)triangles);
+  REQUIRE_OK(uh_session_soft_triangles(s, 0, indices, triangles));
+  for (i = 0; i < 3 * triangles; ++i) CHECK(indices[i] >= 0 && indices[i] < vertices);
+  REQUIRE_OK(uh_session_soft_vertices(s, 0, rest, vertices, &step));
+  CHECK(step == 0);
+  CHECK_STATUS(uh_session_soft_vertices(s, 0, pressed, vertices - 1, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "xyz has room for") != NULL);
+  CHECK_STATUS(uh_session_soft_vertices(s, 0, NULL, vertices, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(uh_session_soft_vertex_count(s, 1, &i), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "no scene object 1") != NULL);
+
+  REQUIRE_OK(uh_session_run_stepped(s, 1.0, 1)); /* the ball 6 mm into the block's top */
+  REQUIRE_OK(uh_session_soft_vertices(s, 0, pressed, vertices, &step));
+  CHECK(step >= 90); /* 100 Hz steps */
+  for (i = 0; i < vertices; ++i) {
+    const float* r = rest + 3 * i;
+    const double drop = (double)r[2] - (double)pressed[3 * i + 2];
+    if (fabs((double)r[2]) < 1e-6 && sqrt((double)(r[0] * r[0] + r[1] * r[1])) < 0.004) {
+      ++under;
+      if (drop > deepest) deepest = drop;
+    }
+  }
+  printf("soft block: %d vertices, %d triangles; %d top vertices under the ball, deepest drop %.3f mm\n",
+         vertices, triangles, under, deepest * 1e3);
+  CHECK(under > 0);
+  CHECK(deepest > 5e-4);
+  uh_session_destroy(s);
+
+  REQUIRE_OK(uh_session_create(scene, &def, &s));
+  CHECK_STATUS(uh_session_soft_vertex_count(s, 0, &i), UH_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(uh_last_error(), "is rigid") != NULL);
+  uh_session_destroy(s);
+  uh_scene_destroy(scene);
+  free(rest);
+  free(pressed);
+  free(indices);
+}
+
 /* Two tools added through calls, each on its own device: the left stylus presses into the bunny,
  * the right one into a ball; each contact event names its tool. */
 static void test_several_tools(void) {
@@ -907,7 +963,8 @@ int main(int argc, char** argv) {
                {"two_tools", test_two_tools},
                {"older_caller", test_older_caller},
                {"several_tools", test_several_tools},
-               {"proxy_choice", test_proxy_choice}};
+               {"proxy_choice", test_proxy_choice},
+               {"soft_vertices", test_soft_vertices}};
   size_t i;
   if (argc != 2) {
     fprintf(stderr, "usage: %s TEST\n", argv[0]);

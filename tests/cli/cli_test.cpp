@@ -1205,6 +1205,28 @@ TEST_F(CliTest, ExploreNamesAnUnknownObjectAndWritesItsPlot) {
   EXPECT_EQ(read_text(png).substr(1, 3), "PNG");
 }
 
+// a PNG's height, from its header (IHDR: width, then height, big-endian, from byte 16)
+std::uint32_t png_height(const std::string& png) {
+  std::uint32_t h = 0;
+  for (std::size_t i = 20; i < 24 && i < png.size(); ++i) h = (h << 8) | static_cast<unsigned char>(png[i]);
+  return h;
+}
+
+// a scene with a soft object gets a fourth panel: its indentation against the force
+TEST_F(CliTest, RunPlotsASoftObjectsIndentationAgainstForce) {
+  const fs::path soft = dir_ / "soft.png", rigid = dir_ / "rigid.png";
+  const fs::path scenes = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes";
+  const std::string env = fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string());
+  const CommandRun r = uh(fmt::format("run '{}' --stepped --seconds 1 --plot '{}'",
+                                      (scenes / "soft_block.json").string(), soft.string()), env);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CommandRun b = uh(fmt::format("run '{}' --stepped --seconds 0.2 --plot '{}'",
+                                      (scenes / "bunny_sweep.json").string(), rigid.string()), env);
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(png_height(read_text(soft)), 4u * 260u);
+  EXPECT_EQ(png_height(read_text(rigid)), 3u * 260u);
+}
+
 // a threaded run clocked by HD's scheduler (the stand-in's own thread)
 TEST_F(CliTest, RunOnOpenHapticsNamedOnTheCommandLine) {
   const fs::path scene = write_small_device_scene(dir_);

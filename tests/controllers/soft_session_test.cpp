@@ -48,6 +48,22 @@ Press press(double depth_m, bool soft, Path path) {
   const auto& rest = sim->body().mesh.nodes;
   for (std::size_t n = 0; n < rest.size(); ++n)
     out.indentation_m = std::max(out.indentation_m, rest[n].z() - sim->fem().positions()[n].z());
+  // the report's record (uh run --plot): a sample per step, the last one this step's
+  const auto& soft_report = (*session)->report().soft;
+  EXPECT_EQ(soft_report.size(), 1u);
+  if (!soft_report.empty()) {
+    const auto& samples = soft_report.front().samples;
+    EXPECT_EQ(samples.size(), 100u);  // 1 s at 100 Hz
+    Eigen::Vector3d total = Eigen::Vector3d::Zero();
+    for (const auto& l : sim->loads()) total += l;
+    EXPECT_NEAR(samples.back().force_n, total.norm(), 1e-12);
+    std::vector<float> xyz(3 * sim->body().surface.vertices.size());
+    soft::deform_surface(sim->body(), sim->fem().positions(), xyz);
+    double deepest = 0.0;
+    for (std::size_t v = 0; v < sim->body().surface.vertices.size(); ++v)
+      deepest = std::max(deepest, sim->body().surface.vertices[v].z() - double{xyz[3 * v + 2]});
+    EXPECT_NEAR(samples.back().indentation_m, deepest, 1e-9);
+  }
   // the last soft step (tick 990) spread what the ball felt on the tick before it
   Eigen::Vector3d loads = Eigen::Vector3d::Zero();
   for (const auto& l : sim->loads()) loads += l;

@@ -474,6 +474,54 @@ TEST_F(ServerTest, DefaultSessionRunsStreamsStateAndStopsWithTheReport) {
   c.request({{"type", "close"}}, "closed");
 }
 
+// scenes/soft_block.json served: its block's mesh comes refined and marked soft, and while its ball
+// presses it the states carry the block's deformed vertices, changed from rest, the top under the
+// ball gone down, within the protocol's bounds.
+TEST_F(ServerTest, AWatchedSoftBlockStreamsItsDeformedVertices) {
+  std::filesystem::create_directories(dir_ / "scenes");
+  std::filesystem::create_directories(dir_ / "assets" / "meshes");
+  std::filesystem::copy_file(testing::assets().parent_path() / "scenes" / "soft_block.json",
+                             dir_ / "scenes" / "soft_block.json");
+  for (const char* mesh : {"block.obj", "ball.obj"})
+    std::filesystem::copy_file(testing::assets() / "meshes" / mesh, dir_ / "assets" / "meshes" / mesh);
+  Client c(port());
+  c.hello();
+  c.request({{"type", "open"}, {"scene", "scenes/soft_block.json"}}, "opened");
+  const json mesh = c.request({{"type", "get_mesh"}, {"object", "block"}}, "mesh");
+  EXPECT_EQ(mesh["soft"], true);
+  const std::vector<double> rest = mesh["vertices"].get<std::vector<double>>();
+  ASSERT_GT(rest.size(), 3u * 1000u);  // block.obj's 8 corners, refined
+  c.request({{"type", "subscribe"}, {"rate_hz", 100}}, "subscribed");
+  c.request({{"type", "start"}}, "started");
+
+  int deformed_states = 0, states = 0;
+  std::uint64_t last_step = 0;
+  double deepest = 0.0;
+  for (; states < 1000 && deepest < 1e-3; ++states) {
+    const json st = c.expect("state");
+    if (!st.contains("deformed")) continue;
+    ASSERT_EQ(st["deformed"].size(), 1u);
+    const json& d = st["deformed"][0];
+    EXPECT_EQ(d["object"], "block");
+    EXPECT_GT(d["step"].get<std::uint64_t>(), last_step) << "only a newer step is sent";
+    last_step = d["step"].get<std::uint64_t>();
+    const double unit = d["unit_m"].get<double>();
+    const auto& v = d["vertices"];
+    ASSERT_EQ(v.size(), rest.size());
+    ++deformed_states;
+    for (std::size_t i = 0; i + 2 < rest.size(); i += 3) {
+      const bool under_ball = std::abs(rest[i + 2]) < 1e-6 && std::hypot(rest[i], rest[i + 1]) < 0.004;
+      if (under_ball) deepest = std::max(deepest, rest[i + 2] - v[i + 2].get<double>() * unit);
+    }
+  }
+  std::printf("%d states, %d with deformed vertices (last step %llu); the top under the ball %.2f mm down\n",
+              states, deformed_states, static_cast<unsigned long long>(last_step), deepest * 1e3);
+  EXPECT_GT(deepest, 1e-3);
+  // at most kDeformedRateHz of the states carry them (100 Hz subscribed, 30 Hz at most)
+  EXPECT_LE(deformed_states, states * kDeformedRateHz / 100.0 + 2);
+  c.request({{"type", "stop"}}, "stopped");
+}
+
 TEST_F(ServerTest, OneClientControlsOthersWatchAndItsDisconnectStopsTheSession) {
   Client watcher(port());
   watcher.hello();

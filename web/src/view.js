@@ -17,7 +17,9 @@ const live = {
   toolDrawn: null,      // where the tool was drawn last frame [px, canvas]
   forceN: 0,            // |force| of the newest state [N]
   lastContact: null,
+  deformed: 0,          // soft objects' surfaces redrawn from a state's `deformed`
 };
+const softMeshes = new Map();  // a soft object's name -> its drawn mesh, whose vertices states move
 window.uhView = live;
 
 const container = document.getElementById('view');
@@ -98,6 +100,7 @@ async function loadScene() {
   live.scene = description.name;
   $('scene').textContent = description.name;
   objectsGroup.clear();
+  softMeshes.clear();
   live.meshes = 0;
   const box = new THREE.Box3();
   for (const object of description.objects) {
@@ -107,6 +110,7 @@ async function loadScene() {
     const color = object.watched ? 0xd8dee9 : 0x81a1c1;
     const mesh = meshFrom(geometry, new THREE.MeshStandardMaterial({ color, roughness: 0.8 }));
     applyPose(mesh, object.pose);
+    if (geometry.soft) softMeshes.set(object.name, mesh);
     objectsGroup.add(mesh);
     box.expandByObject(mesh);
     live.meshes++;
@@ -130,8 +134,24 @@ async function loadScene() {
   }
 }
 
+// a soft object's vertices as its newest simulation step left them (integers of unit_m, object frame)
+function showDeformed(entries) {
+  for (const entry of entries) {
+    const mesh = softMeshes.get(entry.object);
+    if (!mesh) continue;
+    const position = mesh.geometry.getAttribute('position');
+    if (position.array.length !== entry.vertices.length) continue;
+    for (let i = 0; i < entry.vertices.length; i++) position.array[i] = entry.vertices[i] * entry.unit_m;
+    position.needsUpdate = true;
+    mesh.geometry.computeVertexNormals();
+    mesh.geometry.computeBoundingSphere();
+    live.deformed++;
+  }
+}
+
 function showState(s) {
   live.states++;
+  if (s.deformed) showDeformed(s.deformed);
   live.toolPosition = s.tool.position;
   applyPose(tool, { position: s.tool.position, rotation: s.tool.orientation });
   if (s.handle) {

@@ -24,6 +24,7 @@
 #include "uh/controllers/scene.hpp"
 #include "uh/controllers/session_model.hpp"
 #include "uh/controllers/soft_simulation.hpp"
+#include <span>
 #include "uh/core/delegator.hpp"
 #include "uh/core/event_counter.hpp"
 #include "uh/core/latest_value.hpp"
@@ -149,6 +150,12 @@ struct SessionReport : ToolReport {
   std::uint64_t coherent_queries = 0;  ///< collision queries that reused their kept candidates
   std::vector<RateSample> collision_rates;
   std::vector<ToolReport> tools;  ///< per tool, in Scene::tools order
+  /// Per soft object (scene order): a sample per simulation step, its indentation and force.
+  struct SoftObjectReport {
+    std::string object;
+    std::vector<SoftSample> samples;
+  };
+  std::vector<SoftObjectReport> soft;
 };
 
 /// The newest state of one tool of a session, as its haptic thread sent it in its last tick (plain
@@ -299,6 +306,18 @@ class HapticSession {
   const SoftSimulation* soft_simulation(std::size_t object) const {
     return object < soft_.size() ? soft_[object].get() : nullptr;
   }
+  /// Scene object `object`'s drawn surface at rest (its mesh refined, load_soft_surface): the
+  /// triangles of the deformed vertices. An error naming the object when it is rigid or there is
+  /// no such object.
+  Result<const soft::SurfaceMesh*> soft_surface(std::size_t object) const;
+  /// The vertices of that surface, as soft_surface().
+  Result<std::size_t> soft_vertex_count(std::size_t object) const;
+  /// Copies object `object`'s newest deformed surface into `xyz` (x, y, z floats per vertex, [m]
+  /// in the object's frame, as its mesh is) and returns the step that made it (0: at rest). An
+  /// error when the object is rigid or `xyz` holds fewer than 3 * soft_vertex_count() floats.
+  /// Any thread but the simulation's, while the session runs or not; never makes the simulation,
+  /// collision or haptic threads wait.
+  Result<std::uint64_t> soft_vertices(std::size_t object, std::span<float> xyz);
   /// The rate of every deformable object's simulation thread [Hz] (docs/deformables.md, "In a session").
   static constexpr double kSoftRateHz = 100.0;
 
@@ -331,6 +350,7 @@ class HapticSession {
                     std::int32_t pairs);
   bool any_fault() const;
   void stop_soft();
+  void collect_soft_report();  // once the simulations stopped
   Status soft_error() const;
   bool haptic_threads_running() const;
   bool soft_threads_running() const;

@@ -17,6 +17,7 @@
 #include "uh/core/result.hpp"
 #include "uh/scene/scene.hpp"
 #include "uh/scene/validate.hpp"
+#include "uh/soft/surface_mesh.hpp"
 
 namespace uh::controllers {
 
@@ -54,5 +55,10 @@ Result<ShapeTree> load_shape_tree(
 /// without the mesh it was packed from).
 /// The mesh is read and validated as for packing. Setup only.
 Result<std::shared_ptr<const collette::MeshInside>> load_shape_surface(const SceneShape& shape);
+
+/// A soft object's drawn surface: the shape's mesh in metres, refined (soft::refine_surface); its
+/// vertices are those a session deforms and `uh serve` draws. Empty for a shape with no mesh file.
+/// Setup only.
+Result<soft::SurfaceMesh> load_soft_surface(const SceneShape& shape);
 
 }  // namespace uh::controllers

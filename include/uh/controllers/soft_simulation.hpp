@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -42,6 +43,19 @@ struct SoftContacts {
   std::array<float, kCapacity> weights{};
   /// the pairs' weighted mean normal, pushing the tool out of the object [unit, world]; zero: none
   Vec3 normal_world{};
+};
+
+/// The drawn surface's deformed vertices as one step left them.
+struct SoftSurface {
+  std::vector<float> xyz;  ///< x, y, z per vertex of the body's surface [m, object frame]
+  std::uint64_t step = 0;  ///< the step that made them (1, 2, ...)
+};
+
+/// One step of a soft object as `uh run --plot` draws it: how deep it was pressed and how hard.
+struct SoftSample {
+  double time_s = 0.0;         ///< the simulation's time at the step's end [s]
+  double indentation_m = 0.0;  ///< the deepest downward (world -z) displacement of a surface vertex [m]
+  double force_n = 0.0;        ///< |sum of the step's loads|: what the tools pressed it with [N]
 };
 
 class SoftSimulation {
@@ -74,7 +88,16 @@ class SoftSimulation {
   /// the step took and the object's compliance there (ForceController::feel_compliance_of).
   LatestValue<ContactCompliance>& compliance(std::size_t tool) { return *compliances_[tool]; }
 
-  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree.
+  /// Vertices of the body's drawn surface (SoftBodyModel::surface).
+  std::size_t surface_vertex_count() const { return body_->surface.vertices.size(); }
+  /// Copies the newest published deformed surface into `xyz` (3 floats per vertex, as many as
+  /// fit; the rest pose before the first step) and returns the step that made it (0: at rest).
+  /// Any thread but the simulation's; readers take turns (a lock among readers: the simulation
+  /// thread never takes it, so it never waits).
+  std::uint64_t read_surface(std::span<float> xyz);
+
+  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree
+  /// and the deformed surface.
   Status step(double dt_s);
 
   /// Runs step() at `rate_hz` on its own thread until stop(). Controlling thread.
@@ -90,6 +113,10 @@ class SoftSimulation {
   const std::vector<Eigen::Vector3d>& loads() const { return loads_; }
   /// The last step's deformed leaf spheres [m, object frame]. Simulation thread (or after stop()).
   std::span<const Sphere> spheres() const { return spheres_; }
+  /// A sample per step (the first kRecordCapacity; allocated at create()). Simulation thread (or
+  /// after stop()).
+  const std::vector<SoftSample>& record() const { return record_; }
+  static constexpr std::size_t kRecordCapacity = 60000;  // ten minutes at 100 Hz
   const soft::CorotationalFem& fem() const { return fem_; }
   const soft::SoftBodyModel& body() const { return *body_; }
 
@@ -100,12 +127,17 @@ class SoftSimulation {
   bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
   Status publish_compliances();
   void weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame, SoftContacts& out) const;
+  void publish_surface(double dt_s);
+  void record_step(double dt_s, std::span<const float> xyz);
 
   std::shared_ptr<const soft::SoftBodyModel> body_;
   std::shared_ptr<const collette::SphereTree> rest_tree_;
   soft::CorotationalFem fem_;
   Quat object_from_world_;
   LatestValue<collette::SphereTree> trees_;
+  LatestValue<SoftSurface> surfaces_;  // simulation -> readers of the drawn surface
+  std::mutex surface_readers_;         // one reader of surfaces_ at a time
+  std::uint64_t steps_ = 0;
   std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<double> proxy_smoothing_m_;  // per tool: 0 weighs pairs by overlap, > 0 by nearness
@@ -113,6 +145,8 @@ class SoftSimulation {
   std::vector<Eigen::Vector3d> loads_;
   std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of publish_compliances
   std::vector<Sphere> spheres_;
+  Vec3 down_in_object_;  // the world's -z in the object's frame
+  std::vector<SoftSample> record_;
   std::unique_ptr<FixedRateLoop> loop_;  // made by start()
   Status failure_ = Ok{};
 };
