@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 namespace uh::soft {
@@ -189,23 +190,48 @@ Result<SoftBodyModel> build_soft_body(const InsidePredicate& inside, std::span<c
   }
   const TetLocator locator(body.mesh, body.rest_inverse);
   if (Status s = embed_leaves(locator, leaves, body); !s) return s.error();
+  body.spheres_by_tet.resize(body.spheres.size());
+  std::iota(body.spheres_by_tet.begin(), body.spheres_by_tet.end(), 0);
+  std::stable_sort(body.spheres_by_tet.begin(), body.spheres_by_tet.end(), [&](std::int32_t a, std::int32_t b) {
+    return body.spheres[static_cast<std::size_t>(a)].tet < body.spheres[static_cast<std::size_t>(b)].tet;
+  });
   body.surface = params.surface;
   embed_surface(locator, params.fixed, body);
   return body;
 }
 
+namespace {
+
+// A tetrahedron's smallest principal stretch: the smallest singular value of its deformation
+// gradient F, the square root of F^T F's smallest eigenvalue (closed form, several times quicker
+// than an SVD); an inverted element's is taken as 0. At least kMinSphereStretch.
+double smallest_stretch(const SoftBodyModel& body, const std::vector<Eigen::Vector3d>& positions, std::size_t tet) {
+  const Eigen::Matrix3d f = tet_edges(body.mesh, positions, tet) * body.rest_inverse[tet];
+  if (!(f.determinant() > 0.0)) return kMinSphereStretch;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(f.transpose() * f, Eigen::EigenvaluesOnly);
+  return std::max(std::sqrt(std::max(eigen.eigenvalues().minCoeff(), 0.0)), kMinSphereStretch);
+}
+
+}  // namespace
+
 void deform_spheres(const SoftBodyModel& body, const std::vector<Eigen::Vector3d>& positions, std::span<Sphere> out) {
   const std::size_t n = std::min(out.size(), body.spheres.size());
-  for (std::size_t i = 0; i < n; ++i) {
+  const bool by_tet = body.spheres_by_tet.size() == body.spheres.size();
+  std::int32_t last_tet = -1;
+  double stretch = 1.0;
+  for (std::size_t k = 0; k < body.spheres.size(); ++k) {
+    const auto i = by_tet ? static_cast<std::size_t>(body.spheres_by_tet[k]) : k;
+    if (i >= n) continue;
     const EmbeddedSphere& e = body.spheres[i];
     const auto tet = static_cast<std::size_t>(e.tet);
+    if (e.tet != last_tet) {
+      stretch = smallest_stretch(body, positions, tet);
+      last_tet = e.tet;
+    }
     const auto& t = body.mesh.tets[tet];
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) centre += e.weights[k] * node_of(positions, t[static_cast<std::size_t>(k)]);
-    const Eigen::Matrix3d f = tet_edges(body.mesh, positions, tet) * body.rest_inverse[tet];
-    // fixed-size singular values: no allocation; an inverted element's smallest is taken as 0
-    const Eigen::Vector3d sigma = Eigen::JacobiSVD<Eigen::Matrix3d>(f).singularValues();
-    const double stretch = f.determinant() > 0.0 ? std::max(sigma.minCoeff(), kMinSphereStretch) : kMinSphereStretch;
+    for (int c = 0; c < 4; ++c) centre += e.weights[c] * node_of(positions, t[static_cast<std::size_t>(c)]);
     out[i] = Sphere{static_cast<float>(centre.x()), static_cast<float>(centre.y()), static_cast<float>(centre.z()),
                     static_cast<float>(e.rest_radius * stretch)};
   }

@@ -96,6 +96,22 @@ TEST(SoftBody, AtRestTheEmbeddedSpheresAreThePacking) {
   }
 }
 
+// Sphere i's radius by an SVD of its element's deformation gradient, built here from the nodes
+// (deform_spheres takes the eigenvalues of F^T F, once per element)
+double reference_radius(const SoftBodyModel& body, const std::vector<Eigen::Vector3d>& positions, std::size_t i) {
+  const EmbeddedSphere& e = body.spheres[i];
+  const auto& t = body.mesh.tets[static_cast<std::size_t>(e.tet)];
+  Eigen::Matrix3d now, rest;
+  for (int c = 0; c < 3; ++c) {
+    const auto a = static_cast<std::size_t>(t[0]), b = static_cast<std::size_t>(t[static_cast<std::size_t>(c + 1)]);
+    now.col(c) = positions[b] - positions[a];
+    rest.col(c) = body.mesh.nodes[b] - body.mesh.nodes[a];
+  }
+  const Eigen::Matrix3d f = now * rest.inverse();
+  const double sigma = Eigen::JacobiSVD<Eigen::Matrix3d>(f).singularValues().minCoeff();
+  return e.rest_radius * (f.determinant() > 0.0 ? std::max(sigma, kMinSphereStretch) : kMinSphereStretch);
+}
+
 TEST(SoftBody, PressedTheSpheresStayInsideAndTheRefittedTreeBoundsItsChildren) {
   const std::vector<Sphere> leaves = ball_packing();
   const SoftBodyModel body = ball_body(leaves);
@@ -131,6 +147,9 @@ TEST(SoftBody, PressedTheSpheresStayInsideAndTheRefittedTreeBoundsItsChildren) {
     for (std::size_t i = 0; i < moved.size(); ++i) {
       ASSERT_TRUE(inside_some_tet(body.mesh, fem->positions(), centre(moved[i]))) << "step " << step << " sphere " << i;
       smallest_stretch = std::min(smallest_stretch, double{moved[i].radius} / double{leaves[i].radius});
+      // the radius against its element's smallest singular value by an SVD of its own
+      const double reference = reference_radius(body, fem->positions(), i);
+      ASSERT_NEAR(double{moved[i].radius}, reference, 1e-6 * reference) << "step " << step << " sphere " << i;
     }
     ASSERT_EQ(nodes_not_bounding_children(tree), 0) << "step " << step;
   }

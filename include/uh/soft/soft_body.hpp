@@ -65,6 +65,9 @@ struct SoftBodyModel {
   ElasticMaterial material;
   std::vector<std::int32_t> fixed;          ///< held nodes (in the fixed box)
   std::vector<EmbeddedSphere> spheres;      ///< one per leaf of the packing, in packing order
+  /// The spheres' indices ordered by their tetrahedron: deform_spheres finds each tetrahedron's
+  /// stretch once for all its spheres (a face's small spheres share their element).
+  std::vector<std::int32_t> spheres_by_tet;
   std::vector<Eigen::Matrix3d> rest_inverse;///< per tetrahedron: inverse of its rest edge matrix
   SurfaceMesh surface;                      ///< the drawn surface at rest (SoftBodyParams::surface)
   std::vector<EmbeddedVertex> surface_embedding;  ///< one per surface vertex
@@ -81,7 +84,8 @@ Result<SoftBodyModel> build_soft_body(const InsidePredicate& inside, std::span<c
 /// (one per leaf): each centre at its barycentric weights in its tetrahedron, each radius its rest
 /// radius times that tetrahedron's smallest principal stretch (the smallest singular value of
 /// its deformation gradient, at least kMinSphereStretch: an inverted element keeps a small
-/// sphere), so a compressed sphere shrinks with its element. Real-time safe: no allocation.
+/// sphere), so a compressed sphere shrinks with its element: once per tetrahedron (spheres_by_tet),
+/// from the eigenvalues of F^T F in closed form. Real-time safe: no allocation.
 void deform_spheres(const SoftBodyModel& body, const std::vector<Eigen::Vector3d>& positions, std::span<Sphere> out);
 
 /// The drawn surface's vertices of a body whose nodes are at `positions`, as x, y, z floats
