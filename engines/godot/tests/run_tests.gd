@@ -2,7 +2,8 @@ extends SceneTree
 # Headless tests of the addon and the demo (scripts/godot-test.sh runs them with godot3-server
 # against the uh program of the build): the demo's main scene is sent to uh serve (started as a
 # child process), the tool's node follows the device, on_collision fires with force, and freeing
-# the scene stops the session (zero force) and the service. Ends with "N passed, N failed".
+# the scene stops the session (zero force) and the service. Then the soft demo (soft.tscn): the
+# block's drawn mesh goes down under the stylus. Ends with "N passed, N failed".
 
 const HapticManagerScript = preload("res://addons/unrealhaptics/haptic_manager.gd")
 
@@ -90,7 +91,52 @@ func _run():
 		check(state.has("force") and state["force"] == [0.0, 0.0, 0.0],
 			"the force sent to the device after the stop is zero: %s" % to_json(state.get("force")))
 	check(not HapticManagerScript.process_alive(pid), "the uh serve the manager started has exited")
+	yield(_run_soft(), "completed")
 	finish()
+
+
+# The soft demo: the block's SoftMesh is the service's refined surface, and its top under the stylus
+# goes down as the deformed vertices come (driven 8 mm down into E = 50 kPa).
+func _run_soft():
+	started = false
+	var soft = load("res://soft.tscn").instance()
+	var manager = soft.get_node("HapticManager")
+	manager.port = int(OS.get_environment("UH_TEST_PORT"))
+	manager.connect("session_started", self, "_on_started")
+	root.add_child(soft)
+	var until = OS.get_ticks_msec() + 120000
+	while not started and manager.last_error == "" and OS.get_ticks_msec() < until:
+		yield(create_timer(0.05), "timeout")
+	print("uh serve pid ", manager.child_pid)
+	check(started, "the soft demo's session starts (%s)" % manager.last_error)
+	var block = soft.get_node("SoftBlock")
+	var instance = block.soft_mesh_instance()
+	check(instance != null and instance.mesh != null, "the soft block is drawn from the service's refined surface")
+	if instance != null and instance.mesh != null:
+		var vertices = instance.mesh.surface_get_arrays(0)[Mesh.ARRAY_VERTEX]
+		var rest = _lowest_under_stylus(instance)
+		check(vertices.size() > 1000 and abs(rest) < 1e-6,
+			"at rest: %d vertices, the top under the stylus at z = %.6f m" % [vertices.size(), rest])
+		var lowest = rest
+		until = OS.get_ticks_msec() + 20000
+		while lowest > rest - 5e-4 and OS.get_ticks_msec() < until:
+			yield(create_timer(0.1), "timeout")
+			lowest = min(lowest, _lowest_under_stylus(instance))
+		check(lowest < rest - 1e-4, "the drawn block's top goes down under the stylus: %.2f mm (%d deformed surfaces drawn)"
+			% [(lowest - rest) * 1000.0, block.soft_updates])
+	var pid = manager.child_pid
+	soft.queue_free()
+	yield(create_timer(0.2), "timeout")
+	check(not HapticManagerScript.process_alive(pid), "the soft demo's uh serve has exited")
+
+
+# The lowest z [m] of the drawn top face's vertices within 1 cm of the stylus (x = y = 0).
+func _lowest_under_stylus(instance):
+	var lowest = INF
+	for v in instance.mesh.surface_get_arrays(0)[Mesh.ARRAY_VERTEX]:
+		if abs(v.x) < 0.01 and abs(v.y) < 0.01 and v.z > -0.01:
+			lowest = min(lowest, v.z)
+	return lowest
 
 
 func finish():

@@ -63,6 +63,7 @@ var _force_component = null
 var _tool_node = null
 var _volumes = []
 var _sent_poses = {}
+var _soft_nodes = {}  # object name -> the ColletteStaticMesh of a soft object
 
 
 func _ready():
@@ -177,6 +178,12 @@ func _start():
 			return false
 		added.append(node.object_name())
 		_sent_poses[node.object_name()] = node.global_transform
+		if node.is_soft():
+			var mesh = yield(_request({"type": "get_mesh", "object": node.object_name()}), "completed")
+			if not _ok(mesh):
+				return false
+			node.show_soft_mesh(mesh)
+			_soft_nodes[node.object_name()] = node
 	if added.size() > 0:
 		for name in defaults:
 			if not name in added:
@@ -329,6 +336,9 @@ func _dispatch(m):
 		force = _vec3(m["force"])
 		torque = _vec3(m["torque"])
 		_new_state = true
+		for entry in m.get("deformed", []):
+			if _soft_nodes.has(entry.get("object")):
+				_soft_nodes[entry["object"]].on_deformed(entry)
 		for volume in _volumes:
 			volume.on_state(m)
 	elif type == "contact":
