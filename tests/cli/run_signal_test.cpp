@@ -242,11 +242,14 @@ TEST_P(RunSignalTest, StopsWithZeroForceSummaryAndExitStatus) {
                         : has_thread(pid, "uh-haptic");
   };
   const auto deadline = std::chrono::steady_clock::now() + 60s;
-  while (!running() && std::chrono::steady_clock::now() < deadline) {
+  // (one reading of the thread list decides: a second one can miss a thread that is being listed
+  // while another starts, which failed this test once under ASan)
+  bool ran = false;
+  while (!(ran = running()) && std::chrono::steady_clock::now() < deadline) {
     if (waitpid(pid, nullptr, WNOHANG) != 0) FAIL() << "uh run ended before it ran: " << read_text(err);
     std::this_thread::sleep_for(5ms);
   }
-  ASSERT_TRUE(running()) << "uh run never started its haptic thread: " << read_text(err);
+  ASSERT_TRUE(ran) << "uh run never started its haptic thread: " << read_text(err);
   // in contact: the trace written so far holds a force (a wait for the event, not a time: a
   // loaded machine or a sanitizer takes longer)
   while (largest_force_so_far(trace) <= 0.1 && std::chrono::steady_clock::now() < deadline) {
