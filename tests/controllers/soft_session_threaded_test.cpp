@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "scene_test_support.hpp"
 #include "soft_block_support.hpp"
 #include "uh/controllers/haptic_session.hpp"
@@ -19,10 +22,17 @@ TEST(SoftSessionThreads, TheSimulationThreadStepsBesideTheHapticAndCollisionThre
   const SoftSimulation* sim = (*session)->soft_simulation(0);
   ASSERT_NE(sim, nullptr);
   EXPECT_EQ((*session)->soft_simulation(1), nullptr);
-  // one second of the press: the ball reaches its depth after half of it
-  const Status ran = (*session)->run(1.0);
-  ASSERT_TRUE(ran) << ran.error().message;
-  EXPECT_GT(sim->stats().ticks, 10u) << "the simulation thread stepped";
+  // the press (the ball reaches its depth after half a second), until the simulation thread has
+  // stepped 50 times, a wait for the event rather than a time: under ThreadSanitizer on a loaded
+  // machine a second held fewer than ten steps
+  const Status started = (*session)->start();
+  ASSERT_TRUE(started) << started.error().message;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (sim->stats().ticks < 50u && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const Status stopped = (*session)->stop();
+  ASSERT_TRUE(stopped) << stopped.error().message;
+  EXPECT_GE(sim->stats().ticks, 50u) << "the simulation thread stepped";
   EXPECT_TRUE(sim->failure());
   EXPECT_GT((*session)->report().contact_ticks, 0u);
   // the block went down under the ball (the loads came back from the haptic thread)
