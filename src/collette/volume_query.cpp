@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "lanes_sse2.hpp"
+#include "uh/core/address_wait.hpp"
 #include "volume_traversal.hpp"
 
 namespace uh::collette {
@@ -70,7 +71,7 @@ struct QueryWorker {
   ~QueryWorker() {
     stop.store(true, std::memory_order_release);
     posted.fetch_add(1, std::memory_order_release);
-    posted.notify_one();
+    wake_one(posted);
     thread.join();
   }
   QueryWorker(const QueryWorker&) = delete;
@@ -116,7 +117,7 @@ struct QueryWorker {
         now = posted.load(std::memory_order_acquire);
       }
       while (now == seen) {
-        posted.wait(seen, std::memory_order_acquire);
+        wait_while_equal(posted, seen);
         now = posted.load(std::memory_order_acquire);
       }
       seen = now;
@@ -204,7 +205,7 @@ int run_shared(detail::QueryWorker& w, Traversal& t, int lanes, const SphereTree
   w.finished.store(0, std::memory_order_relaxed);
   w.claim.store(static_cast<std::uint32_t>(chunks) << 16, std::memory_order_release);
   w.posted.fetch_add(1, std::memory_order_release);
-  w.posted.notify_one();
+  wake_one(w.posted);
   if (options.worker_claims_first) {
     while (w.claim.load(std::memory_order_acquire) >> 16 == static_cast<std::uint32_t>(chunks)) {
 #if defined(__SSE2__)

@@ -470,20 +470,19 @@ void HapticSession::take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& 
   }
 }
 
-void HapticSession::monitor(std::stop_token stop) {
+void HapticSession::monitor() {
   std::vector<haptico::TraceSample> buffer;
   buffer.reserve(static_cast<std::size_t>(haptic_hz_) + 16);
-  std::mutex wake_mutex;
-  std::condition_variable_any wake;
   const double start_s = started_s_;
   std::uint64_t last_steps = 0;
   std::vector<std::uint64_t> last_ticks;
   for (const auto& rig : rigs_) last_ticks.push_back(rig->manager->ticks());
   double last_window_s = 0.0;
-  while (!stop.stop_requested()) {
+  // a last pass after stop() woke it, as after every 20 ms
+  for (bool stopping = false; !stopping;) {
     {
-      std::unique_lock lock(wake_mutex);
-      wake.wait_for(lock, stop, std::chrono::milliseconds(20), [] { return false; });
+      std::unique_lock lock(monitor_mutex_);
+      stopping = monitor_wake_.wait_for(lock, std::chrono::milliseconds(20), [this] { return monitor_stop_; });
     }
     // the CSV trace is the first tool's (its columns describe one device)
     for (std::size_t t = 0; t < rigs_.size(); ++t) take_trace(*rigs_[t], buffer, t == 0 ? trace_ : nullptr);
@@ -534,7 +533,8 @@ Status HapticSession::start(std::ostream* trace) {
     }
   }
   phase_ = Phase::kRunning;
-  monitor_thread_ = std::jthread([this](std::stop_token stop) { monitor(stop); });
+  monitor_stop_ = false;
+  monitor_thread_ = std::thread([this] { monitor(); });
   return Ok{};
 }
 
@@ -587,7 +587,11 @@ Status HapticSession::stop() {
   const bool haptic_alive = haptic_threads_running();
   const bool collision_alive = world_->running();
   const double seconds = halted_at_s - started_s_;
-  monitor_thread_.request_stop();
+  {
+    std::lock_guard lock(monitor_mutex_);
+    monitor_stop_ = true;
+  }
+  monitor_wake_.notify_all();
   monitor_thread_.join();
   collect_report(seconds, false);  // before the loops stop: their statistics describe the run itself
   for (auto& rig : rigs_) rig->manager->stop();

@@ -6,6 +6,7 @@
 /// runs, and stops it. What `uh run`, the C API and the Python module run.
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -13,7 +14,6 @@
 #include <mutex>
 #include <optional>
 #include <ostream>
-#include <stop_token>
 #include <string>
 #include <thread>
 #include <vector>
@@ -343,7 +343,7 @@ class HapticSession {
   void record_proxy_ends();
   void publish_report();
   void take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
-  void monitor(std::stop_token stop);
+  void monitor();
   void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
   void on_step(double time_s);
   void contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s, double volume,
@@ -388,7 +388,13 @@ class HapticSession {
   std::ostream* trace_ = nullptr;  // written by the monitor thread while it runs, then by stop()
   // steady-clock time stop() zeroed the force [s]; owner -> monitor thread
   std::atomic<double> halted_at_s_{std::numeric_limits<double>::infinity()};
-  std::jthread monitor_thread_;
+  // stop() sets monitor_stop_ and wakes the monitor from its 20 ms sleep. A plain condition
+  // variable: std::jthread's stop token waits through std::stop_callback, which can hang for
+  // good under Debian's mingw-w64 libstdc++ (uh/core/address_wait.hpp); the C API test did.
+  std::mutex monitor_mutex_;
+  std::condition_variable monitor_wake_;
+  bool monitor_stop_ = false;  // guarded by monitor_mutex_
+  std::thread monitor_thread_;
 };
 
 /// The report as the JSON object `uh run --json` prints (nested: device.*, haptic.*, collision.*,
