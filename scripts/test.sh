@@ -127,7 +127,7 @@ stage "build (Windows x64, mingw-w64; the C API's tests under wine64)"
 if uh_build build/windows uh_capi_test -- -DCMAKE_TOOLCHAIN_FILE="$uh_root/cmake/mingw-w64-x86_64.cmake" \
      -DCMAKE_BUILD_TYPE=Release; then
   run_ctest windows build/windows
-  # wine's server outlives the last test program by a minute (cmake/wine-run.sh.in): end it now
+  # wine's server and its services outlive the last test program by a few seconds: end them now
   WINEPREFIX="$uh_root/build/windows/wine-prefix" /usr/lib/wine/wineserver -k 2>/dev/null || true
 else
   echo "test: Windows build failed"; status=1; failed=$((failed + 1))
