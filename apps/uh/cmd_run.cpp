@@ -125,6 +125,20 @@ void print_tool_summary(const controllers::ToolReport& r, bool stepped, const st
               static_cast<unsigned long long>(r.contact_ticks), r.work_on_hand_j, r.coupling ? " (virtual coupling)" : "");
 }
 
+// a soft object's line: its simulation thread's rate and step time
+void print_soft_summary(const controllers::SessionReport::SoftObjectReport& s, bool stepped) {
+  if (stepped) {
+    std::printf("  soft      '%s': %lld tetrahedra, %llu steps at %.0f Hz of simulated time\n", s.object.c_str(),
+                static_cast<long long>(s.tetrahedra), static_cast<unsigned long long>(s.steps), s.target_hz);
+    return;
+  }
+  std::printf("  soft      '%s': %lld tetrahedra, %.1f steps/s (target %.0f), %llu steps, %llu missed deadlines, "
+              "step p50 %.2f ms, p99 %.2f ms, max %.2f ms\n",
+              s.object.c_str(), static_cast<long long>(s.tetrahedra), s.rate_hz, s.target_hz,
+              static_cast<unsigned long long>(s.steps), static_cast<unsigned long long>(s.missed_deadlines),
+              s.step_p50_ms, s.step_p99_ms, s.step_max_ms);
+}
+
 void print_summary(const controllers::SessionReport& r) {
   std::printf("scene %s: %.1f s%s%s\n", r.scene.c_str(), r.seconds,
               r.stepped ? " (stepped, simulated time)" : "", r.stopped_early ? " (stopped early)" : "");
@@ -136,6 +150,7 @@ void print_summary(const controllers::SessionReport& r) {
   // one block per device; a one-tool session's block is as it always was
   for (const controllers::ToolReport& t : r.tools)
     print_tool_summary(t, r.stepped, r.tools.size() > 1 ? fmt::format("tool '{}': ", t.tool) : std::string());
+  for (const auto& s : r.soft) print_soft_summary(s, r.stepped);
 }
 
 // The scene to run: the file's (or the default one) with --device's driver and selection on its tool

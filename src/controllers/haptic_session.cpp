@@ -515,7 +515,7 @@ Status HapticSession::start(std::ostream* trace) {
   if (auto started = world_->start(); !started) return started;
   for (std::size_t i = 0; i < soft_.size(); ++i) {
     if (!soft_[i]) continue;
-    if (auto started = soft_[i]->start(kSoftRateHz); !started) {
+    if (auto started = soft_[i]->start(soft_rate_hz(i)); !started) {
       stop_soft();
       world_->stop();
       return started;
@@ -650,6 +650,10 @@ Result<std::uint64_t> HapticSession::soft_vertices(std::size_t object, std::span
   return soft_[object]->read_surface(xyz);
 }
 
+double HapticSession::soft_rate_hz(std::size_t object) const {
+  return scene().objects[object].deformable.value().rate_hz;  // soft_[object] exists: it is deformable
+}
+
 void HapticSession::stop_soft() {
   for (auto& soft : soft_)
     if (soft) soft->stop();
@@ -658,7 +662,25 @@ void HapticSession::stop_soft() {
 void HapticSession::collect_soft_report() {
   report_.soft.clear();
   for (std::size_t i = 0; i < soft_.size(); ++i)
-    if (soft_[i]) report_.soft.push_back({.object = scene().objects[i].name, .samples = soft_[i]->record()});
+    if (soft_[i]) report_.soft.push_back(soft_object_report(i));
+}
+
+SessionReport::SoftObjectReport HapticSession::soft_object_report(std::size_t object) const {
+  const SoftSimulation& soft = *soft_[object];
+  const FixedRateLoopStats loop = soft.stats();
+  SessionReport::SoftObjectReport r{.object = scene().objects[object].name,
+                                    .tetrahedra = static_cast<std::int64_t>(soft.body().mesh.tets.size()),
+                                    .target_hz = soft_rate_hz(object),
+                                    .steps = soft.steps(),
+                                    .samples = soft.record()};
+  // a stepped run's steps are simulated time: no wall-clock rate or duration to report
+  if (loop.ticks == 0) return r;
+  r.rate_hz = loop.achieved_rate_hz;
+  r.missed_deadlines = loop.missed_deadlines;
+  r.step_p50_ms = loop.callback_duration.p50_ns * 1e-6;
+  r.step_p99_ms = loop.callback_duration.p99_ns * 1e-6;
+  r.step_max_ms = loop.callback_duration.max_ns * 1e-6;
+  return r;
 }
 
 Status HapticSession::soft_error() const {
@@ -719,16 +741,17 @@ Status HapticSession::run_stepped(double seconds, int ticks_per_collision_step, 
     for (std::size_t t = 0; t < rigs_.size(); ++t) take_trace(*rigs_[t], buffer, t == 0 ? trace : nullptr);
   };
   const auto ticks = static_cast<std::int64_t>(std::llround(seconds * haptic_hz_));
-  // the soft objects step in simulated time too, at their own rate
-  const std::int64_t ticks_per_soft_step = std::max<std::int64_t>(1, std::llround(haptic_hz_ / kSoftRateHz));
-  const double soft_dt_s = static_cast<double>(ticks_per_soft_step) / haptic_hz_;
+  // the soft objects step in simulated time too, each at its own rate (in whole ticks)
+  std::vector<std::int64_t> ticks_per_soft_step(soft_.size(), 1);
+  for (std::size_t i = 0; i < soft_.size(); ++i)
+    if (soft_[i]) ticks_per_soft_step[i] = std::max<std::int64_t>(1, std::llround(haptic_hz_ / soft_rate_hz(i)));
   Status soft_stepped = Ok{};
   std::int64_t k = 0;
   for (; k < ticks && !stop_requested_.load(std::memory_order_relaxed) && !any_fault() && soft_stepped; ++k) {
     const double t = static_cast<double>(k) / haptic_hz_;
-    if (k % ticks_per_soft_step == 0)
-      for (auto& soft : soft_)
-        if (soft && soft_stepped) soft_stepped = soft->step(soft_dt_s);
+    for (std::size_t i = 0; i < soft_.size() && soft_stepped; ++i)
+      if (soft_[i] && k % ticks_per_soft_step[i] == 0)
+        soft_stepped = soft_[i]->step(static_cast<double>(ticks_per_soft_step[i]) / haptic_hz_);
     // the collision step sees the tool poses of the previous tick, as the threaded world would
     if (k % ticks_per_collision_step == 0) world_->step(t);
     for (auto& rig : rigs_) rig->manager->step(t);
@@ -944,6 +967,16 @@ std::string session_report_json(const SessionReport& r) {
   nlohmann::json tools = nlohmann::json::array();
   for (const ToolReport& t : r.tools) tools.push_back(tool_report_json(t));
   j["tools"] = std::move(tools);
+  nlohmann::json soft = nlohmann::json::array();
+  for (const SessionReport::SoftObjectReport& s : r.soft)
+    soft.push_back({{"object", s.object},
+                    {"tetrahedra", s.tetrahedra},
+                    {"target_hz", s.target_hz},
+                    {"rate_hz", s.rate_hz},
+                    {"steps", s.steps},
+                    {"missed_deadlines", s.missed_deadlines},
+                    {"step_ms", {{"p50", s.step_p50_ms}, {"p99", s.step_p99_ms}, {"max", s.step_max_ms}}}});
+  j["soft"] = std::move(soft);
   return j.dump(2);
 }
 

@@ -168,12 +168,13 @@ Status read_shape(const FieldReader& r, const json& j, const std::string& path, 
 Status read_deformable(const FieldReader& r, const json& j, const std::string& path, SceneDeformable& d) {
   UH_CHECK(r.require_object(j, path));
   UH_CHECK(r.check_keys(j, path,
-                        {"young_modulus_pa", "poisson_ratio", "density_kg_m3", "damping", "tetrahedra", "fixed"}));
+                        {"young_modulus_pa", "poisson_ratio", "density_kg_m3", "damping", "tetrahedra", "rate_hz", "fixed"}));
   UH_CHECK(r.number(j, path, "young_modulus_pa", d.young_modulus_pa));
   UH_CHECK(r.number(j, path, "poisson_ratio", d.poisson_ratio));
   UH_CHECK(r.number(j, path, "density_kg_m3", d.density_kg_m3));
   UH_CHECK(r.number(j, path, "damping", d.damping));
   UH_CHECK(r.integer(j, path, "tetrahedra", d.tetrahedra));
+  UH_CHECK(r.number(j, path, "rate_hz", d.rate_hz));
   const auto fixed = j.find("fixed");
   if (fixed == j.end()) return Ok{};
   const std::string p = FieldReader::join(path, "fixed");

@@ -55,7 +55,8 @@ json deformable_json(const SceneDeformable& d) {
   json j{{"young_modulus_pa", d.young_modulus_pa},
          {"poisson_ratio", d.poisson_ratio},
          {"density_kg_m3", d.density_kg_m3},
-         {"damping", d.damping}};
+         {"damping", d.damping},
+         {"rate_hz", d.rate_hz}};
   if (d.tetrahedra != 0) j["tetrahedra"] = d.tetrahedra;  // left out: chosen from the object's size
   if (d.fixed_box) j["fixed"] = {{"box", json::array({array_of(d.fixed_box->min), array_of(d.fixed_box->max)})}};
   return j;

@@ -237,6 +237,7 @@ Status validate_deformable(const SceneObject& object, const std::string& path) {
   UH_VALIDATE(in_range(join(path, "damping"), d.damping, 0.0, 1.0));
   // 0 (or the field left out): chosen from the object's size
   if (d.tetrahedra != 0) UH_VALIDATE(whole_in_range(join(path, "tetrahedra"), d.tetrahedra, 6, 200'000));
+  UH_VALIDATE(in_range(join(path, "rate_hz"), d.rate_hz, 10.0, 2000.0));
   if (!d.fixed_box) return Ok{};
   const std::string box = join(path, "fixed.box");
   UH_VALIDATE(finite(box + "[0]", d.fixed_box->min));

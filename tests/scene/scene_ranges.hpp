@@ -34,6 +34,7 @@ inline constexpr std::array kFieldRanges{
     FieldRange{"objects[0].deformable.density_kg_m3", 1.0, 1e5},
     FieldRange{"objects[0].deformable.damping", 0.0, 1.0},
     FieldRange{"objects[0].deformable.tetrahedra", 6.0, 200000.0, true},
+    FieldRange{"objects[0].deformable.rate_hz", 10.0, 2000.0},
     FieldRange{"tool.spheres", 1.0, 2000000.0, true},
     FieldRange{"tool.meters_per_unit", 1e-9, 1e6},
     FieldRange{"tool.force.stiffness", 0.0, 1e12},

@@ -150,9 +150,17 @@ struct SessionReport : ToolReport {
   std::uint64_t coherent_queries = 0;  ///< collision queries that reused their kept candidates
   std::vector<RateSample> collision_rates;
   std::vector<ToolReport> tools;  ///< per tool, in Scene::tools order
-  /// Per soft object (scene order): a sample per simulation step, its indentation and force.
+  /// Per soft object (scene order): its simulation thread's rate and a sample per step (its
+  /// indentation and force).
   struct SoftObjectReport {
     std::string object;
+    std::int64_t tetrahedra = 0;
+    double target_hz = 0.0;  ///< the scene's deformable.rate_hz
+    /// steps a second of wall time (FixedRateLoopStats::achieved_rate_hz); 0 in a stepped run
+    double rate_hz = 0.0;
+    std::uint64_t steps = 0;
+    std::uint64_t missed_deadlines = 0;  ///< steps that started more than a period late
+    double step_p50_ms = 0.0, step_p99_ms = 0.0, step_max_ms = 0.0;  ///< a step's wall time; 0 stepped
     std::vector<SoftSample> samples;
   };
   std::vector<SoftObjectReport> soft;
@@ -318,8 +326,6 @@ class HapticSession {
   /// Any thread but the simulation's, while the session runs or not; never makes the simulation,
   /// collision or haptic threads wait.
   Result<std::uint64_t> soft_vertices(std::size_t object, std::span<float> xyz);
-  /// The rate of every deformable object's simulation thread [Hz] (docs/deformables.md, "In a session").
-  static constexpr double kSoftRateHz = 100.0;
 
  private:
   enum class Phase : std::uint8_t { kReady, kRunning, kStopped };
@@ -344,6 +350,8 @@ class HapticSession {
   void publish_report();
   void take_trace(ToolRig& rig, std::vector<haptico::TraceSample>& buffer, std::ostream* trace);
   void monitor();
+  double soft_rate_hz(std::size_t object) const;  // the object's deformable.rate_hz
+  SessionReport::SoftObjectReport soft_object_report(std::size_t object) const;
   void on_collision(collette::ObjectId a, collette::ObjectId b, const ContactFrame& frame);
   void on_step(double time_s);
   void contact_edge(ToolRig& rig, collette::ObjectId object, bool touching, double time_s, double volume,

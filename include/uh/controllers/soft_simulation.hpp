@@ -116,7 +116,9 @@ class SoftSimulation {
   /// A sample per step (the first kRecordCapacity; allocated at create()). Simulation thread (or
   /// after stop()).
   const std::vector<SoftSample>& record() const { return record_; }
-  static constexpr std::size_t kRecordCapacity = 60000;  // ten minutes at 100 Hz
+  static constexpr std::size_t kRecordCapacity = 60000;  // five minutes at 200 Hz
+  /// Steps taken so far. Simulation thread (or after stop()).
+  std::uint64_t steps() const { return steps_; }
   const soft::CorotationalFem& fem() const { return fem_; }
   const soft::SoftBodyModel& body() const { return *body_; }
 

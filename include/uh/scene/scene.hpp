@@ -52,6 +52,7 @@ struct SceneDeformable {
   double density_kg_m3 = 1000.0;    ///< rho [kg/m^3]
   double damping = 0.01;            ///< stiffness-proportional (Rayleigh) damping [s]: damps deformation only
   std::int64_t tetrahedra = 0;      ///< about this many elements; 0 = chosen from the object's size
+  double rate_hz = 200.0;           ///< the simulation thread's steps a second [Hz] (fixed steps of 1/rate_hz)
   /// `fixed.box`: mesh vertices and tet nodes inside it [m], object frame, are held in place.
   struct Box {
     Vec3 min{};

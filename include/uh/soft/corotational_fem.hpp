@@ -181,7 +181,8 @@ class CorotationalFem {
   std::vector<std::int32_t> factor_starts_, factor_rows_;
   std::vector<float> factor_blocks_;                  // 9 per block, column-major
   std::vector<std::array<float, 3>> factor_diagonal_;  // L(1,0), L(2,0), L(2,1) of each diagonal block
-  Eigen::VectorXd diagonal_inverse_;
+  Eigen::VectorXf diagonal_inverse_;
+  Eigen::VectorXf sweep_;  // the preconditioner's sweeps, in place (single precision)
   std::vector<Eigen::Vector3d> forces_;    // scratch: external loads and inertia
   std::vector<NodeContact> contacts_;      // scratch: the obstacle's contacts of the last iterate
 };
