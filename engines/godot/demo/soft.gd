@@ -1,6 +1,7 @@
 extends Spatial
-# The soft demo: the default scene's stylus, driven 8 mm down (its force capped at 8 N) into a soft
-# block (scenes/soft_block.json's, E = 50 kPa, its base held) and back by a simulated line device;
+# The soft demo: the default scene's stylus, driven from 2 cm above a soft block to 8 mm into it
+# (its force capped at 8 N) and back by a simulated line device (the block is scenes/soft_block.json's,
+# E = 50 kPa, its base held);
 # the block is the Godot scene's SoftBlock node (sent inline with its `deformable` settings), drawn
 # from the service's refined surface, which follows the deformed vertices.
 
