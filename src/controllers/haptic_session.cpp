@@ -967,6 +967,7 @@ std::string session_report_json(const SessionReport& r) {
   nlohmann::json tools = nlohmann::json::array();
   for (const ToolReport& t : r.tools) tools.push_back(tool_report_json(t));
   j["tools"] = std::move(tools);
+  if (r.soft.empty()) return j.dump(2);  // a rigid scene's report is as it always was
   nlohmann::json soft = nlohmann::json::array();
   for (const SessionReport::SoftObjectReport& s : r.soft)
     soft.push_back({{"object", s.object},

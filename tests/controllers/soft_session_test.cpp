@@ -62,6 +62,9 @@ Press press(double depth_m, bool soft, Path path) {
   if (!soft_report.empty()) {
     const auto& samples = soft_report.front().samples;
     EXPECT_EQ(samples.size(), static_cast<std::size_t>(scene.objects[0].deformable->rate_hz));  // 1 s of steps
+    EXPECT_EQ(soft_report.front().steps, samples.size());
+    EXPECT_EQ(soft_report.front().target_hz, scene.objects[0].deformable->rate_hz);
+    EXPECT_EQ(soft_report.front().rate_hz, 0.0) << "stepped: simulated time, no wall-clock rate";
     Eigen::Vector3d total = Eigen::Vector3d::Zero();
     for (const auto& l : sim->loads()) total += l;
     EXPECT_NEAR(samples.back().force_n, total.norm(), 1e-12);

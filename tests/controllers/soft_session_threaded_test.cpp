@@ -33,6 +33,14 @@ TEST(SoftSessionThreads, TheSimulationThreadStepsBesideTheHapticAndCollisionThre
   const Status stopped = (*session)->stop();
   ASSERT_TRUE(stopped) << stopped.error().message;
   EXPECT_GE(sim->stats().ticks, 50u) << "the simulation thread stepped";
+  // the report gives the rate the thread kept, from its own loop (not the target)
+  const auto& soft = (*session)->report().soft;
+  ASSERT_EQ(soft.size(), 1u);
+  EXPECT_EQ(soft[0].steps, sim->stats().ticks);
+  EXPECT_EQ(soft[0].rate_hz, sim->stats().achieved_rate_hz);
+  EXPECT_GT(soft[0].rate_hz, 0.0);
+  EXPECT_GT(soft[0].step_p99_ms, 0.0);
+  EXPECT_EQ(soft[0].tetrahedra, static_cast<std::int64_t>(sim->body().mesh.tets.size()));
   EXPECT_TRUE(sim->failure());
   EXPECT_GT((*session)->report().contact_ticks, 0u);
   // the block went down under the ball (the loads came back from the haptic thread)
