@@ -265,7 +265,7 @@ void SphereTree::refit(std::span<const Sphere> leaves) {
     }
     node.radius = std::nextafter(static_cast<float>(radius), std::numeric_limits<float>::infinity());
     node.volume = static_cast<float>(volume);
-    leaf_parent_volume_ += sphere_volume(static_cast<double>(node.radius)) * leaf_children / node.count;
+    leaf_parent_volume_ += sphere_volume(static_cast<double>(node.radius)) * static_cast<double>(leaf_children) / node.count;
   }
   const auto w = static_cast<std::size_t>(block_width_);
   std::size_t k = 0;
