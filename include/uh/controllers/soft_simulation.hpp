@@ -70,11 +70,11 @@ struct SoftTreeOptions {
   /// spheres); its block sheared until its top has moved about its height (19 mm) reaches 1.45
   /// refitted only (tests/controllers/soft_tree_rebuild_test.cpp).
   static constexpr double kRebuildDistortion = 1.3;
-  /// Each step refits the tree; when the refitted tree's looseness (the volume of its inner node
-  /// spheres over the object's volume) exceeds this many times the looseness its hierarchy had
-  /// when it was built (at rest, or at the last rebuild), the step rebuilds the hierarchy over the
-  /// deformed spheres instead (collette::rebuild_sphere_tree, with the rest tree's arity). > 1;
-  /// infinity: never.
+  /// Each step refits the tree; when the refitted tree's looseness (the volume of its node spheres
+  /// just above the leaves, SphereTree::leaf_parent_volume, over the object's volume) exceeds this
+  /// many times that of its hierarchy refitted where it was built (at rest, or at the last
+  /// rebuild), the step rebuilds the hierarchy over the deformed spheres instead
+  /// (collette::rebuild_sphere_tree, with the rest tree's arity). > 1; infinity: never.
   double rebuild_distortion = kRebuildDistortion;
   /// The most of the simulation thread's time that rebuilds may take, in (0, 1]: after a rebuild
   /// that took T, the next waits until T (1 / share - 1) has passed (a body crushed until its
@@ -145,8 +145,8 @@ class SoftSimulation {
   static constexpr std::size_t kRecordCapacity = 60000;  // five minutes at 200 Hz
   /// Steps taken so far. Simulation thread (or after stop()).
   std::uint64_t steps() const { return steps_; }
-  /// The last step's tree distortion: its refitted tree's looseness over the looseness of its
-  /// hierarchy when built (SoftTreeOptions::rebuild_distortion; 1 right after a rebuild). Simulation
+  /// The last step's tree distortion (SoftTreeOptions::rebuild_distortion): 1 at rest, a little
+  /// under 1 right after a rebuild (the builder's spheres are tighter than a refit's). Simulation
   /// thread (or after stop()).
   double tree_distortion() const { return tree_distortion_; }
   /// How many steps rebuilt the tree. Simulation thread (or after stop()).
