@@ -3,7 +3,8 @@
 // face pushed by a swinging load. items_per_second is steps per second. Two solvers in the same
 // run: the default (conjugate gradients preconditioned by an earlier factorisation) and the direct
 // reference (the current system factorised every step). Also: the packing riding along (each
-// step's deform_spheres and SphereTree::refit) against the sphere count, and the memory a block's
+// step's deform_spheres and SphereTree::refit, and the rebuild a step makes instead of the refit
+// when the tree is too distorted) against the sphere count, and the memory a block's
 // model and solver hold against its tetrahedron count.
 
 #include <benchmark/benchmark.h>
@@ -182,15 +183,22 @@ void deform_spheres_by_svd(const SoftBodyModel& body, const std::vector<Eigen::V
 
 // The packing riding along, per simulation step: every sphere moved with its tetrahedron and its
 // radius scaled by its smallest stretch (deform_spheres, `deform`), the tree refitted bottom-up
-// (SphereTree::refit, `refit`), or both (`step`); items_per_second is spheres per second.
-enum class RidePart { kDeform, kDeformBySvd, kRefit, kStep };
+// (SphereTree::refit, `refit`), or both (`step`); or the hierarchy regrouped over the moved
+// spheres (collette::rebuild_sphere_tree, `rebuild`: what a step does instead of the refit when
+// the tree is too distorted); items_per_second is spheres per second.
+enum class RidePart { kDeform, kDeformBySvd, kRefit, kStep, kRebuild };
 void run_riding_packing(benchmark::State& state, RidePart part) {
   auto packing = make_riding_packing(state, static_cast<int>(state.range(0)));
   if (!packing) return;
+  if (part == RidePart::kRebuild) {
+    deform_spheres(packing->body, packing->positions, packing->moved);
+    packing->tree.refit(packing->moved);
+  }
   for (auto _ : state) {
     if (part == RidePart::kDeformBySvd) deform_spheres_by_svd(packing->body, packing->positions, packing->moved);
-    else if (part != RidePart::kRefit) deform_spheres(packing->body, packing->positions, packing->moved);
+    else if (part == RidePart::kDeform || part == RidePart::kStep) deform_spheres(packing->body, packing->positions, packing->moved);
     if (part == RidePart::kRefit || part == RidePart::kStep) packing->tree.refit(packing->moved);
+    if (part == RidePart::kRebuild && !uh::collette::rebuild_sphere_tree(packing->tree)) state.SkipWithError("the rebuild failed");
     benchmark::DoNotOptimize(packing->moved.data());
     benchmark::DoNotOptimize(packing->tree.nodes().data());
   }
@@ -200,10 +208,12 @@ void BM_SoftPackingDeform(benchmark::State& state) { run_riding_packing(state, R
 void BM_SoftPackingDeformBySvd(benchmark::State& state) { run_riding_packing(state, RidePart::kDeformBySvd); }
 void BM_SoftPackingRefit(benchmark::State& state) { run_riding_packing(state, RidePart::kRefit); }
 void BM_SoftPackingStep(benchmark::State& state) { run_riding_packing(state, RidePart::kStep); }
+void BM_SoftPackingRebuild(benchmark::State& state) { run_riding_packing(state, RidePart::kRebuild); }
 BENCHMARK(BM_SoftPackingDeform)->Arg(1000)->Arg(10000)->Arg(50000)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 BENCHMARK(BM_SoftPackingDeformBySvd)->Arg(1000)->Arg(10000)->Arg(50000)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 BENCHMARK(BM_SoftPackingRefit)->Arg(1000)->Arg(10000)->Arg(50000)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 BENCHMARK(BM_SoftPackingStep)->Arg(1000)->Arg(10000)->Arg(50000)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+BENCHMARK(BM_SoftPackingRebuild)->Arg(1000)->Arg(10000)->Arg(50000)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 double heap_in_use_mb() {
   const struct mallinfo2 info = mallinfo2();

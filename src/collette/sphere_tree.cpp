@@ -25,13 +25,27 @@ double sphere_volume(double r) { return 4.0 / 3.0 * 3.14159265358979323846 * r *
 
 SphereTree::SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> leaves, int depth, int arity)
     : nodes_(std::move(nodes)), leaves_(std::move(leaves)), depth_(depth), arity_(arity) {
+  derive();
+}
+
+double SphereTree::leaf_share(std::size_t i) const {
+  const SphereTreeNode& node = nodes_[i];
+  if (node.is_leaf() || node.count < 1 || node.first < 0 ||
+      static_cast<std::size_t>(node.first) + static_cast<std::size_t>(node.count) > nodes_.size())
+    return 0.0;
+  int leaves = 0;
+  for (int c = node.first; c < node.first + node.count; ++c) leaves += nodes_[static_cast<std::size_t>(c)].is_leaf() ? 1 : 0;
+  return static_cast<double>(leaves) / node.count;
+}
+
+void SphereTree::derive() {
   const std::size_t n = nodes_.size();
-  if (n == 0) return;
   density_.resize(n);
+  leaf_parent_volume_ = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const SphereTreeNode& node = nodes_[i];
-    const double r = static_cast<double>(node.radius);
-    const double ball = 4.0 / 3.0 * 3.14159265358979323846 * r * r * r;
+    const double ball = sphere_volume(static_cast<double>(node.radius));
+    if (!node.is_leaf()) leaf_parent_volume_ += ball * leaf_share(i);
     density_[i] = node.is_leaf() || !(ball > 0.0) ? 1.f : static_cast<float>(std::min(1.0, static_cast<double>(node.volume) / ball));
   }
   // the blocks are only built for well-formed child ranges; validate() reports the others and
@@ -54,6 +68,7 @@ SphereTree::SphereTree(std::vector<SphereTreeNode> nodes, std::vector<Sphere> le
   block_child_.assign(static_cast<std::size_t>(blocks) * w, 0);
   block_count_.assign(static_cast<std::size_t>(blocks), 0);
   block_leaf_mask_.assign(static_cast<std::size_t>(blocks), 0);
+  if (n == 0) return;
   auto id_of = [&](std::size_t i) -> std::int32_t {
     const SphereTreeNode& node = nodes_[i];
     if (node.is_leaf()) return ~node.first;
@@ -211,6 +226,7 @@ bool SphereTree::refittable() const {
 void SphereTree::refit(std::span<const Sphere> leaves) {
   const std::size_t n = std::min(leaves.size(), leaves_.size());
   std::copy_n(leaves.begin(), n, leaves_.begin());
+  leaf_parent_volume_ = 0.0;
   // children after parents: a reverse sweep sees every child refitted before its parent
   for (std::size_t i = nodes_.size(); i-- > 0;) {
     SphereTreeNode& node = nodes_[i];
@@ -226,7 +242,9 @@ void SphereTree::refit(std::span<const Sphere> leaves) {
     const auto children = std::span<const SphereTreeNode>(nodes_).subspan(static_cast<std::size_t>(node.first),
                                                                            static_cast<std::size_t>(node.count));
     double volume = 0.0, cx = 0.0, cy = 0.0, cz = 0.0;
+    int leaf_children = 0;
     for (const SphereTreeNode& c : children) {
+      leaf_children += c.is_leaf() ? 1 : 0;
       const auto v = static_cast<double>(c.volume);
       volume += v;
       cx += v * static_cast<double>(c.x);
@@ -247,6 +265,7 @@ void SphereTree::refit(std::span<const Sphere> leaves) {
     }
     node.radius = std::nextafter(static_cast<float>(radius), std::numeric_limits<float>::infinity());
     node.volume = static_cast<float>(volume);
+    leaf_parent_volume_ += sphere_volume(static_cast<double>(node.radius)) * static_cast<double>(leaf_children) / node.count;
   }
   const auto w = static_cast<std::size_t>(block_width_);
   std::size_t k = 0;

@@ -348,9 +348,8 @@ std::vector<int> split_balanced(std::span<const Sphere> leaves, std::span<int> i
   return sizes;
 }
 
-}  // namespace
-
-Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options) {
+// Bad options or leaves, as build_sphere_tree() reports them.
+Status check_input(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options) {
   if (leaves.empty()) return Error{"no leaf spheres (a tree needs at least one)"};
   if (options.arity < 2 || options.arity > kMaxSphereTreeArity)
     return Error{"arity " + std::to_string(options.arity) + " outside 2.." + std::to_string(kMaxSphereTreeArity)};
@@ -361,13 +360,16 @@ Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const Spher
     if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !std::isfinite(s.radius) || !(s.radius > 0.f))
       return Error{"leaf sphere " + std::to_string(i) + " has a non-finite centre or a radius that is not positive"};
   }
+  return Ok{};
+}
 
+// The hierarchy over `leaves` (checked) into `nodes` (cleared first; its storage is reused), laid
+// out depth-first with children after their parent; returns the depth.
+int build_nodes(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options, std::vector<SphereTreeNode>& nodes) {
   std::vector<int> idx(leaves.size());
   for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i);
-  std::vector<SphereTreeNode> nodes;
-  nodes.reserve(2 * leaves.size());
+  nodes.clear();
   nodes.emplace_back();
-
   struct Work {
     int node, begin, end, depth;
   };
@@ -425,7 +427,25 @@ Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const Spher
     for (int c = n.first; c < n.first + n.count; ++c) v += static_cast<double>(nodes[static_cast<std::size_t>(c)].volume);
     n.volume = static_cast<float>(v);
   }
+  return depth;
+}
+
+}  // namespace
+
+Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options) {
+  if (Status checked = check_input(leaves, options); !checked) return checked.error();
+  std::vector<SphereTreeNode> nodes;
+  nodes.reserve(2 * leaves.size());
+  const int depth = build_nodes(leaves, options, nodes);
   return SphereTree(std::move(nodes), std::vector<Sphere>(leaves.begin(), leaves.end()), depth, options.arity);
+}
+
+Status rebuild_sphere_tree(SphereTree& tree, const SphereTreeBuildOptions& options) {
+  if (Status checked = check_input(tree.leaves_, options); !checked) return checked;
+  tree.depth_ = build_nodes(tree.leaves_, options, tree.nodes_);
+  tree.arity_ = options.arity;
+  tree.derive();
+  return Ok{};
 }
 
 }  // namespace uh::collette

@@ -37,29 +37,45 @@ std::span<const SpherePairContact> section_pairs(const ContactFrame& frame, cons
 
 Result<std::unique_ptr<SoftSimulation>> SoftSimulation::create(std::shared_ptr<const soft::SoftBodyModel> body,
                                                                std::shared_ptr<const collette::SphereTree> rest_tree,
-                                                               const Pose& world_from_object, std::size_t tools) {
+                                                               const Pose& world_from_object, std::size_t tools,
+                                                               const SoftTreeOptions& tree_options) {
   if (!body || !rest_tree || !rest_tree->refittable() ||
       static_cast<std::size_t>(rest_tree->leaf_count()) != body->spheres.size())
     return Error{"soft simulation: the tree is not the soft body's packing, or cannot be refitted", ErrorKind::kInvalid};
+  if (!(tree_options.rebuild_distortion > 1.0) || !(tree_options.rebuild_time_share > 0.0) ||
+      !(tree_options.rebuild_time_share <= 1.0) || rest_tree->arity() < 2 || rest_tree->arity() > collette::kMaxSphereTreeArity)
+    return Error{fmt::format("soft simulation: rebuild_distortion {} is not above 1 or rebuild_time_share {} is not in "
+                             "(0, 1], or the tree's arity {} cannot be rebuilt",
+                             tree_options.rebuild_distortion, tree_options.rebuild_time_share, rest_tree->arity()),
+                 ErrorKind::kInvalid};
   auto fem = soft::CorotationalFem::create(body->mesh, body->material, body->fixed);
   if (!fem) return fem.error();
   return std::unique_ptr<SoftSimulation>(
-      new SoftSimulation(std::move(body), std::move(rest_tree), std::move(*fem), world_from_object, tools));
+      new SoftSimulation(std::move(body), std::move(rest_tree), std::move(*fem), world_from_object, tools, tree_options));
 }
 
 SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
                                std::shared_ptr<const collette::SphereTree> rest_tree, soft::CorotationalFem fem,
-                               const Pose& world_from_object, std::size_t tools)
+                               const Pose& world_from_object, std::size_t tools,
+                               const SoftTreeOptions& tree_options)
     : body_(std::move(body)),
       rest_tree_(std::move(rest_tree)),
       fem_(std::move(fem)),
       object_from_world_(conjugate(world_from_object.rotation)),
+      tree_options_(tree_options),
+      rebuild_options_{.arity = rest_tree_->arity()},
+      hierarchy_(*rest_tree_),
       loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       unit_loads_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       unit_moves_(body_->mesh.nodes.size(), Eigen::Vector3d::Zero()),
       spheres_(rest_tree_->leaves().begin(), rest_tree_->leaves().end()),
       down_in_object_(rotate(object_from_world_, Vec3{0.0, 0.0, -1.0})) {
   record_.reserve(kRecordCapacity);
+  // the baseline a refitted tree is measured against is this hierarchy refitted where it was
+  // built: a refit's node spheres (around their children's centroid) are looser than the
+  // builder's (the smallest enclosing sphere), by a quarter of the volume on a packing at rest
+  hierarchy_.refit(spheres_);
+  hierarchy_looseness_ = looseness(hierarchy_);
   for (std::size_t t = 0; t < tools; ++t) {
     contacts_.push_back(std::make_unique<LatestValue<SoftContacts>>());
     tool_forces_.push_back(std::make_unique<LatestValue<Vec3>>());
@@ -206,12 +222,64 @@ Status SoftSimulation::step(double dt_s) {
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
   if (Status s = publish_compliances(); !s) return s;
   soft::deform_spheres(*body_, fem_.positions(), spheres_);
-  collette::SphereTree& tree = trees_.write_buffer();
-  // a slot the reader never handed back before holds no tree yet: it gets the rest tree once
-  if (tree.node_count() != rest_tree_->node_count()) tree = *rest_tree_;
-  tree.refit(spheres_);
+  if (Status s = refit_or_rebuild(trees_.write_buffer()); !s) return s;
   trees_.publish();
   publish_surface(dt_s);
+  return Ok{};
+}
+
+// The looseness of a tree of this object at the FEM's positions: the volume of its node spheres
+// just above the leaves over the object's volume (the lattice's); 0 when that volume is not
+// positive (elements turned inside out: nothing to measure). The node spheres' volume is what a
+// refit loosens and what the builder's cuts keep small (it decides how many node pairs a query
+// visits); over the object's volume, so that a squashed object, whose regrouped tree would be
+// smaller, counts as distorted too (its refitted spheres keep their rest size). A sum rather than
+// the worst node: a press dents a few nodes, which a rebuild would not help, while a whole region
+// sheared, twisted or squashed loosens many. Computed from the refit's own sum
+// (SphereTree::leaf_parent_volume) and one pass over the tetrahedra, not the leaves.
+double SoftSimulation::looseness(const collette::SphereTree& tree) const {
+  const double volume = soft::mesh_volume(body_->mesh, fem_.positions());
+  return volume > 0.0 ? tree.leaf_parent_volume() / volume : 0.0;
+}
+
+// The generation of the hierarchy that `slot` (one of trees_' three) holds.
+std::uint64_t& SoftSimulation::hierarchy_of(const collette::SphereTree& slot) {
+  for (SlotHierarchy& s : slot_hierarchies_)
+    if (s.slot == &slot || s.slot == nullptr) {
+      s.slot = &slot;
+      return s.generation;
+    }
+  // a triple buffer has three slots: never reached; a fourth would take the hierarchy every time
+  unknown_slot_generation_ = 0;
+  return unknown_slot_generation_;
+}
+
+// Refits `slot` (the write buffer) over the step's spheres, first copying the current hierarchy
+// into it if it holds an older one (or none: a slot's first turn); rebuilds the hierarchy there
+// when the refit has grown too loose, and makes that the current one for the other slots.
+Status SoftSimulation::refit_or_rebuild(collette::SphereTree& slot) {
+  std::uint64_t& generation = hierarchy_of(slot);
+  if (generation != hierarchy_generation_) {
+    slot = hierarchy_;  // into the slot's own storage, sized on its first turn
+    generation = hierarchy_generation_;
+  }
+  slot.refit(spheres_);
+  const double now = looseness(slot);
+  if (!(now > 0.0)) return Ok{};  // no volume to measure against: the last distortion stands
+  tree_distortion_ = now / hierarchy_looseness_;
+  if (!(tree_distortion_ > tree_options_.rebuild_distortion)) return Ok{};
+  const auto started = std::chrono::steady_clock::now();
+  if (started < next_rebuild_) return Ok{};
+  if (Status s = collette::rebuild_sphere_tree(slot, rebuild_options_); !s) return s;
+  const auto took = std::chrono::steady_clock::now() - started;
+  next_rebuild_ = started + took + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                       took * (1.0 / tree_options_.rebuild_time_share - 1.0));
+  hierarchy_ = slot;
+  generation = ++hierarchy_generation_;
+  hierarchy_.refit(spheres_);  // the baseline, refitted where it was built (as at construction)
+  hierarchy_looseness_ = looseness(hierarchy_);
+  tree_distortion_ = looseness(slot) / hierarchy_looseness_;
+  ++tree_rebuilds_;
   return Ok{};
 }
 
@@ -236,7 +304,10 @@ void SoftSimulation::record_step(double dt_s, std::span<const float> xyz) {
   }
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
   for (const auto& l : loads_) total += l;
-  record_.push_back({.time_s = static_cast<double>(steps_) * dt_s, .indentation_m = deepest, .force_n = total.norm()});
+  record_.push_back({.time_s = static_cast<double>(steps_) * dt_s,
+                     .indentation_m = deepest,
+                     .force_n = total.norm(),
+                     .tree_distortion = tree_distortion_});
 }
 
 std::uint64_t SoftSimulation::read_surface(std::span<float> xyz) {

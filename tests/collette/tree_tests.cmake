@@ -1,5 +1,6 @@
 list(APPEND UH_COLLETTE_TEST_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/tree_builder_test.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/tree_rebuild_test.cpp
   ${CMAKE_CURRENT_LIST_DIR}/query_volume_test.cpp
   ${CMAKE_CURRENT_LIST_DIR}/query_time_critical_test.cpp
   ${CMAKE_CURRENT_LIST_DIR}/query_distance_test.cpp

@@ -26,6 +26,16 @@ namespace {
 using testing::Path;
 using testing::soft_block;
 
+// The largest tree distortion of a run's soft steps (SoftSample::tree_distortion): an ordinary
+// press keeps the refitted tree, far from a rebuild
+double largest_tree_distortion(const SessionReport& r) {
+  double largest = 0.0;
+  for (const auto& object : r.soft)
+    for (const SoftSample& sample : object.samples) largest = std::max(largest, sample.tree_distortion);
+  return largest;
+}
+constexpr double kOrdinaryDistortion = 1.0 + 0.25 * (SoftTreeOptions::kRebuildDistortion - 1.0);
+
 struct Press {
   double force_n = 0.0;        // the ball's force at the end [N]
   double indentation_m = 0.0;  // the largest downward displacement of a node of the block [m]
@@ -74,7 +84,12 @@ Press press(double depth_m, bool soft, Path path) {
     for (std::size_t v = 0; v < sim->body().surface.vertices.size(); ++v)
       deepest = std::max(deepest, sim->body().surface.vertices[v].z() - double{xyz[3 * v + 2]});
     EXPECT_NEAR(samples.back().indentation_m, deepest, 1e-9);
+    const double distortion = largest_tree_distortion((*session)->report());
+    std::printf("pressed %.1f mm: largest tree distortion %.5f, at the end %.5f\n", 1e3 * depth_m, distortion,
+                samples.back().tree_distortion);
+    EXPECT_LT(distortion, kOrdinaryDistortion);
   }
+  EXPECT_EQ(sim->tree_rebuilds(), 0u);
   // the last soft step spread what the ball felt on the tick before it
   Eigen::Vector3d loads = Eigen::Vector3d::Zero();
   for (const auto& l : sim->loads()) loads += l;
@@ -201,6 +216,8 @@ TEST(SoftSession, RepeatedPressesOnTheSoftBlockPutNoEnergyIntoAReactingHand) {
     EXPECT_GT(r.force_max_n, 1.0) << hz << " Hz: and are pushed back";
     EXPECT_LT(p.lowest_m, 0.01 - 0.002) << hz << " Hz: the block gives: the ball goes 2 mm below its rest top face";
     EXPECT_LE(into_hand, 0.0) << hz << " Hz";
+    std::printf("largest tree distortion %.5f\n", largest_tree_distortion(r));
+    EXPECT_LT(largest_tree_distortion(r), kOrdinaryDistortion) << hz << " Hz";
     EXPECT_LE(r.work_on_hand_j, 0.9 * kHandDamping * r.contact_squared_speed_integral) << hz << " Hz";
   }
   const HandPress too_stiff = hand_press(10.0 * kHandDamping, 1000.0);

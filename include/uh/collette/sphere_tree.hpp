@@ -6,7 +6,8 @@
 ///
 /// Built by build_sphere_tree() (sphere_tree_builder.hpp) or loaded from a .ist file
 /// (ist_file.hpp). Once built it never changes: share it read-only between any number of threads;
-/// the per-thread scratch lives in the query objects (volume_query.hpp, ...).
+/// the per-thread scratch lives in the query objects (volume_query.hpp, ...). A deformable
+/// object's own copies are the exception: refit() and rebuild_sphere_tree() change them.
 
 #include <cstdint>
 #include <span>
@@ -16,6 +17,10 @@
 #include "uh/core/result.hpp"
 
 namespace uh::collette {
+
+struct SphereTreeBuildOptions;
+class SphereTree;
+Status rebuild_sphere_tree(SphereTree& tree, const SphereTreeBuildOptions& options);
 
 /// One node of a SphereTree: 32 bytes, so that two nodes share a cache line and a 4-child block
 /// is two lines. Frame and length unit: those of the object's mesh.
@@ -57,6 +62,14 @@ class SphereTree {
   int arity() const { return arity_; }
   /// Sum of the leaf sphere volumes [length^3].
   double total_volume() const { return nodes_.empty() ? 0.0 : static_cast<double>(nodes_.front().volume); }
+  /// Sum of the sphere volumes of the inner nodes just above the leaves [length^3] (each inner
+  /// node counted by the share of its children that are leaves: in a balanced tree, the lowest
+  /// inner level). A refit loosens it as the leaves move apart from their first grouping, and a
+  /// rebuild over the moved leaves tightens it again; the levels above are left out because an
+  /// elongated shape keeps them loose however they are grouped. A deformable object compares it
+  /// with its own volume to tell when to rebuild (docs/deformables.md). Kept by the constructor
+  /// and refit().
+  double leaf_parent_volume() const { return leaf_parent_volume_; }
 
   /// Derived, traversal-friendly copy of the hierarchy used by the queries (built by the
   /// constructor; read-only). Every inner node owns one "block" holding its children's spheres as
@@ -86,7 +99,8 @@ class SphereTree {
   /// never a tree other threads read meanwhile): moves the leaf spheres to `leaves` (one per leaf,
   /// packing order, positive radii) and refits every inner node bottom-up to enclose its
   /// children (centre: their volume-weighted centroid), with volumes, densities and the
-  /// traversal blocks. The topology stays. Needs refittable(). Real-time safe: no allocation.
+  /// traversal blocks. The topology stays (rebuild_sphere_tree() regroups the leaves where they
+  /// are). Needs refittable(). Real-time safe: no allocation.
   void refit(std::span<const Sphere> leaves);
 
   Blocks blocks() const {
@@ -95,6 +109,13 @@ class SphereTree {
   }
 
  private:
+  friend Status rebuild_sphere_tree(SphereTree& tree, const SphereTreeBuildOptions& options);
+  // the densities, leaf_parent_volume() and the traversal blocks, from the nodes (their arrays
+  // keep their storage when the sizes stay)
+  void derive();
+  // the share of node i's children that are leaves (0 for a leaf or a malformed range)
+  double leaf_share(std::size_t i) const;
+
   std::vector<float> block_bounds_;
   std::vector<std::int32_t> block_child_;
   std::vector<std::uint8_t> block_count_;
@@ -106,6 +127,7 @@ class SphereTree {
   std::vector<Sphere> leaves_;
   int depth_ = 0;
   int arity_ = 0;
+  double leaf_parent_volume_ = 0.0;
 };
 
 /// Checks every invariant of `tree`: non-empty; children contiguous, in range and at most

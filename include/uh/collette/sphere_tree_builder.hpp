@@ -50,4 +50,14 @@ struct SphereTreeBuildOptions {
 /// Not real-time safe; any thread. About 0.18 s for 10,000 leaves (k-means: 0.03 s).
 Result<SphereTree> build_sphere_tree(std::span<const Sphere> leaves, const SphereTreeBuildOptions& options = {});
 
+/// Regroups `tree`'s hierarchy over its leaves where they are now (as the last
+/// SphereTree::refit() left them): the same leaves in the same order (a leaf node still names its
+/// leaf by index), new inner nodes, exactly as build_sphere_tree() would build them over those
+/// leaves, with the densities and traversal blocks. The result is refittable(). For a deformable
+/// object whose refitted tree has grown loose. The tree's arrays keep their storage when the node
+/// count stays (the balanced split's count depends on the leaf count and arity alone); the
+/// grouping's own scratch is allocated. Fails as build_sphere_tree() does (the tree is unchanged).
+/// Not real-time safe; the thread that owns the tree. Costs what build_sphere_tree() does.
+Status rebuild_sphere_tree(SphereTree& tree, const SphereTreeBuildOptions& options = {});
+
 }  // namespace uh::collette

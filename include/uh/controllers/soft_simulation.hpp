@@ -4,7 +4,8 @@
 /// session"). Three kinds of thread meet here, each through its own lock-free handoff:
 ///  - the simulation thread (step(), at a fixed rate): takes the newest contacts and tool
 ///    forces, turns them into nodal loads, steps the FEM, moves the packing's spheres with their
-///    tetrahedra and refits a copy of the tree, which it publishes (LatestValue: the newest wins);
+///    tetrahedra and refits a copy of the tree (or rebuilds it when the refit has grown too
+///    loose: SoftTreeOptions), which it publishes (LatestValue: the newest wins);
 ///  - the collision thread queries the newest published tree (CollisionObjectDef::deformed_trees)
 ///    and posts the object's pairs of each tool's frame (post_contacts);
 ///  - each tool's haptic thread posts the force its tool felt (post_tool_force).
@@ -13,6 +14,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "uh/collette/sphere_tree.hpp"
+#include "uh/collette/sphere_tree_builder.hpp"
 #include "uh/controllers/contact_compliance.hpp"
 #include "uh/core/contact.hpp"
 #include "uh/core/fixed_rate_loop.hpp"
@@ -56,16 +59,39 @@ struct SoftSample {
   double time_s = 0.0;         ///< the simulation's time at the step's end [s]
   double indentation_m = 0.0;  ///< the deepest downward (world -z) displacement of a surface vertex [m]
   double force_n = 0.0;        ///< |sum of the step's loads|: what the tools pressed it with [N]
+  double tree_distortion = 1.0;  ///< the step's tree distortion (SoftSimulation::tree_distortion)
+};
+
+/// How a soft object's tree follows its deformation (docs/deformables.md, "The packing rides
+/// along").
+struct SoftTreeOptions {
+  /// The default of rebuild_distortion: scenes/soft_block.json's presses (the ball 2 and 4 mm into
+  /// the block, the reacting hand's presses) keep the distortion at or below 1 (a dent shrinks its
+  /// spheres); its block sheared until its top has moved about its height (19 mm) reaches 1.45
+  /// refitted only (tests/controllers/soft_tree_rebuild_test.cpp).
+  static constexpr double kRebuildDistortion = 1.3;
+  /// Each step refits the tree; when the refitted tree's looseness (the volume of its node spheres
+  /// just above the leaves, SphereTree::leaf_parent_volume, over the object's volume) exceeds this
+  /// many times that of its hierarchy refitted where it was built (at rest, or at the last
+  /// rebuild), the step rebuilds the hierarchy over the deformed spheres instead
+  /// (collette::rebuild_sphere_tree, with the rest tree's arity). > 1; infinity: never.
+  double rebuild_distortion = kRebuildDistortion;
+  /// The most of the simulation thread's time that rebuilds may take, in (0, 1]: after a rebuild
+  /// that took T, the next waits until T (1 / share - 1) has passed (a body crushed until its
+  /// elements invert loosens a fresh tree within a step, and a rebuild costs tens of steps at
+  /// 10,000 spheres).
+  double rebuild_time_share = 0.1;
 };
 
 class SoftSimulation {
  public:
   /// The simulation of `body` (its rest model) whose rest tree is `rest_tree`, placed with
-  /// `world_from_object`, touched by `tools` tools. Fails when the FEM cannot be built or the tree
-  /// cannot be refitted. Setup only.
+  /// `world_from_object`, touched by `tools` tools. Fails when the FEM cannot be built, the tree
+  /// cannot be refitted or `tree_options` are out of range. Setup only.
   static Result<std::unique_ptr<SoftSimulation>> create(std::shared_ptr<const soft::SoftBodyModel> body,
                                                         std::shared_ptr<const collette::SphereTree> rest_tree,
-                                                        const Pose& world_from_object, std::size_t tools);
+                                                        const Pose& world_from_object, std::size_t tools,
+                                                        const SoftTreeOptions& tree_options = {});
 
   /// The trees the collision thread queries (its only reader).
   LatestValue<collette::SphereTree>& trees() { return trees_; }
@@ -96,8 +122,8 @@ class SoftSimulation {
   /// thread never takes it, so it never waits).
   std::uint64_t read_surface(std::span<float> xyz);
 
-  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted tree
-  /// and the deformed surface.
+  /// Simulation thread: one step of `dt_s` under the newest contacts; publishes the refitted (or
+  /// rebuilt) tree and the deformed surface.
   Status step(double dt_s);
 
   /// Runs step() at `rate_hz` on its own thread until stop(). Controlling thread.
@@ -119,13 +145,23 @@ class SoftSimulation {
   static constexpr std::size_t kRecordCapacity = 60000;  // five minutes at 200 Hz
   /// Steps taken so far. Simulation thread (or after stop()).
   std::uint64_t steps() const { return steps_; }
+  /// The last step's tree distortion (SoftTreeOptions::rebuild_distortion): 1 at rest, a little
+  /// under 1 right after a rebuild (the builder's spheres are tighter than a refit's). Simulation
+  /// thread (or after stop()).
+  double tree_distortion() const { return tree_distortion_; }
+  /// How many steps rebuilt the tree. Simulation thread (or after stop()).
+  std::uint64_t tree_rebuilds() const { return tree_rebuilds_; }
   const soft::CorotationalFem& fem() const { return fem_; }
   const soft::SoftBodyModel& body() const { return *body_; }
 
  private:
   SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body, std::shared_ptr<const collette::SphereTree> rest_tree,
-                 soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools);
+                 soft::CorotationalFem fem, const Pose& world_from_object, std::size_t tools,
+                 const SoftTreeOptions& tree_options);
   void gather_loads();
+  Status refit_or_rebuild(collette::SphereTree& slot);
+  std::uint64_t& hierarchy_of(const collette::SphereTree& slot);
+  double looseness(const collette::SphereTree& tree) const;
   bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
   Status publish_compliances();
   void weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame, SoftContacts& out) const;
@@ -137,6 +173,23 @@ class SoftSimulation {
   soft::CorotationalFem fem_;
   Quat object_from_world_;
   LatestValue<collette::SphereTree> trees_;
+  // The current hierarchy (the rest tree's until a rebuild) and its generation; each slot of trees_
+  // keeps the generation it holds (by address: a triple buffer has three), and one holding an
+  // older one takes a copy of this before its refit.
+  SoftTreeOptions tree_options_;
+  collette::SphereTreeBuildOptions rebuild_options_;
+  collette::SphereTree hierarchy_;
+  std::uint64_t hierarchy_generation_ = 1;
+  struct SlotHierarchy {
+    const collette::SphereTree* slot = nullptr;
+    std::uint64_t generation = 0;  // 0: none yet
+  };
+  std::array<SlotHierarchy, 3> slot_hierarchies_{};
+  std::uint64_t unknown_slot_generation_ = 0;
+  double hierarchy_looseness_ = 1.0;  // the looseness of hierarchy_ when it was built
+  double tree_distortion_ = 1.0;
+  std::uint64_t tree_rebuilds_ = 0;
+  std::chrono::steady_clock::time_point next_rebuild_{};  // none before (rebuild_time_share)
   LatestValue<SoftSurface> surfaces_;  // simulation -> readers of the drawn surface
   std::mutex surface_readers_;         // one reader of surfaces_ at a time
   std::uint64_t steps_ = 0;
