@@ -101,7 +101,7 @@ void print_tool_summary(const controllers::ToolReport& r, bool stepped, const st
   if (!stepped)
     std::printf("  tick      p50 %.1f us, p99 %.1f us, max %.1f us\n", r.tick_p50_us, r.tick_p99_us,
                 r.tick_max_us);
-  if (r.proxy)
+  if (r.proxy) {
     std::printf("  proxy     %llu updates, %llu in contact, %llu unsolved, up to %d constraints, solve p50 %.1f us, "
                 "p99 %.1f us, deepest %.3f mm, ended at (%.4f, %.4f, %.4f) m\n",
                 static_cast<unsigned long long>(r.proxy_stats.updates),
@@ -109,7 +109,13 @@ void print_tool_summary(const controllers::ToolReport& r, bool stepped, const st
                 static_cast<unsigned long long>(r.proxy_stats.unsolved), r.proxy_stats.max_constraints,
                 r.proxy_stats.solve_time.p50_ns * 1e-3, r.proxy_stats.solve_time.p99_ns * 1e-3,
                 r.proxy_stats.deepest_m * 1e3, r.proxy_position.x, r.proxy_position.y, r.proxy_position.z);
-  else if (r.multi_rate && r.tick_force == "model")
+    // a tool that begins inside an object has no side to keep (it follows the handle until it is
+    // out): said, or a run that never felt the object puzzles
+    if (r.proxy_stats.free_updates > 0)
+      std::printf("            the tool began inside an object: the proxy followed the handle freely for %llu "
+                  "updates, until the tool was out of every object\n",
+                  static_cast<unsigned long long>(r.proxy_stats.free_updates));
+  } else if (r.multi_rate && r.tick_force == "model")
     std::printf("  model     %llu ticks beyond the trust range, %llu holding%s\n",
                 static_cast<unsigned long long>(r.model_clamped_ticks),
                 static_cast<unsigned long long>(r.model_held_ticks),

@@ -1227,6 +1227,35 @@ TEST_F(CliTest, RunPlotsASoftObjectsIndentationAgainstForce) {
   EXPECT_EQ(png_height(read_text(rigid)), 3u * 260u);
 }
 
+// A ball tool that begins inside the block has no side to keep: the proxy follows the handle
+// freely, the run feels nothing, and the summary says why; started above the block it holds.
+TEST_F(CliTest, RunSaysWhenTheToolBeganInsideAnObject) {
+  const fs::path scenes = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes";
+  std::ifstream in(scenes / "soft_block.json");
+  nlohmann::json j = nlohmann::json::parse(in);
+  j["objects"][0].erase("deformable");
+  j["objects"][0]["mesh"] = (scenes / j["objects"][0]["mesh"].get<std::string>()).lexically_normal().string();
+  j["tool"]["mesh"] = (scenes / j["tool"]["mesh"].get<std::string>()).lexically_normal().string();
+  const std::string env = fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string());
+  const auto run_from = [&](double start_z) {
+    // the ball (1 cm radius) from start_z down to 4 mm below the block's top face (z = 0)
+    j["tool"]["device"]["config"]["start"] = {0.0, 0.0, start_z};
+    j["tool"]["device"]["config"]["end"] = {0.0, 0.0, -0.004};
+    const fs::path scene = dir_ / fmt::format("began_{}.json", static_cast<int>(start_z * 1000));
+    std::ofstream(scene) << j.dump(2);
+    return uh(fmt::format("run '{}' --stepped --seconds 1", scene.string()), env);
+  };
+  const CommandRun inside = run_from(0.008);
+  ASSERT_EQ(inside.exit_code, 0) << inside.err;
+  EXPECT_NE(inside.out.find("the tool began inside an object: the proxy followed the handle freely"), std::string::npos)
+      << inside.out;
+  EXPECT_NE(inside.out.find(" 0 in contact"), std::string::npos) << inside.out;
+  const CommandRun above = run_from(0.012);
+  ASSERT_EQ(above.exit_code, 0) << above.err;
+  EXPECT_EQ(above.out.find("began inside"), std::string::npos) << above.out;
+  EXPECT_EQ(above.out.find(" 0 in contact"), std::string::npos) << above.out;
+}
+
 // a threaded run clocked by HD's scheduler (the stand-in's own thread)
 TEST_F(CliTest, RunOnOpenHapticsNamedOnTheCommandLine) {
   const fs::path scene = write_small_device_scene(dir_);
