@@ -327,6 +327,9 @@ Status SoftSimulation::start(double rate_hz) {
   // no spinning before each deadline: the simulation shares the machine's cores with the haptic
   // and collision threads, and a millisecond late is nothing at its rate
   loop_ = std::make_unique<FixedRateLoop>(FixedRateLoopOptions{.rate_hz = rate_hz, .spin_us = 0.0, .name = "uh-soft"});
+  // a factorisation in place takes several periods at a few thousand tetrahedra: on its own
+  // thread the steps go on meanwhile (stepped runs, which must repeat exactly, never start this)
+  fem_.factorise_in_background(true);
   const double dt_s = 1.0 / rate_hz;
   return loop_->start([this, dt_s](const TickInfo&) {
     // a fixed step whatever the tick's lateness: the simulation's time is its own
@@ -338,7 +341,9 @@ Status SoftSimulation::start(double rate_hz) {
 }
 
 void SoftSimulation::stop() {
-  if (loop_) loop_->stop();
+  if (!loop_) return;
+  loop_->stop();
+  fem_.factorise_in_background(false);  // the loop has ended: nothing steps any more
 }
 
 }  // namespace uh::controllers

@@ -1,5 +1,7 @@
 #include "uh/soft/corotational_fem.hpp"
 
+#include "background_factorisation.hpp"
+
 #include <Eigen/LU>
 
 #include <algorithm>
@@ -9,6 +11,11 @@
 
 namespace uh::soft {
 namespace {
+
+// with a factorisation under way on the worker, the iterations may go on this many times as far
+// as max_iterations before the system is factorised in place (a step a few times as long, rather
+// than one tens of times as long)
+constexpr int kBackgroundIterationFactor = 4;
 
 // the rotation of F = R S for det F > 0, by Newton's iteration X <- (g X + X^-T / g) / 2 with
 // Higham's scaling g: quadratic, a handful of iterations, orthogonal to 1e-12
@@ -242,7 +249,7 @@ void CorotationalFem::build_pattern() {
   }
   diagonal_slots_.resize(at(static_cast<std::int32_t>(dofs)));
   for (Eigen::Index d = 0; d < dofs; ++d) diagonal_slots_[static_cast<std::size_t>(d)] = slot(d, d);
-  solver_ = std::make_unique<Factorisation>();
+  solver_ = std::make_unique<SystemFactorisation>();
   solver_->analyzePattern(system_);
 }
 
@@ -340,12 +347,42 @@ void CorotationalFem::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) con
 // Preconditioned conjugate gradients on the current system, preconditioned by the factorisation of
 // an earlier one: rotations change little from step to step, so a few iterations reach the
 // solution. When they do not, the current system is factorised and solved directly, and that
-// factorisation preconditions the next steps.
+// factorisation preconditions the next steps. In the background (factorise_in_background), a
+// solve that took three quarters of max_iterations asks the worker for a fresh factorisation of
+// its system (the iterations creep up over tens of steps as the rotations drift from the
+// factorised ones, so it arrives before they reach max_iterations), and they go on with the
+// older one meanwhile, up to kBackgroundIterationFactor times as far.
 Status CorotationalFem::solve_system() {
   iterations_ = 0;
-  if (!solver_options_.direct && factorised_ && conjugate_gradients()) return Ok{};
-  return factorise_and_solve();
+  if (solver_options_.direct || !factorised_) return factorise_and_solve();
+  if (background_) take_background_preconditioner();
+  const int limit = solver_options_.max_iterations * (background_ ? kBackgroundIterationFactor : 1);
+  if (!conjugate_gradients(limit)) return factorise_and_solve();
+  if (background_ && 4 * iterations_ >= 3 * solver_options_.max_iterations) background_->request(system_, static_cast<std::uint64_t>(factorisations_));
+  return Ok{};
 }
+
+// the worker's preconditioner, unless a factorisation in place came since it was asked for (that
+// one is newer); a system the worker could not factorise is left to the next solve's fallback
+void CorotationalFem::take_background_preconditioner() {
+  std::uint64_t asked_at = 0;
+  if (background_->take(taken_, asked_at) != BackgroundFactorisation::Taken::kPreconditioner) return;
+  if (asked_at != static_cast<std::uint64_t>(factorisations_)) return;
+  preconditioner_.swap(taken_);
+  ++background_factorisations_;
+}
+
+void CorotationalFem::factorise_in_background(bool on) {
+  if (!on) {
+    background_.reset();
+  } else if (!background_) {
+    background_ = std::make_unique<BackgroundFactorisation>(system_);
+  }
+}
+
+CorotationalFem::~CorotationalFem() = default;
+CorotationalFem::CorotationalFem(CorotationalFem&&) noexcept = default;
+CorotationalFem& CorotationalFem::operator=(CorotationalFem&&) noexcept = default;
 
 Status CorotationalFem::factorise_and_solve() {
   iterations_ = 0;
@@ -356,109 +393,32 @@ Status CorotationalFem::factorise_and_solve() {
                  ErrorKind::kInvalid};
   }
   ++factorisations_;
-  keep_preconditioner();
+  preconditioner_.keep(*solver_);
   increment_ = solver_->solve(rhs_);
   if (!increment_.allFinite()) return Error{"soft::CorotationalFem: the solve gave a non-finite step", ErrorKind::kInvalid};
   return Ok{};
 }
 
-void CorotationalFem::keep_preconditioner() {
-  const auto& lower = solver_->matrixL().nestedExpression();
-  const auto nodes = static_cast<std::int32_t>(lower.cols() / 3);
-  factor_starts_.assign(1, 0);
-  factor_rows_.clear();
-  factor_blocks_.clear();
-  factor_diagonal_.assign(at(nodes), {0.0F, 0.0F, 0.0F});
-  std::vector<std::int32_t> block_of_node(at(nodes), -1);  // the block of node row I in this column
-  for (std::int32_t column_node = 0; column_node < nodes; ++column_node) {
-    for (int c = 0; c < 3; ++c) {
-      const std::int32_t column = 3 * column_node + c;
-      for (auto k = lower.outerIndexPtr()[column]; k < lower.outerIndexPtr()[column + 1]; ++k) {
-        const std::int32_t row = lower.innerIndexPtr()[k];
-        const auto value = static_cast<float>(lower.valuePtr()[k]);
-        if (row <= column) continue;
-        const std::int32_t row_node = row / 3;
-        if (row_node == column_node) {
-          factor_diagonal_[at(column_node)][at(c + row % 3 - 1)] = value;  // (1,0) -> 0, (2,0) -> 1, (2,1) -> 2
-          continue;
-        }
-        std::int32_t& block = block_of_node[at(row_node)];
-        if (block < 0) {
-          block = static_cast<std::int32_t>(factor_rows_.size());
-          factor_rows_.push_back(row_node);
-          factor_blocks_.resize(factor_blocks_.size() + 9, 0.0F);
-        }
-        factor_blocks_[at(9 * block + 3 * c + row % 3)] = value;
-      }
-    }
-    for (auto b = at(factor_starts_.back()); b < factor_rows_.size(); ++b) block_of_node[at(factor_rows_[b])] = -1;
-    factor_starts_.push_back(static_cast<std::int32_t>(factor_rows_.size()));
-  }
-  diagonal_inverse_ = solver_->vectorD().cwiseInverse().cast<float>();
-  sweep_.resize(diagonal_inverse_.size());
-}
-
-// result = L^-T D^-1 L^-1 residual with the single-precision blocks of L
-void CorotationalFem::precondition(const Eigen::VectorXd& residual, Eigen::VectorXd& result) {
-  // both sweeps in single precision, as the factor is stored: the preconditioner need only be
-  // close (the residual CG stops on is the double one), and floats halve the sweeps' memory
-  // traffic and drop a conversion per multiply
-  const auto nodes = static_cast<std::int32_t>(factor_diagonal_.size());
-  sweep_ = residual.cast<float>();
-  float* y = sweep_.data();
-  for (std::int32_t j = 0; j < nodes; ++j) {
-    const auto& d = factor_diagonal_[at(j)];
-    float* yj = y + 3 * j;
-    yj[1] -= d[0] * yj[0];
-    yj[2] -= d[1] * yj[0] + d[2] * yj[1];
-    const float y0 = yj[0], y1 = yj[1], y2 = yj[2];
-    for (std::int32_t b = factor_starts_[at(j)]; b < factor_starts_[at(j + 1)]; ++b) {
-      const float* l = &factor_blocks_[at(9 * b)];
-      float* yi = y + 3 * factor_rows_[at(b)];
-      for (int r = 0; r < 3; ++r) yi[r] -= l[r] * y0 + l[3 + r] * y1 + l[6 + r] * y2;
-    }
-  }
-  sweep_.array() *= diagonal_inverse_.array();
-  for (std::int32_t j = nodes - 1; j >= 0; --j) {
-    float* yj = y + 3 * j;
-    float s0 = 0.0F, s1 = 0.0F, s2 = 0.0F;
-    for (std::int32_t b = factor_starts_[at(j)]; b < factor_starts_[at(j + 1)]; ++b) {
-      const float* l = &factor_blocks_[at(9 * b)];
-      const float* yi = y + 3 * factor_rows_[at(b)];
-      s0 += l[0] * yi[0] + l[1] * yi[1] + l[2] * yi[2];
-      s1 += l[3] * yi[0] + l[4] * yi[1] + l[5] * yi[2];
-      s2 += l[6] * yi[0] + l[7] * yi[1] + l[8] * yi[2];
-    }
-    yj[0] -= s0;
-    yj[1] -= s1;
-    yj[2] -= s2;
-    const auto& d = factor_diagonal_[at(j)];
-    yj[1] -= d[2] * yj[2];
-    yj[0] -= d[0] * yj[1] + d[1] * yj[2];
-  }
-  result = sweep_.cast<double>();
-}
-
-bool CorotationalFem::conjugate_gradients() {
+bool CorotationalFem::conjugate_gradients(int max_iterations) {
   const double target = solver_options_.relative_residual * rhs_.norm();
   multiply(increment_, product_);
   residual_ = rhs_ - product_;
-  precondition(residual_, preconditioned_);
+  preconditioner_.apply(residual_, preconditioned_);
   direction_ = preconditioned_;
   double rz = residual_.dot(preconditioned_);
-  for (int iteration = 0; iteration < solver_options_.max_iterations; ++iteration) {
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
     iterations_ = iteration;
     if (!(residual_.norm() > target)) return increment_.allFinite();
     multiply(direction_, product_);
     const double alpha = rz / direction_.dot(product_);
     increment_ += alpha * direction_;
     residual_ -= alpha * product_;
-    precondition(residual_, preconditioned_);
+    preconditioner_.apply(residual_, preconditioned_);
     const double rz_next = residual_.dot(preconditioned_);
     direction_ = preconditioned_ + (rz_next / rz) * direction_;
     rz = rz_next;
   }
-  iterations_ = solver_options_.max_iterations;
+  iterations_ = max_iterations;
   return !(residual_.norm() > target) && increment_.allFinite();
 }
 
@@ -558,7 +518,7 @@ Status CorotationalFem::step_response(const std::vector<Eigen::Vector3d>& loads,
     const std::int32_t f = free_index_[node];
     if (f >= 0) response_loads_.segment<3>(3 * f) = loads[node];
   }
-  precondition(response_loads_, response_);
+  preconditioner_.apply(response_loads_, response_);
   moves.resize(positions_.size());
   for (std::size_t node = 0; node < positions_.size(); ++node) {
     const std::int32_t f = free_index_[node];

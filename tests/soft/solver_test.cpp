@@ -8,87 +8,58 @@
 #include <cmath>
 #include <numbers>
 
-#include "uh/soft/corotational_fem.hpp"
-#include "uh/soft/voxel_lattice.hpp"
+#include "solver_shapes.hpp"
+#include "uh/soft/block_preconditioner.hpp"
 
 namespace uh::soft {
 namespace {
 
-// the largest distance [m] between two position sets
-double largest_difference(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  double largest = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) largest = std::max(largest, (a[i] - b[i]).norm());
-  return largest;
-}
-
-// A box lattice from the origin to `max` of `cells`, and the nodes of its base (held)
-struct HeldBox {
-  TetMesh mesh;
-  std::vector<std::int32_t> base;
-};
-HeldBox held_box(const Eigen::Vector3d& max, const Eigen::Vector3i& cells) {
-  auto mesh = build_box_lattice(Eigen::Vector3d::Zero(), max, cells);
-  EXPECT_TRUE(mesh);
-  if (!mesh) return {};
-  auto base = nodes_in_box(*mesh, Eigen::Vector3d::Zero(), Eigen::Vector3d(max.x(), max.y(), 0.0));
-  return {std::move(*mesh), std::move(base)};
-}
-
-// a soft solid (E [Pa]), lightly damped
-ElasticMaterial soft_material(double young_modulus_pa) {
-  return {.young_modulus_pa = young_modulus_pa, .poisson_ratio = 0.4, .density_kg_m3 = 1000.0,
-          .stiffness_damping_s = 0.002};
-}
-
 TEST(SoftSolver, IteratedStepMatchesDirectSolve) {
-  // a soft 6 x 6 x 12 cm column held at its base, its top swung sideways by a load that bends it
-  // by tens of degrees, so the rotations drift far from those of the preconditioner
-  const Eigen::Vector3d max(0.06, 0.06, 0.12);
-  const HeldBox box = held_box(max, Eigen::Vector3i(5, 5, 10));
-  const TetMesh* mesh = &box.mesh;
-  const auto& base = box.base;
-  const ElasticMaterial material = soft_material(2.0e4);
-  const SolverOptions iterated{};
-  auto fast = CorotationalFem::create(*mesh, material, base, iterated);
-  auto direct = CorotationalFem::create(*mesh, material, base, {.direct = true});
-  ASSERT_TRUE(fast && direct);
-  const auto top = nodes_in_box(*mesh, Eigen::Vector3d(0.0, 0.0, max.z()), max);
-  std::vector<Eigen::Vector3d> loads(mesh->nodes.size(), Eigen::Vector3d::Zero());
-  constexpr double kDt = 1.0 / 200.0;
-  constexpr int kSteps = 300;
-  double worst = 0.0;
-  double largest_move = 0.0;
-  double tilt = 0.0;  // the largest displacement from rest [m]
-  int compared = 0;
-  for (int step = 0; step < kSteps; ++step) {
-    const double swing = std::sin(2.0 * std::numbers::pi * 1.5 * kDt * step);
-    for (const std::int32_t node : top) {
-      loads[static_cast<std::size_t>(node)] = Eigen::Vector3d(1.2 * swing, 0.4, 0.0) / static_cast<double>(top.size());
-    }
-    const std::vector<Eigen::Vector3d> start = fast->positions();
-    const bool compare = step % 10 == 9;
-    if (compare) {
-      ASSERT_TRUE(direct->set_state(fast->positions(), fast->velocities()));
-    }
-    ASSERT_TRUE(fast->step(kDt, loads)) << step;
-    const double move = largest_difference(fast->positions(), start);
-    largest_move = std::max(largest_move, move);
-    tilt = std::max(tilt, largest_difference(fast->positions(), mesh->nodes));
-    if (!compare) continue;
-    ASSERT_TRUE(direct->step(kDt, loads)) << step;
-    // relative to the step's largest node move
-    worst = std::max(worst, largest_difference(fast->positions(), direct->positions()) / move);
-    ++compared;
-  }
+  const HeldBox box = swinging_column();
+  auto fast = CorotationalFem::create(box.mesh, soft_material(2.0e4), box.base, {});
+  ASSERT_TRUE(fast);
+  const SwingComparison swing = swing_against_direct(*fast, box, 0.0);
   std::printf("%d steps compared: the iterated step is within %.1e of the direct one (of the step's largest "
               "move); %d factorisations in %d steps, largest move %.1f mm per step, %.0f mm from rest\n",
-              compared, worst, fast->factorisations(), kSteps, 1e3 * largest_move, 1e3 * tilt);
+              swing.compared, swing.worst, fast->factorisations(), kSwingSteps, 1e3 * swing.largest_move,
+              1e3 * swing.tilt);
   // the column bends: its top moves by a third of its height
-  EXPECT_GT(tilt, 0.04) << "the load should bend the column far";
+  EXPECT_GT(swing.tilt, 0.04) << "the load should bend the column far";
   // a relative residual of 1e-6 leaves a step error of that order
-  EXPECT_LT(worst, 1e-5);
+  EXPECT_LT(swing.worst, 1e-5);
   // the iterations did the work: most steps were not factorised
-  EXPECT_LT(fast->factorisations(), kSteps / 10);
+  EXPECT_LT(fast->factorisations(), kSwingSteps / 10);
+}
+
+// The preconditioner's float copy of a factorisation against a dense Cholesky solve of the same
+// system: a symmetric positive definite matrix of 12 nodes' 3 x 3 blocks, banded as a lattice's.
+TEST(SoftSolver, BlockPreconditionerSolvesTheFactorisedSystem) {
+  const int n = 3 * 12;
+  Eigen::MatrixXd random = Eigen::MatrixXd::Random(n, n);
+  Eigen::MatrixXd dense = random * random.transpose() + n * Eigen::MatrixXd::Identity(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (std::abs(i / 3 - j / 3) > 2) dense(i, j) = 0.0;  // a banded block pattern, as a lattice's
+  dense += 4.0 * n * Eigen::MatrixXd::Identity(n, n);  // diagonally dominant again
+  const Eigen::MatrixXd dense_lower = dense.triangularView<Eigen::Lower>();
+  const Eigen::SparseMatrix<double> lower = dense_lower.sparseView();
+  SystemFactorisation factorised(lower);
+  ASSERT_EQ(factorised.info(), Eigen::Success);
+  BlockPreconditioner preconditioner;
+  EXPECT_TRUE(preconditioner.empty());
+  preconditioner.keep(factorised);
+  const Eigen::VectorXd residual = Eigen::VectorXd::Random(n);
+  Eigen::VectorXd solved;
+  preconditioner.apply(residual, solved);
+  const Eigen::VectorXd reference = dense.llt().solve(residual);  // dense Cholesky, no sparse code
+  EXPECT_LT((solved - reference).norm(), 1e-5 * reference.norm());
+  // swapped out, the other holds it and solves the same
+  BlockPreconditioner other;
+  other.swap(preconditioner);
+  EXPECT_TRUE(preconditioner.empty());
+  Eigen::VectorXd again;
+  other.apply(residual, again);
+  EXPECT_EQ(again, solved);
 }
 
 // step_response (the compliance a contact feels within one step, by the kept factorisation) against

@@ -12,9 +12,12 @@
 #include <vector>
 
 #include "uh/core/result.hpp"
+#include "uh/soft/block_preconditioner.hpp"
 #include "uh/soft/tet_mesh.hpp"
 
 namespace uh::soft {
+
+class BackgroundFactorisation;
 
 /// Linear isotropic elasticity with mass and Rayleigh damping, C = alpha M + beta K.
 struct ElasticMaterial {
@@ -58,9 +61,9 @@ std::vector<std::int32_t> nodes_in_box(const TetMesh& mesh, const Eigen::Vector3
 /// with the rotations of the step's start, and solved by conjugate gradients preconditioned with a
 /// sparse LDL^T factorisation of an earlier step's system (same pattern, analysed once, kept as a
 /// single-precision copy in 3 x 3 node blocks), which is refactored only when the iterations do
-/// not converge quickly (SolverOptions). Fixed nodes are eliminated: they
-/// stay at their held position (the rest position unless moved with `hold`).
-/// Not thread-safe: one simulation thread owns it. Not real-time: the assembly writes into fixed
+/// not converge quickly (SolverOptions), in place or on a worker thread (factorise_in_background).
+/// Fixed nodes are eliminated: they stay at their held position (the rest position unless moved
+/// with `hold`). Not thread-safe: one simulation thread owns it (and its worker, when it has one). Not real-time: the assembly writes into fixed
 /// slots, but Eigen's products, solves and factorisations may allocate.
 class CorotationalFem {
  public:
@@ -69,6 +72,16 @@ class CorotationalFem {
   /// degenerate mesh.
   static Result<CorotationalFem> create(TetMesh mesh, const ElasticMaterial& material,
                                         const std::vector<std::int32_t>& fixed, const SolverOptions& solver = {});
+  ~CorotationalFem();
+  CorotationalFem(CorotationalFem&&) noexcept;
+  CorotationalFem& operator=(CorotationalFem&&) noexcept;
+
+  /// With `on`, a stale preconditioner is refactorised on a worker thread while the steps iterate
+  /// on with the old one (up to 4 x max_iterations), so a step never stops for a factorisation:
+  /// for a simulation thread that must keep its rate (tens of milliseconds at 5,000 tetrahedra).
+  /// The solves then depend on timing (each still reaches relative_residual); off (the default),
+  /// every run of the same steps is the same. Starts or ends the worker thread.
+  void factorise_in_background(bool on);
 
   /// One backward-Euler step of `dt_s` [s] under `external_forces` [N] (one per node, object frame;
   /// those on fixed nodes are ignored). Fails when dt_s is not positive and finite, the forces are
@@ -112,6 +125,8 @@ class CorotationalFem {
   /// How many times the system was factorised (the others were solved by iterations on an older
   /// factorisation).
   int factorisations() const { return factorisations_; }
+  /// How many of the worker's factorisations preconditioned the later steps (factorise_in_background).
+  int background_factorisations() const { return background_factorisations_; }
   /// Conjugate-gradient iterations of the last solve (0 when it was factorised and solved directly).
   int last_iterations() const { return iterations_; }
   const SolverOptions& solver_options() const { return solver_options_; }
@@ -137,10 +152,9 @@ class CorotationalFem {
                         double stiffness_coefficient);
   Status solve_system();
   Status factorise_and_solve();
-  bool conjugate_gradients();
+  bool conjugate_gradients(int max_iterations);
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
-  void keep_preconditioner();
-  void precondition(const Eigen::VectorXd& residual, Eigen::VectorXd& result);
+  void take_background_preconditioner();
   Status check_loads(const std::vector<Eigen::Vector3d>& external_forces) const;
   Status check_contacts(const std::vector<NodeContact>& contacts) const;
   double apply_increment(double dt_s);
@@ -160,12 +174,7 @@ class CorotationalFem {
   Eigen::SparseMatrix<double> system_;     // over free DOFs, fixed pattern, lower triangle only
   std::vector<std::int32_t> block_slots_;  // per element node pair (a, b) and column c: value index of row 0
   std::vector<std::int32_t> diagonal_slots_;
-  // owned through a pointer: Eigen's solvers cannot be moved
-  // free nodes are numbered in a fill-reducing order of the node graph, so the factor keeps each
-  // node's three rows together (3 x 3 blocks) and is factorised in that order as it stands
-  using Factorisation =
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>;
-  std::unique_ptr<Factorisation> solver_;
+  std::unique_ptr<SystemFactorisation> solver_;  // through a pointer: Eigen's solvers cannot be moved
   bool factorised_ = false;
   int factorisations_ = 0;
   int iterations_ = 0;
@@ -174,15 +183,10 @@ class CorotationalFem {
   Eigen::VectorXd increment_;
   Eigen::VectorXd residual_, preconditioned_, direction_, product_;  // scratch of the iterations
   Eigen::VectorXd response_loads_, response_;                        // scratch of step_response
-  // the preconditioner: a single-precision copy of the factorisation L D L^T = A in 3 x 3 blocks
-  // (a fraction of the memory traffic of its solves, which dominate a step; the iterations stay
-  // in double precision): per node column J, the strict lower part of its diagonal block and the
-  // blocks below it, with their node rows
-  std::vector<std::int32_t> factor_starts_, factor_rows_;
-  std::vector<float> factor_blocks_;                  // 9 per block, column-major
-  std::vector<std::array<float, 3>> factor_diagonal_;  // L(1,0), L(2,0), L(2,1) of each diagonal block
-  Eigen::VectorXf diagonal_inverse_;
-  Eigen::VectorXf sweep_;  // the preconditioner's sweeps, in place (single precision)
+  BlockPreconditioner preconditioner_;  // of the last factorisation (in place or the worker's)
+  BlockPreconditioner taken_;           // scratch: the worker's, before it is known to be the newest
+  std::unique_ptr<BackgroundFactorisation> background_;
+  int background_factorisations_ = 0;
   std::vector<Eigen::Vector3d> forces_;    // scratch: external loads and inertia
   std::vector<NodeContact> contacts_;      // scratch: the obstacle's contacts of the last iterate
 };
