@@ -45,14 +45,17 @@ scene.add(grid);
 const objectsGroup = new THREE.Group();
 scene.add(objectsGroup);
 const toolMaterial = new THREE.MeshStandardMaterial({ color: 0x88c0d0, metalness: 0.2, roughness: 0.5 });
+// the tool and what is drawn about it (its handle, the force), hidden together by `uhView.showTool`
+const toolMarks = new THREE.Group();
+scene.add(toolMarks);
 let tool = new THREE.Group();  // replaced by the tool's mesh once it arrived
-scene.add(tool);
+toolMarks.add(tool);
 // where the device's handle holds the tool: apart from it when the 6-DOF proxy keeps the tool on a
 // surface the handle has pushed into
 const handleMarker = new THREE.Mesh(new THREE.SphereGeometry(0.002, 12, 8),
                                     new THREE.MeshBasicMaterial({ color: 0xbf616a, wireframe: true }));
 handleMarker.visible = false;
-scene.add(handleMarker);
+toolMarks.add(handleMarker);
 const forceArrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.0001, 0xff2a55);
 forceArrow.visible = false;
 // drawn over the meshes: the force often points along the tool, which would hide it
@@ -60,7 +63,7 @@ for (const part of [forceArrow.line, forceArrow.cone]) {
   part.material.depthTest = false;
   part.renderOrder = 1;
 }
-scene.add(forceArrow);
+toolMarks.add(forceArrow);
 
 const $ = (id) => document.getElementById(id);
 function setStatus(text, kind) {
@@ -118,9 +121,9 @@ async function loadScene() {
   if (description.tool.has_mesh) {
     const geometry = await request({ type: 'get_mesh', object: description.tool.name });
     if (generation !== loading) return;
-    scene.remove(tool);
+    toolMarks.remove(tool);
     tool = meshFrom(geometry, toolMaterial);
-    scene.add(tool);
+    toolMarks.add(tool);
     live.meshes++;
   }
   if (!box.isEmpty()) {
@@ -248,6 +251,26 @@ function frame() {
   live.toolDrawn = [(projected.x + 1) * 0.5 * renderer.domElement.width, (1 - projected.y) * 0.5 * renderer.domElement.height];
   requestAnimationFrame(frame);
 }
+
+// For the browser test of soft objects (web/tests/soft_view_test.mjs), which sees them only here:
+// `softVertices(name)`: the vertices of the mesh drawn for soft object `name` (its geometry's
+// positions) in the world frame, flat [x0, y0, z0, ...] [m] (null if no such object is drawn);
+// `showTool(visible)`: show or hide the tool, its handle and the force arrow, so that two frames
+// differ only by what the objects' meshes do.
+live.softVertices = (name) => {
+  const mesh = softMeshes.get(name);
+  if (!mesh || mesh.parent !== objectsGroup) return null;
+  mesh.updateMatrixWorld();
+  const position = mesh.geometry.getAttribute('position');
+  const vertex = new THREE.Vector3();
+  const out = [];
+  for (let i = 0; i < position.count; i++) {
+    vertex.fromBufferAttribute(position, i).applyMatrix4(mesh.matrixWorld);
+    out.push(vertex.x, vertex.y, vertex.z);
+  }
+  return out;
+};
+live.showTool = (visible) => { toolMarks.visible = visible; };
 
 window.addEventListener('resize', () => {
   camera.aspect = window.innerWidth / window.innerHeight;
