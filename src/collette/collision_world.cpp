@@ -510,6 +510,9 @@ void CollisionWorld::run_step(double time_s) {
       object->has_pose = true;
       moved = true;
     }
+    // a new deformed tree is always in another slot than the one read before (the triple buffer
+    // never hands back the slot it takes), so a coherent query, which keeps candidates only for
+    // the tree at their address, traverses it afresh (WorldFixture.CoherentWatchersFollowADeformingTree)
     if (object->deformed_trees != nullptr && object->deformed_trees->update()) {
       object->now = &object->deformed_trees->read_buffer();
       moved = true;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -161,6 +162,45 @@ TEST_F(WorldFixture, CoherentWatchersDeliverTheSameFramesAsTraversingOnes) {
   EXPECT_EQ(plain.stats().coherent_queries, 0u);
   EXPECT_GT(coherent.stats().coherent_queries, 150u) << "the small steps must reuse the kept candidates";
   EXPECT_LT(coherent.stats().coherent_queries, coherent.stats().queries) << "the jump must force a traversal";
+}
+
+// A deforming object (its trees published through `deformed_trees`, as a soft body's simulation
+// does) under a coherent watcher: its leaves move while neither pose does, so the kept candidates
+// of an earlier tree say nothing of the new one. Every frame must agree with a world that traverses.
+TEST_F(WorldFixture, CoherentWatchersFollowADeformingTree) {
+  CollisionWorld plain({.contact_margin = 0.01});
+  CollisionWorld coherent({.contact_margin = 0.01, .coherence_skin = 0.02});
+  LatestValue<SphereTree> trees[2];
+  CollisionWorld* worlds[2] = {&plain, &coherent};
+  WatcherId watchers[2]{};
+  ObjectId tools[2]{};
+  const Pose tool_pose{{}, {0.62, 0.0, 0.0}};
+  for (int k = 0; k < 2; ++k) {
+    const ObjectId soft = *worlds[k]->add_object({.tree = tree, .name = "soft", .deformed_trees = &trees[k]});
+    tools[k] = *worlds[k]->add_object({.tree = tree, .world_from_object = tool_pose, .name = "tool"});
+    watchers[k] = *worlds[k]->add_collision_watcher(soft, tools[k]);
+  }
+  auto frames = std::array{std::make_unique<ContactFrame>(), std::make_unique<ContactFrame>()};
+  std::vector<Sphere> moved = leaves;
+  int touching = 0;
+  for (int step = 0; step < 35; ++step) {
+    // the soft object swells towards the tool, its side 7.5 mm a step, to twice its width, so that
+    // leaves far beyond the skin at first reach the tool (its poses stay where they are)
+    for (std::size_t i = 0; i < moved.size(); ++i) moved[i].x = leaves[i].x * (1.f + 0.03f * static_cast<float>(step));
+    for (int k = 0; k < 2; ++k) {
+      SphereTree& next = trees[k].write_buffer();
+      next = *tree;
+      next.refit(moved);
+      trees[k].publish();
+      worlds[k]->set_pose(tools[k], tool_pose);
+      worlds[k]->step(0.001 * step);
+      ASSERT_TRUE(worlds[k]->read_contact(watchers[k], *frames[static_cast<std::size_t>(k)]));
+    }
+    ASSERT_EQ(frames[1]->pair_count, frames[0]->pair_count) << "step " << step;
+    EXPECT_NEAR(frames[1]->total_volume, frames[0]->total_volume, 1e-12 + 1e-9 * frames[0]->total_volume);
+    if (frames[0]->total_volume > 0.0) ++touching;
+  }
+  EXPECT_GT(touching, 20) << "the swelling object must reach the tool";
 }
 
 TEST_F(WorldFixture, ThreadedWorldPublishesFramesForPosesSetFromAnotherThread) {
