@@ -432,6 +432,7 @@ Status HapticSession::set_object_pose(std::int32_t object, const Pose& world_fro
     return Error{
         fmt::format("{}: there is no object {} (the scene has {})", model_->scene.name, object, object_ids_.size())};
   world_->set_pose(object_ids_[static_cast<std::size_t>(object)], world_from_object);
+  if (const auto& soft = soft_[static_cast<std::size_t>(object)]) soft->set_pose(world_from_object);
   return Ok{};
 }
 

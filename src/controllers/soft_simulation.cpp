@@ -218,6 +218,10 @@ Status SoftSimulation::publish_compliances() {
 }
 
 Status SoftSimulation::step(double dt_s) {
+  if (rotation_in_.update()) {  // moved: the world's forces and its down turn into the object's frame anew
+    object_from_world_ = conjugate(rotation_in_.read_buffer());
+    down_in_object_ = rotate(object_from_world_, Vec3{0.0, 0.0, -1.0});
+  }
   gather_loads();
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
   if (Status s = publish_compliances(); !s) return s;

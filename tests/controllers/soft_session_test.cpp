@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <vector>
 
 #include "hand_energy_support.hpp"
@@ -135,6 +136,46 @@ TEST(SoftSession, OnThePenaltyPathTooTheBlockGivesAndTakesWhatTheBallFelt) {
 // the organ-like blob's top through the proxy for 3 s in simulated time; the blob gives under it
 // (its nodes go down), the loads of the last soft step sum to minus what the stylus felt the tick
 // before it, and the sweep puts no energy into the hand.
+// A soft block moved before the run (HapticSession::set_object_pose) against the same block placed
+// there by its scene: turned a quarter about x and lowered, so that the ball presses its +y face
+// with its base held on a side. The same press must follow, tick for tick: the loads turn into the
+// object's frame with its new pose (with the scene's first pose they would push along the wrong
+// axis of the block).
+std::vector<Vec3> pressed_forces(const Scene& scene, const Pose* moved_to) {
+  SessionOptions options;
+  options.cache_dir = testing::fresh_cache("soft-session-moved");
+  auto session = HapticSession::create(scene, options);
+  EXPECT_TRUE(session.has_value()) << session.error().message;
+  if (!session) return {};
+  std::vector<Vec3> forces;
+  auto seen = (*session)->on_haptic_tick().connect([&](const SessionState& s) { forces.push_back(s.force_world); });
+  if (moved_to != nullptr) {
+    EXPECT_TRUE((*session)->set_object_pose(0, *moved_to));
+  }
+  EXPECT_TRUE((*session)->run_stepped(0.6, 1).has_value());
+  return forces;
+}
+
+TEST(SoftSession, AMovedSoftBlockIsPressedAsOnePlacedThere) {
+  // object +y goes to world +z: the +y face (y = 3.5 cm) comes up to z = 0 and the block stays under
+  // the ball (object z in [-2, 0] cm goes to world y in [-1, 1] cm)
+  const Pose turned{quat_from_axis_angle({1.0, 0.0, 0.0}, std::numbers::pi / 2.0), {0.0, -0.01, -0.035}};
+  Scene placed = soft_block(0.003);
+  placed.objects[0].pose = turned;
+  const std::vector<Vec3> reference = pressed_forces(placed, nullptr);
+  const std::vector<Vec3> moved = pressed_forces(soft_block(0.003), &turned);
+  ASSERT_EQ(moved.size(), reference.size());
+  double largest = 0.0, difference = 0.0;
+  for (std::size_t k = 0; k < reference.size(); ++k) {
+    largest = std::max(largest, norm(reference[k]));
+    difference = std::max(difference, norm(moved[k] - reference[k]));
+  }
+  std::printf("the placed block pushes back up to %.3f N; the moved one differs by %.2e N at most\n", largest,
+              difference);
+  EXPECT_GT(largest, 0.3) << "the ball must press the turned block";
+  EXPECT_LT(difference, 1e-9 * largest);
+}
+
 TEST(SoftSession, TheStylusDentsTheBlobItSweeps) {
   const auto file = std::filesystem::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "soft_blob.json";
   std::ifstream in(file);

@@ -108,6 +108,10 @@ class SoftSimulation {
   /// tool's contact (of its pairs' weights); a frame of this object alone gives it all of the
   /// tool's force. Real-time safe.
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
+  /// Controlling thread: the object now stands at `world_from_object` (HapticSession::set_object_pose);
+  /// the next step turns the world's loads into the object's frame with it (the simulation, its
+  /// tree and surface stay in the object's own frame). Real-time safe.
+  void set_pose(const Pose& world_from_object) { rotation_in_.write(world_from_object.rotation); }
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
   /// What each step tells tool `tool`'s haptic thread (its only reader) of the contact: the force
@@ -172,6 +176,7 @@ class SoftSimulation {
   std::shared_ptr<const collette::SphereTree> rest_tree_;
   soft::CorotationalFem fem_;
   Quat object_from_world_;
+  LatestValue<Quat> rotation_in_;  // controlling thread -> simulation: world_from_object's newest rotation
   LatestValue<collette::SphereTree> trees_;
   // The current hierarchy (the rest tree's until a rebuild) and its generation; each slot of trees_
   // keeps the generation it holds (by address: a triple buffer has three), and one holding an
