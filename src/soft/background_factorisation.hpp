@@ -1,57 +1,55 @@
 #pragma once
 
-#include <condition_variable>
+#include <algorithm>
 #include <cstdint>
-#include <mutex>
-#include <thread>
 
+#include "uh/core/background_worker.hpp"
 #include "uh/soft/block_preconditioner.hpp"
 
 namespace uh::soft {
 
-/// Factorises a copy of a system on its own thread and hands the preconditioner over, so that the
+/// Factorises a copy of a system on a worker thread and hands the preconditioner over, so that the
 /// thread that steps a simulation never stops for a factorisation (tens of milliseconds at 5,000
 /// tetrahedra, several steps at 200 Hz): it iterates on with the older preconditioner meanwhile.
-/// One factorisation at a time. The stepping thread's calls never wait: they only try the lock,
-/// which the worker holds just to change its state.
-/// Built on a mutex and a condition variable (not std::atomic::wait, which loses wake-ups in
-/// the Windows build's libstdc++: docs/core.md).
 class BackgroundFactorisation {
  public:
-  /// A worker for systems of `pattern`'s sparsity (the values are not read). Starts its thread.
-  explicit BackgroundFactorisation(const Eigen::SparseMatrix<double>& pattern);
-  ~BackgroundFactorisation();
-  BackgroundFactorisation(const BackgroundFactorisation&) = delete;
-  BackgroundFactorisation& operator=(const BackgroundFactorisation&) = delete;
+  /// A worker for systems of `pattern`'s sparsity (the values are not read).
+  explicit BackgroundFactorisation(const Eigen::SparseMatrix<double>& pattern) : system_(pattern) {
+    factorisation_.analyzePattern(system_);
+  }
 
-  /// Copies `system`'s values (the pattern's) and starts factorising them, tagged `tag`, unless a
-  /// factorisation is under way or its result not yet taken, or the lock is busy: then false.
-  bool request(const Eigen::SparseMatrix<double>& system, std::uint64_t tag);
+  /// Copies `system`'s values (the pattern's) and starts factorising them, tagged `tag`, unless the
+  /// worker is busy (BackgroundWorker::request): then false.
+  bool request(const Eigen::SparseMatrix<double>& system, std::uint64_t tag) {
+    if (system.nonZeros() != system_.nonZeros()) return false;
+    return worker_.request([&] {
+      std::copy_n(system.valuePtr(), system.nonZeros(), system_.valuePtr());
+      tag_ = tag;
+    });
+  }
 
-  enum class Taken { kNothing, kPreconditioner, kFailed };
-  /// When a factorisation has finished: swaps its preconditioner into `into` (kPreconditioner) or,
-  /// when the system could not be factorised, leaves `into` alone (kFailed); `tag` is the
-  /// request's. kNothing while one is under way, none was asked for, or the lock is busy.
-  Taken take(BlockPreconditioner& into, std::uint64_t& tag);
-
-  /// Factorisations finished on the worker (taken or not).
-  int finished() const;
+  /// When a factorisation has finished: swaps its preconditioner into `into` and its request's tag
+  /// into `tag` (kDone), or, when the system could not be factorised, leaves them (kFailed).
+  BackgroundWorker::Taken take(BlockPreconditioner& into, std::uint64_t& tag) {
+    return worker_.take([&] {
+      into.swap(result_);
+      tag = tag_;
+    });
+  }
 
  private:
-  enum class State { kIdle, kRequested, kWorking, kReady, kFailed };
-  void run();
+  bool factorise() {
+    factorisation_.factorize(system_);
+    if (factorisation_.info() != Eigen::Success) return false;
+    result_.keep(factorisation_);
+    return true;
+  }
 
-  mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  State state_ = State::kIdle;
-  bool stopping_ = false;
-  std::uint64_t tag_ = 0;
-  int finished_ = 0;
-  // written by request() only in kIdle, read by the worker only in kWorking
   Eigen::SparseMatrix<double> system_;
   SystemFactorisation factorisation_;
   BlockPreconditioner result_;
-  std::thread thread_;  // last: started once the members above exist
+  std::uint64_t tag_ = 0;
+  BackgroundWorker worker_{[this] { return factorise(); }};  // last: its thread reads the members above
 };
 
 }  // namespace uh::soft

@@ -366,7 +366,7 @@ Status CorotationalFem::solve_system() {
 // one is newer); a system the worker could not factorise is left to the next solve's fallback
 void CorotationalFem::take_background_preconditioner() {
   std::uint64_t asked_at = 0;
-  if (background_->take(taken_, asked_at) != BackgroundFactorisation::Taken::kPreconditioner) return;
+  if (background_->take(taken_, asked_at) != BackgroundWorker::Taken::kDone) return;
   if (asked_at != static_cast<std::uint64_t>(factorisations_)) return;
   preconditioner_.swap(taken_);
   ++background_factorisations_;
