@@ -258,10 +258,26 @@ std::uint64_t& SoftSimulation::hierarchy_of(const collette::SphereTree& slot) {
   return unknown_slot_generation_;
 }
 
+// The worker's tree (a copy of a refitted slot, rebuilt where its leaves were) and how it went.
+struct SoftSimulation::BackgroundRebuild {
+  collette::SphereTree tree;
+  collette::SphereTreeBuildOptions options;
+  Status outcome = Ok{};
+  std::chrono::steady_clock::duration took{};
+  BackgroundWorker worker{[this] {
+    const auto started = std::chrono::steady_clock::now();
+    outcome = collette::rebuild_sphere_tree(tree, options);
+    took = std::chrono::steady_clock::now() - started;
+    return static_cast<bool>(outcome);
+  }};  // last: its thread reads the members above
+};
+
 // Refits `slot` (the write buffer) over the step's spheres, first copying the current hierarchy
-// into it if it holds an older one (or none: a slot's first turn); rebuilds the hierarchy there
-// when the refit has grown too loose, and makes that the current one for the other slots.
+// into it if it holds an older one (or none: a slot's first turn); when the refit has grown too
+// loose, rebuilds the hierarchy (in place, or asks the worker) and makes the rebuilt one the
+// current one for every slot.
 Status SoftSimulation::refit_or_rebuild(collette::SphereTree& slot) {
+  if (Status s = take_rebuilt_hierarchy(); !s) return s;
   std::uint64_t& generation = hierarchy_of(slot);
   if (generation != hierarchy_generation_) {
     slot = hierarchy_;  // into the slot's own storage, sized on its first turn
@@ -272,19 +288,63 @@ Status SoftSimulation::refit_or_rebuild(collette::SphereTree& slot) {
   if (!(now > 0.0)) return Ok{};  // no volume to measure against: the last distortion stands
   tree_distortion_ = now / hierarchy_looseness_;
   if (!(tree_distortion_ > tree_options_.rebuild_distortion)) return Ok{};
-  const auto started = std::chrono::steady_clock::now();
-  if (started < next_rebuild_) return Ok{};
-  if (Status s = collette::rebuild_sphere_tree(slot, rebuild_options_); !s) return s;
-  const auto took = std::chrono::steady_clock::now() - started;
-  next_rebuild_ = started + took + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                       took * (1.0 / tree_options_.rebuild_time_share - 1.0));
-  hierarchy_ = slot;
-  generation = ++hierarchy_generation_;
-  hierarchy_.refit(spheres_);  // the baseline, refitted where it was built (as at construction)
-  hierarchy_looseness_ = looseness(hierarchy_);
-  tree_distortion_ = looseness(slot) / hierarchy_looseness_;
-  ++tree_rebuilds_;
+  if (std::chrono::steady_clock::now() < next_rebuild_) return Ok{};
+  if (!background_rebuild_) return rebuild_in_place(slot);
+  BackgroundRebuild& b = *background_rebuild_;
+  b.worker.request([&] { b.tree = slot; });  // busy: one is under way already
   return Ok{};
+}
+
+Status SoftSimulation::rebuild_in_place(collette::SphereTree& slot) {
+  const auto started = std::chrono::steady_clock::now();
+  if (Status s = collette::rebuild_sphere_tree(slot, rebuild_options_); !s) return s;
+  hierarchy_ = slot;
+  adopt_hierarchy(std::chrono::steady_clock::now() - started);
+  hierarchy_of(slot) = hierarchy_generation_;
+  tree_distortion_ = looseness(slot) / hierarchy_looseness_;
+  return Ok{};
+}
+
+// The worker's rebuilt hierarchy, once it is done, becomes the current one (each slot takes it on
+// its next turn); it groups the same leaves, so it is refitted where they are now.
+Status SoftSimulation::take_rebuilt_hierarchy() {
+  if (!background_rebuild_) return Ok{};
+  BackgroundRebuild& b = *background_rebuild_;
+  switch (b.worker.take([&] { std::swap(hierarchy_, b.tree); })) {
+    case BackgroundWorker::Taken::kNothing:
+      return Ok{};
+    case BackgroundWorker::Taken::kFailed:
+      return b.outcome;
+    case BackgroundWorker::Taken::kDone:
+      break;
+  }
+  adopt_hierarchy(b.took);
+  return Ok{};
+}
+
+// hierarchy_ (rebuilt, which took `took`) is the current one: a new generation, its baseline
+// looseness refitted where the spheres are (as at construction), the next rebuild not before the
+// time share allows
+void SoftSimulation::adopt_hierarchy(std::chrono::steady_clock::duration took) {
+  next_rebuild_ = std::chrono::steady_clock::now() +
+                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                      took * (1.0 / tree_options_.rebuild_time_share - 1.0));
+  ++hierarchy_generation_;
+  hierarchy_.refit(spheres_);
+  hierarchy_looseness_ = looseness(hierarchy_);
+  ++tree_rebuilds_;
+}
+
+SoftSimulation::~SoftSimulation() { stop(); }
+
+void SoftSimulation::work_in_background(bool on) {
+  fem_.factorise_in_background(on);
+  if (!on) {
+    background_rebuild_.reset();
+  } else if (!background_rebuild_) {
+    background_rebuild_ = std::make_unique<BackgroundRebuild>();
+    background_rebuild_->options = rebuild_options_;
+  }
 }
 
 void SoftSimulation::publish_surface(double dt_s) {
@@ -331,9 +391,9 @@ Status SoftSimulation::start(double rate_hz) {
   // no spinning before each deadline: the simulation shares the machine's cores with the haptic
   // and collision threads, and a millisecond late is nothing at its rate
   loop_ = std::make_unique<FixedRateLoop>(FixedRateLoopOptions{.rate_hz = rate_hz, .spin_us = 0.0, .name = "uh-soft"});
-  // a factorisation in place takes several periods at a few thousand tetrahedra: on its own
-  // thread the steps go on meanwhile (stepped runs, which must repeat exactly, never start this)
-  fem_.factorise_in_background(true);
+  // a factorisation or a rebuild in place takes several periods at a few thousand tetrahedra: on
+  // a worker the steps go on meanwhile (stepped runs, which must repeat exactly, never start this)
+  work_in_background(true);
   const double dt_s = 1.0 / rate_hz;
   return loop_->start([this, dt_s](const TickInfo&) {
     // a fixed step whatever the tick's lateness: the simulation's time is its own
@@ -347,7 +407,7 @@ Status SoftSimulation::start(double rate_hz) {
 void SoftSimulation::stop() {
   if (!loop_) return;
   loop_->stop();
-  fem_.factorise_in_background(false);  // the loop has ended: nothing steps any more
+  work_in_background(false);  // the loop has ended: nothing steps any more
 }
 
 }  // namespace uh::controllers

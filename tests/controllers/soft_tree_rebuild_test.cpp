@@ -8,13 +8,16 @@
 // - the rebuilt tree's looseness (leaf-parent sphere volume over the object's volume) is back
 //   near the rest tree's, where the rest tree refitted to the same spheres stays far above;
 // - a volume query against the published tree finds the pairs and volume of a brute-force loop
-//   over all leaf pairs.
+//   over all leaf pairs;
+// - the same with the rebuilds on a worker thread (also under ThreadSanitizer: label "threads").
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <set>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -85,9 +88,9 @@ struct Pushed {
   int first_rebuild_step = -1;
 };
 
-// `load_n` [N, object frame] on the top layer's spheres for `steps` steps of 10 ms; checks each
-// published tree as the collision thread reads it
-Pushed push(const Block& b, SoftSimulation& sim, const Eigen::Vector3d& load_n, int steps) {
+// `load_n` [N, object frame] on the top layer's spheres for `steps` steps of 10 ms, `pause_s` of wall
+// time after each; checks each published tree as the collision thread reads it
+Pushed push(const Block& b, SoftSimulation& sim, const Eigen::Vector3d& load_n, int steps, double pause_s = 0.0) {
   std::vector<std::int32_t> top;
   for (std::size_t i = 0; i < b.leaves.size(); ++i)
     if (b.leaves[i].z > static_cast<float>(kMax.z() - kSpacing)) top.push_back(static_cast<std::int32_t>(i));
@@ -108,6 +111,7 @@ Pushed push(const Block& b, SoftSimulation& sim, const Eigen::Vector3d& load_n, 
     const Eigen::Vector3d load = load_n * std::min(1.0, 2.0 * (step + 1) / steps);
     sim.post_tool_force(0, Vec3{-load.x(), -load.y(), -load.z()});
     EXPECT_TRUE(sim.step(0.01)) << "step " << step;
+    if (pause_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(pause_s));
     out.largest_distortion = std::max(out.largest_distortion, sim.tree_distortion());
     EXPECT_TRUE(sim.trees().update());
     const collette::SphereTree& published = sim.trees().read_buffer();
@@ -178,6 +182,24 @@ TEST(SoftTreeRebuild, AShearedBlockRebuildsItsTreeIntoEverySlot) {
               p.largest_distortion);
   EXPECT_GT(p.top_moved_m, 0.015);
   EXPECT_GE(p.rebuilds, 1u);
+  expect_rebuilt_tree_is_tight_and_exact(b, **sim);
+}
+
+// The same with the rebuilds on a worker thread (as a session's simulation thread runs them): the
+// steps go on refitting the older hierarchy meanwhile, and every slot takes the rebuilt one.
+TEST(SoftTreeRebuild, RebuiltOnAWorkerTheShearedBlocksTreeReachesEverySlot) {
+  const Block b = make_block();
+  auto sim = SoftSimulation::create(b.body, b.tree, Pose{}, 1);
+  ASSERT_TRUE(sim) << sim.error().message;
+  (*sim)->work_in_background(true);
+  // a simulation thread's pace at 200 Hz, so that the worker's rebuilds arrive between steps
+  const Pushed p = push(b, **sim, Eigen::Vector3d(90.0, 0.0, 0.0), 150, 0.005);
+  std::printf("sheared, rebuilt on the worker: top moved %.1f mm, %llu rebuilds (the first taken at step %d), "
+              "largest distortion %.2f\n",
+              1e3 * p.top_moved_m, static_cast<unsigned long long>(p.rebuilds), p.first_rebuild_step,
+              p.largest_distortion);
+  EXPECT_GE(p.rebuilds, 1u);
+  (*sim)->work_in_background(false);
   expect_rebuilt_tree_is_tight_and_exact(b, **sim);
 }
 
