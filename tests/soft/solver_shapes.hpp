@@ -54,8 +54,9 @@ struct SwingComparison {
 
 // `fast` (a model of `column`) swung by a load on its top that bends it by tens of degrees, so the
 // rotations drift far from those of its preconditioner, `pause_s` [s] of wall time between steps;
-// every tenth step is also taken by a direct solve from the same state and compared.
-inline SwingComparison swing_against_direct(CorotationalFem& fast, const HeldBox& column, double pause_s) {
+// for `steps` steps, every tenth also taken by a direct solve from the same state and compared.
+inline SwingComparison swing_against_direct(CorotationalFem& fast, const HeldBox& column, double pause_s,
+                                            int steps = kSwingSteps) {
   SwingComparison result;
   const TetMesh& mesh = column.mesh;
   auto direct = CorotationalFem::create(mesh, soft_material(2.0e4), column.base, {.direct = true});
@@ -66,7 +67,7 @@ inline SwingComparison swing_against_direct(CorotationalFem& fast, const HeldBox
   const auto top = nodes_in_box(mesh, Eigen::Vector3d(-1.0, -1.0, height), Eigen::Vector3d(1.0, 1.0, height));
   std::vector<Eigen::Vector3d> loads(mesh.nodes.size(), Eigen::Vector3d::Zero());
   constexpr double kDt = 1.0 / 200.0;
-  for (int step = 0; step < kSwingSteps; ++step) {
+  for (int step = 0; step < steps; ++step) {
     const double swing = std::sin(2.0 * std::numbers::pi * 1.5 * kDt * step);
     for (const std::int32_t node : top) {
       loads[static_cast<std::size_t>(node)] = Eigen::Vector3d(1.2 * swing, 0.4, 0.0) / static_cast<double>(top.size());
