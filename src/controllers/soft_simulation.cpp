@@ -339,6 +339,7 @@ SoftSimulation::~SoftSimulation() { stop(); }
 
 void SoftSimulation::work_in_background(bool on) {
   fem_.factorise_in_background(on);
+  fem_.assemble_on_two_threads(on);
   if (!on) {
     background_rebuild_.reset();
   } else if (!background_rebuild_) {

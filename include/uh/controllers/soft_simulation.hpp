@@ -136,8 +136,8 @@ class SoftSimulation {
   /// With `on`, a rebuild of the tree (SoftTreeOptions) runs on a worker thread while the steps go
   /// on refitting the older hierarchy, and the steps after it take the rebuilt one: a step never
   /// stops for it (174 ms at 10,000 spheres, 35 steps at 200 Hz). Off (the default), a step rebuilds
-  /// in place and every run of the same steps is the same. start() turns it on. Also turns the
-  /// FEM's factorisations to the background (CorotationalFem::factorise_in_background).
+  /// in place. start() turns it on. Also gives the FEM's factorisations to a worker and its element
+  /// pass to a second thread (CorotationalFem::factorise_in_background, assemble_on_two_threads).
   /// Controlling thread, while no step runs.
   void work_in_background(bool on);
 

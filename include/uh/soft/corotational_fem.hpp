@@ -18,6 +18,11 @@
 namespace uh::soft {
 
 class BackgroundFactorisation;
+}  // namespace uh::soft
+namespace uh {
+class SideThread;
+}  // namespace uh
+namespace uh::soft {
 
 /// Linear isotropic elasticity with mass and Rayleigh damping, C = alpha M + beta K.
 struct ElasticMaterial {
@@ -83,6 +88,11 @@ class CorotationalFem {
   /// every run of the same steps is the same. Starts or ends the worker thread.
   void factorise_in_background(bool on);
 
+  /// With `on`, each step's element pass (rotations, forces, stiffness: a third of a step) runs on
+  /// two threads, the elements on either side of a cut through the mesh at once and those across it
+  /// after: the same sums in the same order as on one thread. Starts or ends the second thread.
+  void assemble_on_two_threads(bool on);
+
   /// One backward-Euler step of `dt_s` [s] under `external_forces` [N] (one per node, object frame;
   /// those on fixed nodes are ignored). Fails when dt_s is not positive and finite, the forces are
   /// not one finite vector per node, or the factorisation fails; the state is then unchanged.
@@ -145,7 +155,9 @@ class CorotationalFem {
   CorotationalFem() = default;
   void order_free_nodes();
   void build_pattern();
-  void update_rotation(Element& element, const Eigen::Matrix3d& deformation);
+  std::int64_t update_rotation(Element& element, const Eigen::Matrix3d& deformation);
+  std::int64_t assemble_elements(const std::vector<std::int32_t>& elements, double stiffness_coefficient);
+  void partition_elements();
   void assemble(double mass_coefficient, double stiffness_coefficient, const std::vector<Eigen::Vector3d>& loads,
                 const std::vector<NodeContact>& contacts);
   void assemble_element(const Element& element, std::size_t index, const Eigen::Matrix3d& deformation,
@@ -186,6 +198,8 @@ class CorotationalFem {
   BlockPreconditioner preconditioner_;  // of the last factorisation (in place or the worker's)
   BlockPreconditioner taken_;           // scratch: the worker's, before it is known to be the newest
   std::unique_ptr<BackgroundFactorisation> background_;
+  std::array<std::vector<std::int32_t>, 3> element_sides_;  // elements below the cut, above it, across it
+  std::unique_ptr<SideThread> side_thread_;                 // with assemble_on_two_threads
   int background_factorisations_ = 0;
   std::vector<Eigen::Vector3d> forces_;    // scratch: external loads and inertia
   std::vector<NodeContact> contacts_;      // scratch: the obstacle's contacts of the last iterate
