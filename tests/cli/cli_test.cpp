@@ -876,9 +876,13 @@ TEST_F(CliTest, ExploreRecoversEveryMaterialOfTheMaterialsScene) {
 
 // Through the proxy on the curved dome (k = 3e4, friction and a grating at once): each stroke breaks
 // away uphill on its flank, so the breakaway is read in the surface's frame, not the hand's motion's
-// (read in that frame it was 0.67 for 0.5). Friction within 10 %.
-TEST_F(CliTest, ExploreReadsTheDomesFrictionThroughTheProxy) {
+// (read in that frame it was 0.67 for 0.5). Friction within 10 % and the grating's period within 5 %
+// of the path the tool's centre travels: read along the hand's path, a millimetre under the proxy,
+// it was 2.96 mm for 3.13 at seed 1.
+TEST_F(CliTest, ExploreReadsTheDomesFrictionAndGratingThroughTheProxy) {
   const MaterialsScene scene = materials_scene();
+  const double period = scene.material("dome")["texture"]["period"].get<double>() *
+                        (scene.radius("dome") + scene.tool_radius()) / scene.radius("dome");
   for (const int seed : {1, 2}) {
     const CommandRun r = uh(
         fmt::format("explore '{}' --object dome --seed {} --json", materials_scene_path().string(), seed),
@@ -890,8 +894,39 @@ TEST_F(CliTest, ExploreReadsTheDomesFrictionThroughTheProxy) {
       EXPECT_NEAR(e["friction_" + coefficient].get<double>(), m[coefficient].get<double>(),
                   0.1 * m[coefficient].get<double>())
           << "seed " << seed << " " << coefficient;
+    ASSERT_TRUE(e["texture_period_m"].is_number()) << "seed " << seed << ": " << e;
+    EXPECT_NEAR(e["texture_period_m"].get<double>(), period, 0.05 * period) << "seed " << seed;
     EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << "passive";
   }
+}
+
+// The dome ten times softer (k = 3e3) and packed with 10,000 spheres, through the proxy: the device's
+// spring is 0.19 N/mm, so the hand holding 2 N presses 10 mm under the tool and, on the curve, slides on
+// a line the tool does not follow; friction opposes the tool's motion (the proxy's, the handle plus
+// the force over that spring), and read in the hand's motion the dynamic friction was 0.23 for 0.35.
+TEST_F(CliTest, ExploreReadsASoftDomesFrictionThroughTheProxy) {
+  MaterialsScene scene = materials_scene();
+  nlohmann::json dome;
+  for (const auto& o : scene.scene["objects"])
+    if (o["name"] == "dome") dome = o;
+  const fs::path assets = materials_scene_path().parent_path();
+  dome["mesh"] = (assets / dome["mesh"].get<std::string>()).string();
+  dome["spheres"] = 10000;
+  dome["material"]["stiffness"] = 3000.0;
+  scene.scene["objects"] = nlohmann::json::array({dome});
+  scene.scene["tool"]["mesh"] = (assets / scene.scene["tool"]["mesh"].get<std::string>()).string();
+  const fs::path path = dir_ / "soft_dome.json";
+  std::ofstream(path) << scene.scene.dump(1);
+  const CommandRun r = uh(fmt::format("explore '{}' --seed 2 --json", path.string()),
+                          fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json e = json_of(r)["objects"][0];
+  const auto m = dome["material"]["friction"];
+  for (const std::string coefficient : {"static", "dynamic"})
+    EXPECT_NEAR(e["friction_" + coefficient].get<double>(), m[coefficient].get<double>(),
+                0.1 * m[coefficient].get<double>())
+        << coefficient;
+  EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << "passive";
 }
 
 TEST_F(CliTest, ExploreFindsTheTexturePeriodAtTenKilohertzToo) {
