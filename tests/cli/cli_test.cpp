@@ -1008,8 +1008,8 @@ TEST_F(CliTest, ExploreRecoversEveryMaterialOnAFlatPackedSlab) {
 
 // Friction on the 6-DOF proxy (scenes/materials_packed.json: a block packed with 10,000 spheres of
 // unbounded radius, as a user's own mesh would be): `uh explore` reads each material's static and
-// dynamic friction within 10 %, and the packing's grain as no friction. Measured at seed 1: 0.601 /
-// 0.398 for 0.6 / 0.4, 0.247 / 0.149 for 0.25 / 0.15, 0.008 / 0 on the plain block.
+// dynamic friction within 10 %, and the packing's grain as no friction. Measured at seed 1: 0.597 /
+// 0.400 for 0.6 / 0.4, 0.246 / 0.150 for 0.25 / 0.15, 0.002 / 0.002 on the plain block.
 TEST_F(CliTest, ExploreReadsFrictionThroughTheProxyOnAPackedBlock) {
   const fs::path path = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_packed.json";
   std::ifstream in(path);
