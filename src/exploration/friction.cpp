@@ -20,21 +20,21 @@ namespace {
 
 constexpr std::size_t kRampTicks = 5;  // the stick's ramp before the breakaway, read over this many ticks
 
-// The stroke's surface as the contact travelled it: a reference normal, the stroke's direction
-// across it, and the contact's height along that normal fitted by a parabola in its position along
-// the stroke's direction (not in the distance travelled: the slope of height over position is the
-// surface's tilt from the reference whatever that tilt, where the slope over distance, its sine,
-// left a degree and a half of the force's mean tilt by the friction in the normal, and the
-// breakaway read 0.56 for 0.6 on a flat face).
+// The stroke's surface as the tool's centre travelled it (Slide::centre): a reference normal, the
+// stroke's direction across it, and the centre's height along that normal fitted by a parabola in
+// its position along the stroke's direction (not in the distance travelled: the slope of height over
+// position is the surface's tilt from the reference whatever that tilt, where the slope over
+// distance, its sine, left a degree and a half of the force's mean tilt by the friction in the
+// normal, and the breakaway read 0.56 for 0.6 on a flat face).
 struct StrokeSurface {
   Vec3 mean_normal{};
   Vec3 along{};
   Eigen::Vector3d height{Eigen::Vector3d::Zero()};  // h = c0 + c1 u + c2 u^2, u = (x - mid) / half
   double mid = 0.0, half = 1.0;
 
-  // the surface's normal where the contact is
-  Vec3 normal_at(const Vec3& contact) const {
-    const double u = (dot(contact, along) - mid) / half;
+  // the surface's normal under the tool's centre
+  Vec3 normal_at(const Vec3& centre) const {
+    const double u = (dot(centre, along) - mid) / half;
     const double slope = (height[1] + 2.0 * height[2] * u) / half;
     return normalized(mean_normal - slope * along);
   }

@@ -1,6 +1,8 @@
 #include "slide.hpp"
 
 #include <algorithm>
+#include <cstddef>
+#include <cstdint>
 
 #include "contact.hpp"
 #include "plan.hpp"
