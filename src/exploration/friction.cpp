@@ -18,43 +18,60 @@
 namespace uh::exploration {
 namespace {
 
-// The stroke's surface as the hand found it: the mean direction of the force (the surface's mean
-// normal), the stroke's direction across it, and the contact's height along that normal (the
-// hand's, plus its depth under the surface, the normal force over the stiffness) fitted by a
-// parabola in the travel, whose derivative is the surface's slope along the stroke.
+constexpr std::size_t kRampTicks = 5;  // the stick's ramp before the breakaway, read over this many ticks
+
+// The stroke's surface as the tool's centre travelled it (Slide::centre): a reference normal, the
+// stroke's direction across it, and the centre's height along that normal fitted by a parabola in
+// its position along the stroke's direction (not in the distance travelled: the slope of height over
+// position is the surface's tilt from the reference whatever that tilt, where the slope over
+// distance, its sine, left a degree and a half of the force's mean tilt by the friction in the
+// normal, and the breakaway read 0.56 for 0.6 on a flat face).
 struct StrokeSurface {
   Vec3 mean_normal{};
   Vec3 along{};
-  Eigen::Vector3d height{Eigen::Vector3d::Zero()};  // h = c0 + c1 u + c2 u^2, u = (travel - mid) / half
+  Eigen::Vector3d height{Eigen::Vector3d::Zero()};  // h = c0 + c1 u + c2 u^2, u = (x - mid) / half
   double mid = 0.0, half = 1.0;
 
-  // the surface's normal at sample j's travel
-  Vec3 normal_at(double travel) const {
-    const double slope = (height[1] + 2.0 * height[2] * (travel - mid) / half) / half;
+  // the surface's normal under the tool's centre
+  Vec3 normal_at(const Vec3& centre) const {
+    const double u = (dot(centre, along) - mid) / half;
+    const double slope = (height[1] + 2.0 * height[2] * u) / half;
     return normalized(mean_normal - slope * along);
   }
 };
 
-std::optional<StrokeSurface> stroke_surface(const Slide& s, double stiffness_n_per_m) {
-  if (s.travel.size() < 16) return std::nullopt;
+// Fits the tool centre's height along `surface.mean_normal` against its position along the stroke.
+bool fit_height(const Slide& s, StrokeSurface& surface) {
+  const Vec3 moved = s.centre.back() - s.centre.front();
+  surface.along = normalized(moved - dot(moved, surface.mean_normal) * surface.mean_normal);
+  if (norm(surface.along) == 0.0) return false;
+  const double first = dot(s.centre.front(), surface.along), last = dot(s.centre.back(), surface.along);
+  surface.mid = 0.5 * (first + last);
+  surface.half = std::max(0.5 * std::abs(last - first), 1e-9);
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (const Vec3& c : s.centre) {
+    const double u = (dot(c, surface.along) - surface.mid) / surface.half;
+    const Eigen::Vector3d row(1.0, u, u * u);
+    ata += row * row.transpose();
+    atb += dot(c, surface.mean_normal) * row;
+  }
+  surface.height = ata.ldlt().solve(atb);
+  return surface.height.allFinite();
+}
+
+// Fitted twice: first along the force's mean direction, which friction tilts (22 degrees at mu
+// 0.4), so that a dome's arc lies off-centre in that frame and its end slopes, where the strokes
+// break away, come out degrees off a parabola's; then along the normal the first fit found at the
+// stroke's middle, where the arc is symmetric (within a degree of the dome's normal).
+std::optional<StrokeSurface> stroke_surface(const Slide& s) {
+  if (s.centre.size() < 16) return std::nullopt;
   StrokeSurface surface;
   for (const Vec3& f : s.force) surface.mean_normal += f;
   surface.mean_normal = normalized(surface.mean_normal);
-  const Vec3 moved = s.position.back() - s.position.front();
-  surface.along = normalized(moved - dot(moved, surface.mean_normal) * surface.mean_normal);
-  surface.mid = 0.5 * (s.travel.front() + s.travel.back());
-  surface.half = std::max(0.5 * (s.travel.back() - s.travel.front()), 1e-9);
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-  for (std::size_t j = 0; j < s.travel.size(); ++j) {
-    const double u = (s.travel[j] - surface.mid) / surface.half;
-    const double depth = stiffness_n_per_m > 0.0 ? s.normal_n[j] / stiffness_n_per_m : 0.0;
-    const Eigen::Vector3d row(1.0, u, u * u);
-    ata += row * row.transpose();
-    atb += (dot(s.position[j], surface.mean_normal) + depth) * row;
-  }
-  surface.height = ata.ldlt().solve(atb);
-  if (!surface.height.allFinite() || norm(surface.along) == 0.0) return std::nullopt;
+  if (!fit_height(s, surface)) return std::nullopt;
+  surface.mean_normal = normalized(surface.mean_normal - (surface.height[1] / surface.half) * surface.along);
+  if (!fit_height(s, surface)) return std::nullopt;
   return surface;
 }
 
@@ -68,17 +85,24 @@ double breakaway_ratio(const Slide& s, double length, const std::optional<Stroke
   double peak = -1e300;
   std::size_t at = 0;
   for (std::size_t j = 0; j < s.travel.size(); ++j) {
-    const double against = s.friction_ratio[j] * s.normal_n[j];
+    const double against = s.pulled_n[j];
     if (s.travel[j] < length / 3.0 && against > peak) {
       peak = against;
       at = j;
     }
   }
   if (peak <= -1e300 || !surface) return peak <= -1e300 ? peak : s.friction_ratio[at];
-  const Vec3 n = surface->normal_at(s.travel[at]);
-  const Vec3& f = s.force[at];
-  const double pressing = dot(f, n);
-  return pressing > 0.0 ? norm(f - pressing * n) / pressing : s.friction_ratio[at];
+  const Vec3 n = surface->normal_at(s.centre[at]);
+  const auto ratio = [&](std::size_t j) {
+    const double pressing = dot(s.force[j], n);
+    return pressing > 0.0 ? norm(s.force[j] - pressing * n) / pressing : s.friction_ratio[j];
+  };
+  // The tick of the peak is the last the tool stuck on: the cone's edge lies between its ratio and
+  // the next tick's, had the tool stuck on, so half the ramp's rise per tick is added (up to 5 % of
+  // mu_s low otherwise: 1.25 N/mm x 20 mm/s x 1 ms is 0.0125 of a ratio at 2 N)
+  const std::size_t back = std::min<std::size_t>(at, kRampTicks);
+  const double rise = back > 0 ? (ratio(at) - ratio(at - back)) / static_cast<double>(back) : 0.0;
+  return ratio(at) + 0.5 * std::max(rise, 0.0);
 }
 
 // the median ratio over the samples of `s` travelled between `from_m` and `to_m` (exclusive)
@@ -98,12 +122,11 @@ double mean(const std::vector<double>& v) {
 
 void estimate_friction(const StrokeSlides& slides, const ExploreOptions& o, MaterialEstimate& e) {
   std::vector<double> breakaway, sliding;
-  const double stiffness_n_per_m = e.stiffness_n_per_mm.value_or(0.0) * 1e3;
   for (int leg = 0; leg < 4; ++leg) {
     const Slide& s = slides.legs[leg];
     if (s.travel.empty()) continue;
     const double length = leg_length(o, leg);
-    if (const double peak = breakaway_ratio(s, length, stroke_surface(s, stiffness_n_per_m)); peak > -1e300)
+    if (const double peak = breakaway_ratio(s, length, stroke_surface(s)); peak > -1e300)
       breakaway.push_back(peak);
     if (const auto slid = sliding_ratio(s, 0.5 * length, 0.95 * length)) sliding.push_back(*slid);
   }

@@ -18,7 +18,7 @@ MaterialEstimate estimate_material(const ExploreTrace& trace) {
   MaterialEstimate e;
   estimate_stiffness(trace, e);
   estimate_damping(trace, e);
-  const StrokeSlides slides = stroke_slides(trace);
+  const StrokeSlides slides = stroke_slides(trace, e.stiffness_n_per_mm.value_or(0.0) * 1e3);
   estimate_friction(slides, trace.options, e);
   estimate_texture(slides, trace, e);  // after the stiffness, which it reads
   return e;

@@ -28,9 +28,11 @@ ContourRipple contour_ripple(const Slide& contour, const Vec3 (&axes)[2], double
   ContourRipple r;
   const std::size_t n = contour.position.size();
   r.circle = contour.travel.back();
-  Vec3 centre{};
+  Vec3 centre{}, contact_centre{};
   for (const Vec3& p : contour.position) centre += p;
+  for (const Vec3& c : contour.contact) contact_centre += c;
   centre = centre / static_cast<double>(n);
+  contact_centre = contact_centre / static_cast<double>(n);
   Vec3 normal = cross(axes[0], axes[1]);
   if (normal.z < 0.0) normal = -1.0 * normal;
   std::vector<double> unmoved(n);
@@ -47,7 +49,7 @@ ContourRipple contour_ripple(const Slide& contour, const Vec3 (&axes)[2], double
   // the slow part: the shape and the force loop vary once or twice per turn and drift along it
   for (std::size_t j = 0; j < n; ++j) {
     if (contour.travel[j] < 0.1 * r.circle) continue;  // the seat's transient
-    const Vec3 d = contour.position[j] - centre;
+    const Vec3 d = contour.contact[j] - contact_centre;  // the wave is where the contact is
     const double a = dot(d, axes[0]), b = dot(d, axes[1]), theta = std::atan2(b, a);
     r.slow.insert(r.slow.end(), {1.0, std::cos(theta), std::sin(theta), std::cos(2.0 * theta),
                                  std::sin(2.0 * theta), contour.travel[j] / r.circle});
