@@ -320,7 +320,8 @@ ToolProxy::HoldingFriction ToolProxy::holding_friction(std::span<const forcecomp
 void ToolProxy::count_contacts(std::span<const forcecomp::ProxyConstraint> rows, const Vec3& t, const Vec3& w) {
   std::fill(contact_rows_.begin(), contact_rows_.end(), 0);
   for (const forcecomp::ProxyConstraint& c : rows) {
-    const double gap_after = c.gap - dot(c.normal, t) - dot(cross(c.lever, c.normal), w);
+    // the normal points out of the object: a step along it opens the row (ProxyConstraint)
+    const double gap_after = c.gap + dot(c.normal, t) + dot(cross(c.lever, c.normal), w);
     if (gap_after < 1e-4 && c.tag >= 0 && static_cast<std::size_t>(c.tag) < contact_rows_.size())
       ++contact_rows_[static_cast<std::size_t>(c.tag)];
   }

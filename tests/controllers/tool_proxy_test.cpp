@@ -111,6 +111,48 @@ TEST_P(ThinWall, HoldsTheToolOnTheSideItCameFrom) {
 
 INSTANTIATE_TEST_SUITE_P(TwoAndThreeMillimetres, ThinWall, ::testing::Values(0.002, 0.003));
 
+// The rows a step ends in contact with (ToolProxy::contact_rows: through a proxy, the session's
+// contact begin and end events) count the step's own motion: a handle that jumps behind a plate and
+// back puts the proxy on the plate and takes it off again, and on every step the count says
+// whether the proxy then rests on the plate, judged by its height over where it came to rest.
+TEST(ToolProxy, CountsTheContactOfTheStepItTook) {
+  const Packed plate = pack(box_mesh({0.06, 0.06, 0.003}), 10000);
+  const auto ball_tree = collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}});
+  ASSERT_TRUE(ball_tree);
+  const auto ball = std::make_shared<const collette::SphereTree>(*ball_tree);
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  const auto plate_id = world.add_object({.tree = plate.tree, .is_static = true, .name = "plate"});
+  const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
+  ASSERT_TRUE(plate_id && tool_id);
+  ASSERT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball, {.enabled = true, .step_m = 0.002, .penetration_m = 0.0001}, true);
+  proxy.watch(*plate_id);
+  proxy.bind();
+  // the handle 2 cm above the plate, then 3 cm into it for 40 steps, then 2 cm above again
+  std::vector<double> heights;
+  std::vector<std::int32_t> rows;
+  ProxyState state{};
+  for (int i = 0; i < 120; ++i) {
+    Pose handle{};
+    handle.position = {0.0, 0.0, i < 20 || i >= 60 ? 0.02 : -0.03};
+    proxy.set_target(handle);
+    world.step(1e-3 * i);
+    if (const ProxyState* s = proxy.take()) state = *s;
+    heights.push_back(state.world_from_proxy.position.z);
+    rows.push_back(proxy.contact_rows(0));
+  }
+  const double resting = heights[59];  // 40 steps into the press: on the plate
+  int on = 0, off = 0;
+  for (std::size_t i = 1; i < heights.size(); ++i) {
+    const bool resting_there = heights[i] - resting < 1e-4;
+    EXPECT_EQ(rows[i] > 0, resting_there) << "step " << i << ": " << rows[i] << " rows in contact, the proxy "
+                                          << 1e3 * (heights[i] - resting) << " mm above where it rests";
+    (resting_there ? on : off) += 1;
+  }
+  EXPECT_GT(on, 30);
+  EXPECT_GT(off, 60);
+}
+
 TEST(ToolProxy, SlidesAlongAFaceItIsPressedInto) {
   const Packed plate = pack(box_mesh({0.06, 0.06, 0.003}), 10000);
   const auto ball_tree = collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, 0.005f}});
