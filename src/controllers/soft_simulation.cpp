@@ -391,7 +391,11 @@ std::uint64_t SoftSimulation::read_surface(std::span<float> xyz) {
 Status SoftSimulation::start(double rate_hz) {
   // no spinning before each deadline: the simulation shares the machine's cores with the haptic
   // and collision threads, and a millisecond late is nothing at its rate
-  loop_ = std::make_unique<FixedRateLoop>(FixedRateLoopOptions{.rate_hz = rate_hz, .spin_us = 0.0, .name = "uh-soft"});
+  // a step is a fixed stretch of the simulation's time: steps late after a slow one (preempted,
+  // or its iterations longer) run back to back until on the grid again, so the simulation keeps
+  // time with the clock; only when it falls 20 steps (100 ms at 200 Hz) behind does it skip them
+  loop_ = std::make_unique<FixedRateLoop>(FixedRateLoopOptions{
+      .rate_hz = rate_hz, .spin_us = 0.0, .name = "uh-soft", .catch_up_periods = kCatchUpSteps});
   // a factorisation or a rebuild in place takes several periods at a few thousand tetrahedra: on
   // a worker the steps go on meanwhile (stepped runs, which must repeat exactly, never start this)
   work_in_background(true);

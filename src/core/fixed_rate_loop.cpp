@@ -43,6 +43,10 @@ Status FixedRateLoop::start(Callback callback, ExitCallback on_exit) {
     return Error{"loop '" + options_.name + "': rate_hz = " + std::to_string(options_.rate_hz) +
                  " is out of range (expected 0 < rate_hz <= 100000)"};
   }
+  if (options_.catch_up_periods < 1) {
+    return Error{"loop '" + options_.name + "': catch_up_periods = " + std::to_string(options_.catch_up_periods) +
+                 " is out of range (expected >= 1)"};
+  }
   if (!std::isfinite(options_.spin_us) || options_.spin_us < 0.0) {
     return Error{"loop '" + options_.name + "': spin_us = " + std::to_string(options_.spin_us) +
                  " is invalid (expected a finite value >= 0)"};
@@ -137,9 +141,10 @@ void FixedRateLoop::run(Callback callback, ExitCallback on_exit) {
         now = Clock::now();
       }
 
-      // re-anchor instead of bursting: skip the grid points that are more than a period past
+      // re-anchor instead of bursting: skip the grid points that are more than a period past (or
+      // more than the catch-up the options allow)
       const Nanos late = now - scheduled;
-      if (late > period) {
+      if (late > period * options_.catch_up_periods) {
         const std::int64_t skipped = late.count() / period.count();
         grid += static_cast<std::uint64_t>(skipped);
         scheduled += period * skipped;

@@ -193,6 +193,33 @@ TEST(FixedRateLoop, CountsMissedDeadlinesAndSkipsInsteadOfBursting) {
   EXPECT_GE(s.callback_duration.max_ns, 7e6);
 }
 
+TEST(FixedRateLoop, CatchesUpWhenAllowedSoTheTicksKeepCountWithTheClock) {
+  // the same overruns, allowed to run up to 25 periods late (a simulation's steps): the ticks after
+  // each run back to back until they are on the grid again, and none is skipped
+  uh::FixedRateLoop loop({.rate_hz = 500.0, .catch_up_periods = 25});
+  std::atomic<int> overruns{0};
+  std::atomic<int> short_gaps{0};
+  std::chrono::steady_clock::time_point previous_start{};
+  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
+    if (t.index > 0 && t.start_time - previous_start < 100us) short_gaps.fetch_add(1);
+    previous_start = t.start_time;
+    if (t.index % 10 == 0 && overruns.load() < 10) {
+      overruns.fetch_add(1);
+      std::this_thread::sleep_for(7ms);
+    }
+  }));
+  EXPECT_TRUE(wait_for([&] { return overruns.load() >= 10; }));
+  std::this_thread::sleep_for(40ms);
+  loop.stop();
+  const uh::FixedRateLoopStats s = loop.stats();
+  EXPECT_EQ(s.missed_deadlines, 0u);
+  EXPECT_EQ(s.skipped_ticks, 0u);
+  // every grid point ran: as many ticks as periods elapsed (the last may be on its way)
+  EXPECT_NEAR(static_cast<double>(s.ticks), s.elapsed_s * 500.0 + 1.0, 2.0);
+  EXPECT_GE(short_gaps.load(), 10) << "each overrun is caught up by ticks back to back";
+  EXPECT_FALSE(uh::FixedRateLoop({.catch_up_periods = 0}).start([](const uh::TickInfo&) {}));
+}
+
 TEST(FixedRateLoop, ExposesRaisePriorityOutcome) {
   // SCHED_FIFO needs a privilege this machine may lack: start() must succeed either way
   uh::FixedRateLoop loop({.rate_hz = 1000.0, .raise_priority = true});

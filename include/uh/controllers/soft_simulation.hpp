@@ -159,6 +159,8 @@ class SoftSimulation {
   /// after stop()).
   const std::vector<SoftSample>& record() const { return record_; }
   static constexpr std::size_t kRecordCapacity = 60000;  // five minutes at 200 Hz
+  /// How many steps late the simulation thread may fall before it skips steps (FixedRateLoopOptions::catch_up_periods).
+  static constexpr int kCatchUpSteps = 20;
   /// Steps taken so far. Simulation thread (or after stop()).
   std::uint64_t steps() const { return steps_; }
   /// The last step's tree distortion (SoftTreeOptions::rebuild_distortion): 1 at rest, a little

@@ -12,7 +12,11 @@
 /// the OS took too long), the loop does not run the missed ticks in a burst. It counts one missed
 /// deadline, skips the missed grid points (counted in `skipped_ticks`), and runs the next tick at
 /// once on the latest grid point not in the future, so the grid (phase) is kept. A tick that is
-/// late by less than one period just runs late, and later ticks catch up with the grid.
+/// late by less than one period just runs late, and later ticks catch up with the grid. A loop
+/// whose ticks must keep count with the clock (a simulation's steps, each a fixed stretch of its
+/// time) may allow more: `catch_up_periods` N lets a tick start up to N periods late, so the ticks
+/// after an overrun run back to back until they are on the grid again; only beyond N are grid
+/// points skipped.
 ///
 /// Statistics are written by the loop thread into lock-free histograms (LatencyHistogram) and
 /// atomics; stats() may be called from any thread at any time and returns a plain snapshot.
@@ -47,6 +51,7 @@ struct FixedRateLoopOptions {
   int fifo_priority = 80;       ///< SCHED_FIFO priority used when raise_priority (1..99)
   double spin_us = 80.0;        ///< busy-wait this long before each deadline [us], >= 0
   std::string name = "uh-loop"; ///< thread name (first 15 characters are used by the OS)
+  int catch_up_periods = 1;     ///< how late a tick may start before grid points are skipped [periods], >= 1
 };
 
 /// What the callback gets each tick.
@@ -63,7 +68,7 @@ struct TickInfo {
 /// Snapshot of a FixedRateLoop's statistics since its last start(). Plain data.
 struct FixedRateLoopStats {
   std::uint64_t ticks = 0;             ///< callbacks run
-  std::uint64_t missed_deadlines = 0;  ///< ticks that would have started more than one period late
+  std::uint64_t missed_deadlines = 0;  ///< ticks that would have started more than catch_up_periods late
   std::uint64_t skipped_ticks = 0;     ///< grid points dropped when re-anchoring after misses
   double rate_hz = 0.0;                ///< nominal rate [Hz]
   double achieved_rate_hz = 0.0;       ///< (ticks - 1) / (last start - first start) [Hz]; 0 before 2 ticks
