@@ -166,30 +166,36 @@ TEST(FixedRateLoop, StatsAreReadableWhileRunning) {
   EXPECT_GE(loop.stats().ticks, last_ticks);
 }
 
-TEST(FixedRateLoop, CountsMissedDeadlinesAndSkipsInsteadOfBursting) {
-  // every 5th tick sleeps 3.5 periods: each overrun misses a deadline and drops ~3 grid points
-  uh::FixedRateLoop loop({.rate_hz = 500.0});
+// Runs `loop` (500 Hz) until ten of its ticks, every `every`-th, have slept 7 ms (3.5 periods), and
+// `settle` more; returns the ticks that started less than 0.1 ms after the one before (back to back).
+int run_with_overruns(uh::FixedRateLoop& loop, std::uint64_t every, std::chrono::milliseconds settle) {
   std::atomic<int> overruns{0};
   std::atomic<int> short_gaps{0};
   std::chrono::steady_clock::time_point previous_start{};
-  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
-    // after a skip the loop restarts on the grid instead of running back-to-back catch-up ticks
+  EXPECT_TRUE(loop.start([&](const uh::TickInfo& t) {
     if (t.index > 0 && t.start_time - previous_start < 100us) short_gaps.fetch_add(1);
     previous_start = t.start_time;
-    if (t.index % 5 == 0 && overruns.load() < 10) {
+    if (t.index % every == 0 && overruns.load() < 10) {
       overruns.fetch_add(1);
       std::this_thread::sleep_for(7ms);
     }
   }));
   EXPECT_TRUE(wait_for([&] { return overruns.load() >= 10; }));
-  std::this_thread::sleep_for(20ms);
+  std::this_thread::sleep_for(settle);
   loop.stop();
+  return short_gaps.load();
+}
+
+TEST(FixedRateLoop, CountsMissedDeadlinesAndSkipsInsteadOfBursting) {
+  // every 5th tick sleeps 3.5 periods: each overrun misses a deadline and drops ~3 grid points
+  uh::FixedRateLoop loop({.rate_hz = 500.0});
+  const int short_gaps = run_with_overruns(loop, 5, 20ms);
   const uh::FixedRateLoopStats s = loop.stats();
   EXPECT_GE(s.missed_deadlines, 10u);
   EXPECT_GE(s.skipped_ticks, 20u);  // 7 ms overrun at 2 ms period: at least 2 skipped per overrun
-  // a catch-up burst would give 3 back-to-back ticks per overrun; re-anchoring gives none, bar a
-  // rare one when the sleep overshoots by almost a period
-  EXPECT_LE(short_gaps.load(), 3);
+  // after a skip the loop restarts on the grid: a catch-up burst would give 3 back-to-back ticks per
+  // overrun; re-anchoring gives none, bar a rare one when the sleep overshoots by almost a period
+  EXPECT_LE(short_gaps, 3);
   EXPECT_GE(s.callback_duration.max_ns, 7e6);
 }
 
@@ -197,26 +203,13 @@ TEST(FixedRateLoop, CatchesUpWhenAllowedSoTheTicksKeepCountWithTheClock) {
   // the same overruns, allowed to run up to 25 periods late (a simulation's steps): the ticks after
   // each run back to back until they are on the grid again, and none is skipped
   uh::FixedRateLoop loop({.rate_hz = 500.0, .catch_up_periods = 25});
-  std::atomic<int> overruns{0};
-  std::atomic<int> short_gaps{0};
-  std::chrono::steady_clock::time_point previous_start{};
-  ASSERT_TRUE(loop.start([&](const uh::TickInfo& t) {
-    if (t.index > 0 && t.start_time - previous_start < 100us) short_gaps.fetch_add(1);
-    previous_start = t.start_time;
-    if (t.index % 10 == 0 && overruns.load() < 10) {
-      overruns.fetch_add(1);
-      std::this_thread::sleep_for(7ms);
-    }
-  }));
-  EXPECT_TRUE(wait_for([&] { return overruns.load() >= 10; }));
-  std::this_thread::sleep_for(40ms);
-  loop.stop();
+  const int short_gaps = run_with_overruns(loop, 10, 40ms);
   const uh::FixedRateLoopStats s = loop.stats();
   EXPECT_EQ(s.missed_deadlines, 0u);
   EXPECT_EQ(s.skipped_ticks, 0u);
   // every grid point ran: as many ticks as periods elapsed (the last may be on its way)
   EXPECT_NEAR(static_cast<double>(s.ticks), s.elapsed_s * 500.0 + 1.0, 2.0);
-  EXPECT_GE(short_gaps.load(), 10) << "each overrun is caught up by ticks back to back";
+  EXPECT_GE(short_gaps, 10) << "each overrun is caught up by ticks back to back";
   EXPECT_FALSE(uh::FixedRateLoop({.catch_up_periods = 0}).start([](const uh::TickInfo&) {}));
 }
 
