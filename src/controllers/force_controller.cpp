@@ -348,6 +348,10 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
       add_held(*w, world_from_tool, tool_motion, sum);
   }
   if (model) record_model_check(sum);
+  // a soft object gives under the force between its steps, as through the proxy (with_compliance),
+  // the model's stiffness along the force in series with it
+  if (model && !compliances_.empty() && sum.normal_stiffness > 0.0)
+    sum.contact.force = with_compliance(sum.contact.force, sum.normal_stiffness);
 
   forcecomp::Wrench to_device = sum.contact;
   if (options_.use_coupling) {
@@ -388,6 +392,19 @@ void ForceController::take_model(Watched& w, const Pose& world_from_tool) {
       if (s.live) s.renderer.take(f.patch_models[s.index]);
 }
 
+// How stiff a local model is along the force it gives: -f^ . (dF/dx) f^ [N/L] (the penalty's force
+// grows as the tool moves into the object, against f^), 0 without a force or for a model that
+// softens that way.
+double ForceController::stiffness_along(const forcecomp::WrenchModel& m, const Vec3& force) {
+  const double magnitude = norm(force);
+  if (!m.contact || !(magnitude > 0.0)) return 0.0;
+  const double n[3] = {force.x / magnitude, force.y / magnitude, force.z / magnitude};
+  double k = 0.0;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 3; ++j) k -= n[i] * m.stiffness[i][j] * n[j];
+  return std::isfinite(k) ? std::max(k, 0.0) : 0.0;
+}
+
 // kModel: `w`'s force from its local model at `now`, with its patches' surface stages
 void ForceController::add_modelled(Watched& w, double now, const Pose& world_from_tool,
                                    const forcecomp::BodyMotion& tool_motion, TickSum& sum) {
@@ -402,6 +419,7 @@ void ForceController::add_modelled(Watched& w, double now, const Pose& world_fro
   const forcecomp::Wrench r = w.renderer.render(now, world_from_tool.rotation, tool_motion);
   const forcecomp::WrenchModel& m = w.renderer.model();
   add(sum.contact, r);
+  sum.normal_stiffness += stiffness_along(m, r.force);
   // a patch's penalty: its own model's, or, for one patch, the whole one just rendered (as on the
   // held path)
   if (m.contact && w.has_surface)

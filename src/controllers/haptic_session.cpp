@@ -309,10 +309,11 @@ Status HapticSession::wire_controllers(ToolRig& rig) {
                                         .tool_texture = material.tool_texture,
                                         // a soft object's rest surface is not where it is: its spheres are
                                         .surface = soft_[i] ? nullptr : model_->objects[i].surface});
-    // the proxy rests on a soft object's spheres within the margin: its loads go by nearness, and
-    // the spring to it is felt in series with the object's compliance there
-    if (rig.proxy && soft_[i]) {
-      soft_[i]->rest_on_proxy(t, std::max(force_options.proxy.smoothing_m, force_options.proxy.penetration_m));
+    // the proxy rests on a soft object's spheres within the margin: its loads go by nearness; the
+    // spring to it, or the penalty's local model, is felt in series with the object's compliance
+    if (soft_[i]) {
+      if (rig.proxy)
+        soft_[i]->rest_on_proxy(t, std::max(force_options.proxy.smoothing_m, force_options.proxy.penetration_m));
       rig.force_controller->feel_compliance_of(&soft_[i]->compliance(t));
     }
   }

@@ -113,9 +113,10 @@ class ForceController {
   /// Renders the spring to this tool's proxy instead of penalty forces (the proxy outlives the
   /// controller's ticks). Controlling thread, before bind().
   void render_through(ToolProxy* proxy) { proxy_ = proxy; }
-  /// With a proxy: the proxy rests on a soft object that gives way; `source` (its simulation's,
-  /// read only by this tool's haptic thread) tells how far, so that between the object's steps the
-  /// spring is felt in series with its compliance (with_compliance). Controlling thread, before bind().
+  /// The tool touches a soft object that gives way; `source` (its simulation's, read only by this
+  /// tool's haptic thread) tells how far, so that between the object's steps the spring to the
+  /// proxy, or on the penalty path the local model's stiffness along its force, is felt in series
+  /// with its compliance (with_compliance). Controlling thread, before bind().
   void feel_compliance_of(LatestValue<ContactCompliance>* source) { compliances_.push_back(source); }
   /// With a proxy: the proxy the last tick rendered against (slid towards the handle). Haptic thread.
   const Pose& rendered_proxy() const { return rendered_proxy_; }
@@ -183,6 +184,7 @@ class ForceController {
     Vec3 exact_force{};          // check_model: the exact re-evaluation's force, beside the model's
     std::uint64_t clamped = 0;   // kModel: the renderers' clamped and held ticks
     std::uint64_t held = 0;
+    double normal_stiffness = 0.0;  // kModel: the models' stiffness along their forces [N/L], for a soft object's compliance
   };
   double tick_period(double now);
   void take_model(Watched& w, const Pose& world_from_tool);
@@ -194,6 +196,7 @@ class ForceController {
   // and the constraints holding the proxy
   forcecomp::Wrench proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s, std::int32_t& holding);
   Vec3 with_compliance(const Vec3& spring_force, double spring);
+  static double stiffness_along(const forcecomp::WrenchModel& m, const Vec3& force);
   // the end of every tick: statistics, the safety stage, the device frame
   void finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,
                    double oldest_data_s, std::int32_t pairs, haptico::DeviceCommand& command);
