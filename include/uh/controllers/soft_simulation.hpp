@@ -7,7 +7,8 @@
 ///    tetrahedra and refits a copy of the tree (or rebuilds it when the refit has grown too
 ///    loose: SoftTreeOptions), which it publishes (LatestValue: the newest wins);
 ///  - the collision thread queries the newest published tree (CollisionObjectDef::deformed_trees)
-///    and posts the object's pairs of each tool's frame (post_contacts);
+///    and posts the object's pairs of each tool's frame (post_contacts; a proxy's, weighed where
+///    the proxy moved to after its step: rest_proxy_at);
 ///  - each tool's haptic thread posts the force its tool felt (post_tool_force).
 /// The haptic thread never waits on the simulation: it only writes into its own triple buffer.
 
@@ -99,15 +100,24 @@ class SoftSimulation {
   /// Tool `tool` is a proxy (ToolProxy), which rests on the object's spheres within the margin
   /// rather than in them, so its pairs have no overlap volume: each pair is weighed by its nearness
   /// instead, exp(-(gap - smallest gap) / `smoothing_m`), the share of the proxy's soft-minimum row
-  /// (forcecomp: the soft minimum's gradient) that the pair takes. Setup only, before the threads.
+  /// (forcecomp: the soft minimum's gradient) that the pair takes, at the pose the proxy moved to
+  /// (rest_proxy_at). Setup only, before the threads (it sizes the tool's pair buffer).
   void rest_on_proxy(std::size_t tool, double smoothing_m);
 
   /// Collision thread: the pairs of `frame`'s that touch this object (object `object`, on side A
   /// of a pair as the session watches it) become tool `tool`'s newest contacts; a frame of another
   /// object's watcher is ignored. A tool-against-everything frame gives the object's share of the
   /// tool's contact (of its pairs' weights); a frame of this object alone gives it all of the
-  /// tool's force. Real-time safe.
+  /// tool's force. A proxy's pairs are kept until rest_proxy_at weighs them. Real-time safe.
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
+  /// Collision thread, after proxy tool `tool` (rest_on_proxy) has stepped to `world_from_proxy`:
+  /// the pairs of its last frame (post_contacts), weighed by their nearness at that pose, become
+  /// its newest contacts; nothing when no frame came since the last call. The frame was queried
+  /// where the proxy was before its step, while the force the tool feels until the next step is the
+  /// spring to where it is now: weighed at the old pose, the object would take the force a
+  /// collision step behind where the tool presses it (docs/deformables.md, "What the hand feels").
+  /// Real-time safe.
+  void rest_proxy_at(std::size_t tool, const Pose& world_from_proxy);
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
   /// What each step tells tool `tool`'s haptic thread (its only reader) of the contact: the force
@@ -164,7 +174,23 @@ class SoftSimulation {
   double looseness(const collette::SphereTree& tree) const;
   bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
   Status publish_compliances();
-  void weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame, SoftContacts& out) const;
+  // A pair of a proxy tool's frame, kept by post_contacts until rest_proxy_at weighs it.
+  struct ProxyPair {
+    Vec3 object_centre_world{};  // the object's sphere at the query's pose [m, world]
+    Vec3 tool_centre_local{};    // the tool's sphere [m, tool frame]
+    double radii = 0.0;          // the two spheres' radii [m]
+    std::int32_t leaf = -1;      // the object's leaf (this object's pairs)
+    bool this_object = false;    // false: another object's pair, which counts in the share only
+    double gap = 0.0;            // scratch of weigh_by_nearness [m]
+  };
+  struct ProxyPairs {
+    bool posted = false;          // a frame came since the last rest_proxy_at
+    std::vector<ProxyPair> pairs;  // capacity kProxyPairCapacity (rest_on_proxy), never grown
+  };
+  // a frame's pairs past this many are left out (a tool's pairs within the margin: tens to hundreds)
+  static constexpr std::size_t kProxyPairCapacity = SoftContacts::kCapacity;
+  void keep_proxy_pairs(std::int32_t object, const ContactFrame& frame, ProxyPairs& out) const;
+  void weigh_by_nearness(double smoothing_m, ProxyPairs& frame, const Pose& world_from_proxy, SoftContacts& out) const;
   void publish_surface(double dt_s);
   void record_step(double dt_s, std::span<const float> xyz);
 
@@ -196,6 +222,7 @@ class SoftSimulation {
   std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<double> proxy_smoothing_m_;  // per tool: 0 weighs pairs by overlap, > 0 by nearness
+  std::vector<ProxyPairs> proxy_pairs_;    // per tool: collision thread, a proxy's last frame's pairs
   std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: simulation -> haptic
   std::vector<Eigen::Vector3d> loads_;
   std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of publish_compliances
