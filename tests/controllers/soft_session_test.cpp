@@ -189,14 +189,13 @@ double largest_force_step(const Scene& scene, double seconds, int ticks_per_coll
 }
 
 // The collision thread stepping near the simulation's rate (250 Hz and 143 Hz against 200 Hz): the
-// scene's own press (the ball's lowest point 14 mm below the top face in 2 s, the block pushing back
-// up to the device's 8 N). The proxy moves
-// once a collision step, so the force steps there (the rigid block's too, by the spring times the
-// handle's travel in a collision step); the block's give adds no more. Before the block took the
-// force at the pose the proxy's frame was queried at (a collision step behind where the proxy rests,
-// where the force comes from), the proxy and the dent it left chased each other sideways: steps of
-// 0.97 N at 4 ticks a collision step and 1.0 N at 7 (the device's slew limit), against 0.034 N and
-// 0.044 N rigid.
+// scene's own press, down only (the ball's lowest point to 14 mm below the top face in 2 s, the
+// block pushing back up to the device's 8 N). The proxy moves once a collision step, so the force
+// steps there (the rigid block's too: the spring times the handle's travel in a collision step);
+// the block's give adds no more. While the block took the force at the pose the proxy's frame was
+// queried at (a collision step behind where the proxy rests, where the force comes from), proxy and
+// dent chased each other sideways: steps of 0.97 N at 4 ticks a collision step and 1.0 N at 7 (the
+// limit chain's rate limit), against the rigid block's 0.034 N and 0.044 N.
 TEST(SoftSession, TheForceDoesNotBuzzWhenTheCollisionStepsNearTheSimulationsRate) {
   constexpr double kDepth = 0.014, kDown = 2.0, kSeconds = 2.5;
   for (const int ticks : {4, 7}) {
