@@ -66,6 +66,8 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
   }
   proxy_smoothing_m_.assign(tools, 0.0);
   proxy_pairs_.resize(tools);
+  for (auto& slot : tree_compliances_) slot.assign(tools, ContactCompliance{});
+  compliance_step_sent_.assign(tools, 0);
 }
 
 void SoftSimulation::rest_on_proxy(std::size_t tool, double smoothing_m) {
@@ -111,8 +113,15 @@ void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const 
 }
 
 void SoftSimulation::rest_proxy_at(std::size_t tool, const Pose& world_from_proxy) {
+  if (!(proxy_smoothing_m_[tool] > 0.0)) return;
+  // the tree the collision step took (0: still the rest tree, no step's compliance yet)
+  const ContactCompliance& rested_on = tree_compliances_[trees_.read_slot()][tool];
+  if (rested_on.step != compliance_step_sent_[tool]) {
+    compliances_[tool]->write(rested_on);
+    compliance_step_sent_[tool] = rested_on.step;
+  }
   ProxyPairs& frame = proxy_pairs_[tool];
-  if (!(proxy_smoothing_m_[tool] > 0.0) || !frame.posted) return;
+  if (!frame.posted) return;
   frame.posted = false;
   weigh_by_nearness(proxy_smoothing_m_[tool], frame, world_from_proxy, contacts_[tool]->write_buffer());
   contacts_[tool]->publish();
@@ -204,15 +213,17 @@ void SoftSimulation::gather_loads() {
   }
 }
 
-// For each tool, the force this step took and how far its contact will move per newton more in the
-// next one: a unit load into the object along the contact's normal, spread as the step's loads,
-// through the step's system (CorotationalFem::step_response); the load-weighted mean of the moves
-// along it. Known from the first step in contact, before any force is felt, so the first touch
-// is soft too.
-Status SoftSimulation::publish_compliances() {
+// For each proxy tool, the force this step took and how far its contact will move per newton more
+// in the next one: a unit load into the object along the contact's normal, spread as the step's
+// loads, through the step's system (CorotationalFem::step_response); the load-weighted mean of the
+// moves along it. Known from the first step in contact, before any force is felt, so the first
+// touch is soft too. Kept beside the tree the step publishes (rest_proxy_at hands it over).
+Status SoftSimulation::find_compliances() {
+  std::vector<ContactCompliance>& beside_tree = tree_compliances_[trees_.write_slot()];
   for (std::size_t t = 0; t < compliances_.size(); ++t) {
-    ContactCompliance& out = compliances_[t]->write_buffer();
-    out = {};
+    ContactCompliance& out = beside_tree[t];
+    out = {.step = steps_ + 1};
+    if (!(proxy_smoothing_m_[t] > 0.0)) continue;  // only a proxy feels it
     const SoftContacts& contacts = contacts_[t]->read_buffer();
     std::fill(unit_loads_.begin(), unit_loads_.end(), Eigen::Vector3d::Zero());
     if (contacts.share > 0.0 && spread_tool_force(t, contacts.normal_world * -1.0, unit_loads_)) {
@@ -223,9 +234,9 @@ Status SoftSimulation::publish_compliances() {
       out = {.force_world = felt * contacts.share,
              .share = contacts.share,
              // the haptic thread divides by 1 + k C: never negative, never a NaN
-             .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0};
+             .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0,
+             .step = steps_ + 1};
     }
-    compliances_[t]->publish();
   }
   return Ok{};
 }
@@ -233,7 +244,7 @@ Status SoftSimulation::publish_compliances() {
 Status SoftSimulation::step(double dt_s) {
   gather_loads();
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
-  if (Status s = publish_compliances(); !s) return s;
+  if (Status s = find_compliances(); !s) return s;
   soft::deform_spheres(*body_, fem_.positions(), spheres_);
   if (Status s = refit_or_rebuild(trees_.write_buffer()); !s) return s;
   trees_.publish();

@@ -9,7 +9,10 @@
 ///  - the collision thread queries the newest published tree (CollisionObjectDef::deformed_trees)
 ///    and posts the object's pairs of each tool's frame (post_contacts; a proxy's, weighed where
 ///    the proxy moved to after its step: rest_proxy_at);
-///  - each tool's haptic thread posts the force its tool felt (post_tool_force).
+///  - each tool's haptic thread posts the force its tool felt (post_tool_force);
+///  - each step's compliance at a proxy's contact goes beside the tree it publishes, and the
+///    collision thread hands the compliance of the tree it took to the tool's haptic thread once
+///    the proxy rests on that tree (rest_proxy_at, compliance).
 /// The haptic thread never waits on the simulation: it only writes into its own triple buffer.
 
 #include <Eigen/Core>
@@ -110,18 +113,21 @@ class SoftSimulation {
   /// tool's contact (of its pairs' weights); a frame of this object alone gives it all of the
   /// tool's force. A proxy's pairs are kept until rest_proxy_at weighs them. Real-time safe.
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
-  /// Collision thread, after proxy tool `tool` (rest_on_proxy) has stepped to `world_from_proxy`:
-  /// the pairs of its last frame (post_contacts), weighed by their nearness at that pose, become
-  /// its newest contacts; nothing when no frame came since the last call. The frame was queried
-  /// where the proxy was before its step, while the force the tool feels until the next step is the
-  /// spring to where it is now: weighed at the old pose, the object would take the force a
-  /// collision step behind where the tool presses it (docs/deformables.md, "What the hand feels").
-  /// Real-time safe.
+  /// Collision thread, after proxy tool `tool` (rest_on_proxy) has stepped to `world_from_proxy`
+  /// on the tree the collision step took (trees()): the pairs of its last frame (post_contacts),
+  /// weighed by their nearness at that pose, become its newest contacts (nothing when no frame came
+  /// since the last call), and the compliance of the step that published that tree goes to the
+  /// tool's haptic thread (compliance()). The frame was queried where the proxy was before its
+  /// step, while the force the tool feels until the next step is the spring to where it is now:
+  /// weighed at the old pose, the object would take the force a collision step behind where the
+  /// tool presses it; and the newest step's compliance describes a surface the proxy does not rest
+  /// on yet (docs/deformables.md, "What the hand feels"). Real-time safe.
   void rest_proxy_at(std::size_t tool, const Pose& world_from_proxy);
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
-  /// What each step tells tool `tool`'s haptic thread (its only reader) of the contact: the force
-  /// the step took and the object's compliance there (ForceController::feel_compliance_of).
+  /// What a step tells proxy tool `tool`'s haptic thread (its only reader) of the contact: the
+  /// force the step took and the object's compliance there (ForceController::feel_compliance_of),
+  /// handed over by rest_proxy_at with the tree the proxy rests on.
   LatestValue<ContactCompliance>& compliance(std::size_t tool) { return *compliances_[tool]; }
 
   /// Vertices of the body's drawn surface (SoftBodyModel::surface).
@@ -173,7 +179,7 @@ class SoftSimulation {
   std::uint64_t& hierarchy_of(const collette::SphereTree& slot);
   double looseness(const collette::SphereTree& tree) const;
   bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
-  Status publish_compliances();
+  Status find_compliances();
   // A pair of a proxy tool's frame, kept by post_contacts until rest_proxy_at weighs it.
   struct ProxyPair {
     Vec3 object_centre_world{};  // the object's sphere at the query's pose [m, world]
@@ -223,9 +229,13 @@ class SoftSimulation {
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<double> proxy_smoothing_m_;  // per tool: 0 weighs pairs by overlap, > 0 by nearness
   std::vector<ProxyPairs> proxy_pairs_;    // per tool: collision thread, a proxy's last frame's pairs
-  std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: simulation -> haptic
+  // per slot of trees_ (its read_slot / write_slot), per tool: the compliance of the step that
+  // filled the slot, owned as the slot is (simulation thread, then the collision thread)
+  std::array<std::vector<ContactCompliance>, 3> tree_compliances_;
+  std::vector<std::uint64_t> compliance_step_sent_;  // per tool: collision thread, the last handed over
+  std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: collision -> haptic
   std::vector<Eigen::Vector3d> loads_;
-  std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of publish_compliances
+  std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of find_compliances
   std::vector<Sphere> spheres_;
   Vec3 down_in_object_;  // the world's -z in the object's frame
   std::vector<SoftSample> record_;
