@@ -394,10 +394,17 @@ void HapticSession::on_collision(collette::ObjectId a, collette::ObjectId b, con
 
 void HapticSession::on_step(double time_s) {
   // collision thread, after every proxy's own step: through a proxy the tool rests on the surface
-  // (on the mesh, above the spheres), so its contact is its constraint rows in contact, not overlap
+  // (on the mesh, above the spheres), so its contact is its constraint rows in contact, not overlap;
+  // a soft object takes the force where the proxy now rests, not where the step's query had it
   for (auto& rig : rigs_) {
-    if (!rig->proxy) continue;
+    if (!rig->proxy) {  // a penalty tool's model is built from the tree this step took: its compliance
+      for (const auto& soft : soft_)
+        if (soft) soft->hand_over_compliance(static_cast<std::size_t>(rig->index));
+      continue;
+    }
     const ToolProxy& proxy = *rig->proxy;
+    for (const auto& soft : soft_)
+      if (soft) soft->rest_proxy_at(static_cast<std::size_t>(rig->index), proxy.pose());
     for (std::size_t k = 0; k < proxy.watched_count(); ++k) {
       const std::int32_t rows = proxy.contact_rows(k);
       contact_edge(*rig, proxy.watched_object(k), rows > 0, time_s, 0.0, rows);

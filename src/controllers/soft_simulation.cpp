@@ -10,23 +10,6 @@
 namespace uh::controllers {
 namespace {
 
-// A pair at the poses of its query: its gap, centre distance less both radii [m] (< 0:
-// overlapping), and the unit normal from the object's sphere to the tool's.
-struct PairGeometry {
-  double gap = 0.0;
-  Vec3 normal{};
-};
-PairGeometry pair_geometry(const SpherePairContact& p, const ContactSection& s) {
-  const auto centre = [](const Sphere& x) {
-    return Vec3{static_cast<double>(x.x), static_cast<double>(x.y), static_cast<double>(x.z)};
-  };
-  const Vec3 a = transform_point(s.world_from_a, centre(p.sphere_a_local));
-  const Vec3 b = transform_point(s.world_from_b, centre(p.sphere_b_local));
-  const double distance = norm(b - a);
-  return {.gap = distance - static_cast<double>(p.sphere_a_local.radius) - static_cast<double>(p.sphere_b_local.radius),
-          .normal = distance > 0.0 ? (b - a) / distance : Vec3{}};
-}
-
 Vec3 unit_or_zero(const Vec3& v) { return norm(v) > 0.0 ? v / norm(v) : Vec3{}; }
 
 std::span<const SpherePairContact> section_pairs(const ContactFrame& frame, const ContactSection& s) {
@@ -82,24 +65,27 @@ SoftSimulation::SoftSimulation(std::shared_ptr<const soft::SoftBodyModel> body,
     compliances_.push_back(std::make_unique<LatestValue<ContactCompliance>>());
   }
   proxy_smoothing_m_.assign(tools, 0.0);
+  proxy_pairs_.resize(tools);
+  for (auto& slot : tree_compliances_) slot.assign(tools, ContactCompliance{});
+  compliance_step_sent_.assign(tools, 0);
 }
 
 void SoftSimulation::rest_on_proxy(std::size_t tool, double smoothing_m) {
   proxy_smoothing_m_[tool] = std::max(smoothing_m, 1e-6);
+  proxy_pairs_[tool].pairs.reserve(kProxyPairCapacity);
 }
 
 void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame) {
   // another object's own frame says nothing of this one (a tool against everything says all)
   if (frame.object_a != object && frame.object_a != ContactFrame::kEveryObject) return;
+  if (proxy_smoothing_m_[tool] > 0.0) {
+    keep_proxy_pairs(object, frame, proxy_pairs_[tool]);
+    return;
+  }
   SoftContacts& out = contacts_[tool]->write_buffer();
   out.count = 0;
   out.share = 0.0;
   out.normal_world = {};
-  if (proxy_smoothing_m_[tool] > 0.0) {
-    weigh_by_nearness(proxy_smoothing_m_[tool], object, frame, out);
-    contacts_[tool]->publish();
-    return;
-  }
   std::span<const SpherePairContact> pairs;
   if (frame.object_a == object) {
     pairs = frame.pairs();
@@ -126,35 +112,75 @@ void SoftSimulation::post_contacts(std::size_t tool, std::int32_t object, const 
   contacts_[tool]->publish();
 }
 
+void SoftSimulation::hand_over_compliance(std::size_t tool) {
+  // the tree the collision step took (0: still the rest tree, no step's compliance yet)
+  const ContactCompliance& rested_on = tree_compliances_[trees_.read_slot()][tool];
+  if (rested_on.step != compliance_step_sent_[tool]) {
+    compliances_[tool]->write(rested_on);
+    compliance_step_sent_[tool] = rested_on.step;
+  }
+}
+
+void SoftSimulation::rest_proxy_at(std::size_t tool, const Pose& world_from_proxy) {
+  if (!(proxy_smoothing_m_[tool] > 0.0)) return;
+  hand_over_compliance(tool);
+  ProxyPairs& frame = proxy_pairs_[tool];
+  if (!frame.posted) return;
+  frame.posted = false;
+  weigh_by_nearness(proxy_smoothing_m_[tool], frame, world_from_proxy, contacts_[tool]->write_buffer());
+  contacts_[tool]->publish();
+}
+
+// A proxy's frame, kept as its spheres: the object's where the query had it (it does not move
+// before the next query), the tool's in its own frame, to be placed where the proxy moves to.
+void SoftSimulation::keep_proxy_pairs(std::int32_t object, const ContactFrame& frame, ProxyPairs& out) const {
+  const auto centre = [](const Sphere& x) {
+    return Vec3{static_cast<double>(x.x), static_cast<double>(x.y), static_cast<double>(x.z)};
+  };
+  out.posted = true;
+  out.pairs.clear();  // keeps its capacity: the pushes below never allocate
+  for (const ContactSection& s : frame.sections())
+    for (const SpherePairContact& p : section_pairs(frame, s)) {
+      if (out.pairs.size() == kProxyPairCapacity) return;
+      out.pairs.push_back({.object_centre_world = transform_point(s.world_from_a, centre(p.sphere_a_local)),
+                           .tool_centre_local = centre(p.sphere_b_local),
+                           .radii = static_cast<double>(p.sphere_a_local.radius) +
+                                    static_cast<double>(p.sphere_b_local.radius),
+                           .leaf = p.leaf_a,
+                           .this_object = s.object_a == object});
+    }
+}
+
 // Through a proxy: the proxy rests on the soft minimum of its pairs' gaps (ToolProxy), whose
 // gradient gives each pair exp(-gap / e) over the sum, so each pair takes that share of the force
-// holding the proxy. The frame's pairs are those within the margin; a pair more than 7 e (1.4 mm
-// at e = 0.2 mm) farther than the nearest takes under 0.1 % of the nearest's and is left out, so
-// the buffer holds those that matter. The object's share is its pairs' weight over the frame's.
-void SoftSimulation::weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame,
+// holding the proxy, at the pose the proxy rests at (where the spring the tool feels pulls it). A
+// pair more than 7 e (1.4 mm at e = 0.2 mm) farther than the nearest takes under 0.1 % of the
+// nearest's and is left out, so the buffer holds those that matter. The object's share is its
+// pairs' weight over the frame's.
+void SoftSimulation::weigh_by_nearness(double smoothing_m, ProxyPairs& frame, const Pose& world_from_proxy,
                                        SoftContacts& out) const {
   constexpr double kLeftOut = 1e-3;
   double nearest = std::numeric_limits<double>::infinity();
-  for (const ContactSection& s : frame.sections())
-    for (const SpherePairContact& p : section_pairs(frame, s)) nearest = std::min(nearest, pair_geometry(p, s).gap);
+  for (ProxyPair& p : frame.pairs) {
+    p.gap = norm(transform_point(world_from_proxy, p.tool_centre_local) - p.object_centre_world) - p.radii;
+    nearest = std::min(nearest, p.gap);
+  }
+  out.count = 0;
   double all = 0.0, mine = 0.0;
   Vec3 normal{};
-  for (const ContactSection& s : frame.sections()) {
-    const bool this_object = s.object_a == object;
-    for (const SpherePairContact& p : section_pairs(frame, s)) {
-      const PairGeometry pair = pair_geometry(p, s);
-      const double w = std::exp(-(pair.gap - nearest) / smoothing_m);
-      all += w;
-      if (!this_object) continue;
-      mine += w;
-      if (w < kLeftOut || out.count == SoftContacts::kCapacity || p.leaf_a < 0 ||
-          static_cast<std::size_t>(p.leaf_a) >= body_->spheres.size())
-        continue;
-      out.leaves[static_cast<std::size_t>(out.count)] = p.leaf_a;
-      out.weights[static_cast<std::size_t>(out.count)] = static_cast<float>(w);
-      ++out.count;
-      normal += w * pair.normal;
-    }
+  for (const ProxyPair& p : frame.pairs) {
+    const double w = std::exp(-(p.gap - nearest) / smoothing_m);
+    all += w;
+    if (!p.this_object) continue;
+    mine += w;
+    if (w < kLeftOut || out.count == SoftContacts::kCapacity || p.leaf < 0 ||
+        static_cast<std::size_t>(p.leaf) >= body_->spheres.size())
+      continue;
+    out.leaves[static_cast<std::size_t>(out.count)] = p.leaf;
+    out.weights[static_cast<std::size_t>(out.count)] = static_cast<float>(w);
+    ++out.count;
+    // from the object's sphere to the tool's
+    normal += w * unit_or_zero(transform_point(world_from_proxy, p.tool_centre_local) - p.object_centre_world);
   }
   out.share = all > 0.0 ? mine / all : 0.0;
   out.normal_world = unit_or_zero(normal);
@@ -191,15 +217,16 @@ void SoftSimulation::gather_loads() {
   }
 }
 
-// For each tool, the force this step took and how far its contact will move per newton more in the
-// next one: a unit load into the object along the contact's normal, spread as the step's loads,
-// through the step's system (CorotationalFem::step_response); the load-weighted mean of the moves
-// along it. Known from the first step in contact, before any force is felt, so the first touch
-// is soft too.
-Status SoftSimulation::publish_compliances() {
+// For each tool, the force this step took and how far its contact will move per newton more
+// in the next one: a unit load into the object along the contact's normal, spread as the step's
+// loads, through the step's system (CorotationalFem::step_response); the load-weighted mean of the
+// moves along it. Known from the first step in contact, before any force is felt, so the first
+// touch is soft too. Kept beside the tree the step publishes (hand_over_compliance hands it over).
+Status SoftSimulation::find_compliances() {
+  std::vector<ContactCompliance>& beside_tree = tree_compliances_[trees_.write_slot()];
   for (std::size_t t = 0; t < compliances_.size(); ++t) {
-    ContactCompliance& out = compliances_[t]->write_buffer();
-    out = {};
+    ContactCompliance& out = beside_tree[t];
+    out = {.step = steps_ + 1};
     const SoftContacts& contacts = contacts_[t]->read_buffer();
     std::fill(unit_loads_.begin(), unit_loads_.end(), Eigen::Vector3d::Zero());
     if (contacts.share > 0.0 && spread_tool_force(t, contacts.normal_world * -1.0, unit_loads_)) {
@@ -210,9 +237,9 @@ Status SoftSimulation::publish_compliances() {
       out = {.force_world = felt * contacts.share,
              .share = contacts.share,
              // the haptic thread divides by 1 + k C: never negative, never a NaN
-             .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0};
+             .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0,
+             .step = steps_ + 1};
     }
-    compliances_[t]->publish();
   }
   return Ok{};
 }
@@ -224,7 +251,7 @@ Status SoftSimulation::step(double dt_s) {
   }
   gather_loads();
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
-  if (Status s = publish_compliances(); !s) return s;
+  if (Status s = find_compliances(); !s) return s;
   soft::deform_spheres(*body_, fem_.positions(), spheres_);
   if (Status s = refit_or_rebuild(trees_.write_buffer()); !s) return s;
   trees_.publish();

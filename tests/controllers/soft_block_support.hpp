@@ -18,13 +18,14 @@ inline const std::filesystem::path kSoftBlockFile = std::filesystem::path(UH_TES
 
 enum class Path { kProxy, kPenalty };
 
-// the committed scene, the ball going down to `depth_m` below the top face in 0.5 s and staying;
-// through the proxy (the scene's default) or on the penalty path
-inline Scene soft_block(double depth_m, bool soft = true, Path path = Path::kProxy) {
+// the committed scene, the ball going down to `depth_m` below the top face in `duration_s` (from
+// 12 mm above the top face: its centre 2 mm above) and staying; through the proxy (the scene's
+// default) or on the penalty path
+inline Scene soft_block(double depth_m, bool soft = true, Path path = Path::kProxy, double duration_s = 0.5) {
   std::ifstream in(kSoftBlockFile);
   nlohmann::json j = nlohmann::json::parse(in);
   j["tool"]["device"]["config"]["end"] = {0.0, 0.0, 0.01 - depth_m};  // the ball's centre: its radius above
-  j["tool"]["device"]["config"]["duration_s"] = 0.5;
+  j["tool"]["device"]["config"]["duration_s"] = duration_s;
   j["tool"]["device"]["config"]["bounce"] = false;
   j["objects"][0]["spheres"] = 1500;  // quicker to pack, as deep
   if (!soft) j["objects"][0].erase("deformable");

@@ -211,6 +211,42 @@ TEST(SoftSession, TheStylusDentsTheBlobItSweeps) {
               (*session)->report().work_on_hand_j);
 }
 
+// The largest tick-to-tick step of the force the ball is sent, through the proxy, in a stepped run
+// of `scene` for `seconds` at `ticks_per_collision` haptic ticks a collision step (the last ticks
+// left out: the run ends by sending zero).
+double largest_force_step(const Scene& scene, double seconds, int ticks_per_collision) {
+  SessionOptions options;
+  options.cache_dir = testing::fresh_cache("soft-steps");
+  auto session = HapticSession::create(scene, options);
+  EXPECT_TRUE(session.has_value()) << session.error().message;
+  std::vector<Vec3> forces;
+  auto seen = (*session)->on_haptic_tick().connect([&](const SessionState& s) { forces.push_back(s.force_world); });
+  EXPECT_TRUE((*session)->run_stepped(seconds, ticks_per_collision).has_value());
+  double largest = 0.0;
+  for (std::size_t k = 1; k + 10 < forces.size(); ++k) largest = std::max(largest, norm(forces[k] - forces[k - 1]));
+  std::filesystem::remove_all(options.cache_dir);
+  return largest;
+}
+
+// The collision thread stepping near the simulation's rate (250 Hz and 143 Hz against 200 Hz): the
+// scene's own press, down only (the ball's lowest point to 14 mm below the top face in 2 s, the
+// block pushing back up to the device's 8 N). The proxy moves once a collision step, so the force
+// steps there (the rigid block's too: the spring times the handle's travel in a collision step);
+// the block's give adds no more. While the block took the force at the pose the proxy's frame was
+// queried at (a collision step behind where the proxy rests, where the force comes from), proxy and
+// dent chased each other sideways: steps of 0.97 N at 4 ticks a collision step and 1.0 N at 7 (the
+// limit chain's rate limit), against the rigid block's 0.034 N and 0.044 N.
+TEST(SoftSession, TheForceDoesNotBuzzWhenTheCollisionStepsNearTheSimulationsRate) {
+  constexpr double kDepth = 0.014, kDown = 2.0, kSeconds = 2.5;
+  for (const int ticks : {4, 7}) {
+    const double soft = largest_force_step(soft_block(kDepth, true, Path::kProxy, kDown), kSeconds, ticks);
+    const double rigid = largest_force_step(soft_block(kDepth, false, Path::kProxy, kDown), kSeconds, ticks);
+    std::printf("%d ticks a collision step: largest tick-to-tick step %.4f N soft, %.4f N rigid\n", ticks, soft, rigid);
+    EXPECT_GT(rigid, 0.0) << ticks << " ticks: the ball reached the block";
+    EXPECT_LT(soft, 1.5 * rigid) << ticks << " ticks a collision step";
+  }
+}
+
 struct HandPress {
   SessionReport report;
   double lowest_m = 1.0;  // the ball's (the proxy's) lowest centre [m]; the rest top face is at 0

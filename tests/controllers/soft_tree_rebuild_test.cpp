@@ -9,7 +9,10 @@
 //   near the rest tree's, where the rest tree refitted to the same spheres stays far above;
 // - a volume query against the published tree finds the pairs and volume of a brute-force loop
 //   over all leaf pairs;
-// - the same with the rebuilds on a worker thread (also under ThreadSanitizer: label "threads").
+// - the same with the rebuilds on a worker thread;
+// - a proxy's haptic thread feels the compliance of the step whose tree the collision thread took,
+//   not the newest step's.
+// Also under ThreadSanitizer (label "threads").
 
 #include <gtest/gtest.h>
 
@@ -212,6 +215,58 @@ TEST(SoftTreeRebuild, WithoutRebuildsTheSameShearOnlyRefits) {
   EXPECT_EQ(p.rebuilds, 0u);
   EXPECT_GT(p.largest_distortion, SoftTreeOptions::kRebuildDistortion);
   EXPECT_FALSE(SoftSimulation::create(b.body, b.tree, Pose{}, 1, {.rebuild_distortion = 1.0}));
+}
+
+// A proxy rests on the tree the collision step took, so the compliance its haptic thread feels
+// (SoftSimulation::compliance: how that surface will give) must be of the step that published that
+// tree: the newest step's describes a surface the proxy does not rest on yet (it made the force
+// step up at the simulation step and back at the collision step, docs/deformables.md). A tool
+// sphere rests on the top layer's middle sphere; the simulation steps twice, then the collision
+// thread takes the newest tree, then the simulation steps again.
+TEST(SoftTreeRebuild, AProxyFeelsTheComplianceOfTheTreeItRestsOn) {
+  const Block b = make_block();
+  auto made = SoftSimulation::create(b.body, b.tree, Pose{}, 1);
+  ASSERT_TRUE(made) << made.error().message;
+  SoftSimulation& sim = **made;
+  sim.rest_on_proxy(0, 2e-4);
+  std::size_t middle = 0;
+  const auto off_middle = [](const Sphere& s) { return std::abs(s.x) + std::abs(s.y) - s.z; };
+  for (std::size_t i = 0; i < b.leaves.size(); ++i)
+    if (off_middle(b.leaves[i]) < off_middle(b.leaves[middle])) middle = i;
+  const Sphere& under = b.leaves[middle];
+  const Sphere tool_sphere{0.f, 0.f, 0.f, 0.005f};
+  const auto d = [](float x) { return static_cast<double>(x); };
+  const Pose tool{.rotation = {},
+                  .position = {d(under.x), d(under.y), d(under.z) + d(under.radius) + d(tool_sphere.radius) + 1e-5}};
+  ContactFrame frame;
+  frame.object_a = 0;
+  frame.object_b = 1;
+  frame.resize_pairs(1);
+  frame.pairs()[0].leaf_a = static_cast<std::int32_t>(middle);
+  frame.pairs()[0].sphere_a_local = under;
+  frame.pairs()[0].sphere_b_local = tool_sphere;
+  frame.add_section({.object_a = 0, .object_b = 1, .world_from_a = {}, .world_from_b = tool, .pair_count = 1});
+  sim.post_contacts(0, 0, frame);
+  sim.rest_proxy_at(0, tool);
+  EXPECT_FALSE(sim.compliance(0).update()) << "no step yet: the rest tree";
+  sim.post_tool_force(0, Vec3{0.0, 0.0, 1.0});  // the block pushes the tool up: it takes 1 N down
+  ASSERT_TRUE(sim.step(0.005));
+  ASSERT_TRUE(sim.step(0.005));
+  sim.rest_proxy_at(0, tool);
+  EXPECT_FALSE(sim.compliance(0).update()) << "the collision thread has taken no step's tree yet";
+  ASSERT_TRUE(sim.trees().update());  // the collision thread takes the newest tree, step 2's
+  sim.rest_proxy_at(0, tool);
+  ASSERT_TRUE(sim.compliance(0).update());
+  EXPECT_EQ(sim.compliance(0).read_buffer().step, 2u);
+  EXPECT_GT(sim.compliance(0).read_buffer().compliance_m_per_n, 0.0);
+  EXPECT_NEAR(sim.compliance(0).read_buffer().force_world.z, 1.0, 1e-12);
+  ASSERT_TRUE(sim.step(0.005));
+  sim.rest_proxy_at(0, tool);
+  EXPECT_FALSE(sim.compliance(0).update()) << "the proxy still rests on step 2's tree";
+  ASSERT_TRUE(sim.trees().update());
+  sim.rest_proxy_at(0, tool);
+  ASSERT_TRUE(sim.compliance(0).update());
+  EXPECT_EQ(sim.compliance(0).read_buffer().step, 3u);
 }
 
 }  // namespace

@@ -77,6 +77,23 @@ TEST(LatestValue, AlternatingWritesAndReadsSeeEveryValue) {
   }
 }
 
+// data kept beside each slot (an array of three indexed by write_slot / read_slot) travels with it
+TEST(LatestValue, TheSlotIndicesNameTheSlotsTheBuffersAre) {
+  uh::LatestValue<std::uint64_t> v;
+  std::array<std::uint64_t, 3> beside{};
+  for (std::uint64_t i = 1; i < 20; ++i) {
+    ASSERT_LT(v.write_slot(), 3u);
+    EXPECT_NE(v.write_slot(), v.read_slot()) << "the writer never fills the slot the reader holds";
+    v.write_buffer() = i;
+    beside[v.write_slot()] = 10 * i;
+    v.publish();
+    if (i % 3 == 0) continue;  // now and then the reader misses a value
+    ASSERT_TRUE(v.update());
+    EXPECT_EQ(v.read_buffer(), i);
+    EXPECT_EQ(beside[v.read_slot()], 10 * v.read_buffer());
+  }
+}
+
 TEST(LatestValue, NoTornOrOlderValuesAcrossThreads) {
   uh::LatestValue<Stamped> v;
   constexpr std::uint64_t kWrites = 200'000;

@@ -4,6 +4,8 @@
 /// contact it gives way under (issue 26; docs/deformables.md, "What the hand feels"). Plain data,
 /// handed over in a LatestValue (simulation thread -> the tool's haptic thread).
 
+#include <cstdint>
+
 #include "uh/core/math.hpp"
 
 namespace uh::controllers {
@@ -17,6 +19,9 @@ struct ContactCompliance {
   /// How far the contact moves per newton more within the next step, along the force [m/N] (0:
   /// unknown, or no contact).
   double compliance_m_per_n = 0.0;
+  /// The simulation step that took the force and published the tree the contact is on (1, 2, ...;
+  /// 0: none yet).
+  std::uint64_t step = 0;
 };
 
 }  // namespace uh::controllers

@@ -7,8 +7,12 @@
 ///    tetrahedra and refits a copy of the tree (or rebuilds it when the refit has grown too
 ///    loose: SoftTreeOptions), which it publishes (LatestValue: the newest wins);
 ///  - the collision thread queries the newest published tree (CollisionObjectDef::deformed_trees)
-///    and posts the object's pairs of each tool's frame (post_contacts);
-///  - each tool's haptic thread posts the force its tool felt (post_tool_force).
+///    and posts the object's pairs of each tool's frame (post_contacts; a proxy's, weighed where
+///    the proxy moved to after its step: rest_proxy_at);
+///  - each tool's haptic thread posts the force its tool felt (post_tool_force);
+///  - each step's compliance at a proxy's contact goes beside the tree it publishes, and the
+///    collision thread hands the compliance of the tree it took to the tool's haptic thread once
+///    the proxy rests on that tree (rest_proxy_at, compliance).
 /// The haptic thread never waits on the simulation: it only writes into its own triple buffer.
 
 #include <Eigen/Core>
@@ -102,23 +106,40 @@ class SoftSimulation {
   /// Tool `tool` is a proxy (ToolProxy), which rests on the object's spheres within the margin
   /// rather than in them, so its pairs have no overlap volume: each pair is weighed by its nearness
   /// instead, exp(-(gap - smallest gap) / `smoothing_m`), the share of the proxy's soft-minimum row
-  /// (forcecomp: the soft minimum's gradient) that the pair takes. Setup only, before the threads.
+  /// (forcecomp: the soft minimum's gradient) that the pair takes, at the pose the proxy moved to
+  /// (rest_proxy_at). Setup only, before the threads (it sizes the tool's pair buffer).
   void rest_on_proxy(std::size_t tool, double smoothing_m);
 
   /// Collision thread: the pairs of `frame`'s that touch this object (object `object`, on side A
   /// of a pair as the session watches it) become tool `tool`'s newest contacts; a frame of another
   /// object's watcher is ignored. A tool-against-everything frame gives the object's share of the
   /// tool's contact (of its pairs' weights); a frame of this object alone gives it all of the
-  /// tool's force. Real-time safe.
+  /// tool's force. A proxy's pairs are kept until rest_proxy_at weighs them. Real-time safe.
   void post_contacts(std::size_t tool, std::int32_t object, const ContactFrame& frame);
   /// Controlling thread: the object now stands at `world_from_object` (HapticSession::set_object_pose);
   /// the next step turns the world's loads into the object's frame with it (the simulation, its
   /// tree and surface stay in the object's own frame). Real-time safe.
   void set_pose(const Pose& world_from_object) { rotation_in_.write(world_from_object.rotation); }
+  /// Collision thread, after proxy tool `tool` (rest_on_proxy) has stepped to `world_from_proxy`
+  /// on the tree the collision step took (trees()): the pairs of its last frame (post_contacts),
+  /// weighed by their nearness at that pose, become its newest contacts (nothing when no frame came
+  /// since the last call), and the compliance of the step that published that tree goes to the
+  /// tool's haptic thread (compliance()). The frame was queried where the proxy was before its
+  /// step, while the force the tool feels until the next step is the spring to where it is now:
+  /// weighed at the old pose, the object would take the force a collision step behind where the
+  /// tool presses it; and the newest step's compliance describes a surface the proxy does not rest
+  /// on yet (docs/deformables.md, "What the hand feels"). Real-time safe.
+  void rest_proxy_at(std::size_t tool, const Pose& world_from_proxy);
+  /// Collision thread, after its step: the compliance of the step that published the tree the
+  /// collision step took goes to tool `tool`'s haptic thread (compliance()), once per step, so
+  /// that the haptic thread feels the step whose surface its contact is on (a proxy's rest_proxy_at
+  /// does this; a penalty tool's model is built from that tree). Real-time safe.
+  void hand_over_compliance(std::size_t tool);
   /// Haptic thread of `tool`: the force [N, world] its tool felt this tick. Real-time safe.
   void post_tool_force(std::size_t tool, const Vec3& force_world);
-  /// What each step tells tool `tool`'s haptic thread (its only reader) of the contact: the force
-  /// the step took and the object's compliance there (ForceController::feel_compliance_of).
+  /// What a step tells tool `tool`'s haptic thread (its only reader) of the contact: the force the
+  /// step took and the object's compliance there (ForceController::feel_compliance_of), handed
+  /// over with the tree the tool's contact is on (hand_over_compliance).
   LatestValue<ContactCompliance>& compliance(std::size_t tool) { return *compliances_[tool]; }
 
   /// Vertices of the body's drawn surface (SoftBodyModel::surface).
@@ -184,8 +205,24 @@ class SoftSimulation {
   std::uint64_t& hierarchy_of(const collette::SphereTree& slot);
   double looseness(const collette::SphereTree& tree) const;
   bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
-  Status publish_compliances();
-  void weigh_by_nearness(double smoothing_m, std::int32_t object, const ContactFrame& frame, SoftContacts& out) const;
+  Status find_compliances();
+  // A pair of a proxy tool's frame, kept by post_contacts until rest_proxy_at weighs it.
+  struct ProxyPair {
+    Vec3 object_centre_world{};  // the object's sphere at the query's pose [m, world]
+    Vec3 tool_centre_local{};    // the tool's sphere [m, tool frame]
+    double radii = 0.0;          // the two spheres' radii [m]
+    std::int32_t leaf = -1;      // the object's leaf (this object's pairs)
+    bool this_object = false;    // false: another object's pair, which counts in the share only
+    double gap = 0.0;            // scratch of weigh_by_nearness [m]
+  };
+  struct ProxyPairs {
+    bool posted = false;          // a frame came since the last rest_proxy_at
+    std::vector<ProxyPair> pairs;  // capacity kProxyPairCapacity (rest_on_proxy), never grown
+  };
+  // a frame's pairs past this many are left out (a tool's pairs within the margin: tens to hundreds)
+  static constexpr std::size_t kProxyPairCapacity = SoftContacts::kCapacity;
+  void keep_proxy_pairs(std::int32_t object, const ContactFrame& frame, ProxyPairs& out) const;
+  void weigh_by_nearness(double smoothing_m, ProxyPairs& frame, const Pose& world_from_proxy, SoftContacts& out) const;
   void publish_surface(double dt_s);
   void record_step(double dt_s, std::span<const float> xyz);
 
@@ -220,9 +257,14 @@ class SoftSimulation {
   std::vector<std::unique_ptr<LatestValue<SoftContacts>>> contacts_;  // per tool: collision -> simulation
   std::vector<std::unique_ptr<LatestValue<Vec3>>> tool_forces_;       // per tool: haptic -> simulation
   std::vector<double> proxy_smoothing_m_;  // per tool: 0 weighs pairs by overlap, > 0 by nearness
-  std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: simulation -> haptic
+  std::vector<ProxyPairs> proxy_pairs_;    // per tool: collision thread, a proxy's last frame's pairs
+  // per slot of trees_ (its read_slot / write_slot), per tool: the compliance of the step that
+  // filled the slot, owned as the slot is (simulation thread, then the collision thread)
+  std::array<std::vector<ContactCompliance>, 3> tree_compliances_;
+  std::vector<std::uint64_t> compliance_step_sent_;  // per tool: collision thread, the last handed over
+  std::vector<std::unique_ptr<LatestValue<ContactCompliance>>> compliances_;  // per tool: collision -> haptic
   std::vector<Eigen::Vector3d> loads_;
-  std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of publish_compliances
+  std::vector<Eigen::Vector3d> unit_loads_, unit_moves_;  // scratch of find_compliances
   std::vector<Sphere> spheres_;
   Vec3 down_in_object_;  // the world's -z in the object's frame
   std::vector<SoftSample> record_;

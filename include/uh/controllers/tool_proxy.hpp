@@ -143,7 +143,8 @@ class ToolProxy {
   std::int32_t contact_rows(std::size_t k) const { return contact_rows_[k]; }
 
   ToolProxyStats stats() const;
-  /// The proxy's pose. Only while the collision thread does not run (before start, after stop).
+  /// The proxy's pose. On the collision thread (after on_step: where it moved to), or while the
+  /// collision thread does not run (before start, after stop).
   const Pose& pose() const { return proxy_; }
   const ToolProxyOptions& options() const { return options_; }
   /// The extent used to weigh rotation against translation [m].

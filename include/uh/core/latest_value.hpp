@@ -86,6 +86,13 @@ class LatestValue {
   /// True once update() has taken at least one published value. Reader thread.
   [[nodiscard]] bool has_value() const { return received_; }
 
+  /// Which of the three slots write_buffer() is (0, 1 or 2). Writer thread. With read_slot(), lets
+  /// the two sides keep data beside each slot (an array of three), owned as the slot is: the
+  /// writer's while it fills the slot, the reader's from the update() that takes it.
+  [[nodiscard]] std::size_t write_slot() const { return write_index_; }
+  /// Which of the three slots read_buffer() is. Reader thread.
+  [[nodiscard]] std::size_t read_slot() const { return read_index_; }
+
  private:
   // a slot per cache line (or more for large T) so that writer and reader never share a line
   struct alignas(64) Slot {
