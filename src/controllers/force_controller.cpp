@@ -326,7 +326,7 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   if (proxy_ != nullptr) {
     double data_s = now;
     std::int32_t holding = 0;
-    const forcecomp::Wrench spring = proxy_wrench(world_from_handle_tool, data_s, holding);
+    const forcecomp::Wrench spring = proxy_wrench(world_from_handle_tool, now, data_s, holding);
     finish_tick(spring, spring, now, data_s, holding, command);
     return;
   }
@@ -351,7 +351,7 @@ void ForceController::on_force(const haptico::DeviceState& state, haptico::Devic
   // a soft object gives under the force between its steps, as through the proxy (with_compliance),
   // the model's stiffness along the force in series with it
   if (model && !compliances_.empty() && sum.normal_stiffness > 0.0)
-    sum.contact.force = with_compliance(sum.contact.force, sum.normal_stiffness);
+    sum.contact.force = with_compliance(sum.contact.force, sum.normal_stiffness, now);
 
   forcecomp::Wrench to_device = sum.contact;
   if (options_.use_coupling) {
@@ -477,7 +477,7 @@ void ForceController::record_model_check(const TickSum& sum) {
   raise_max(model_error_max_n_, error);
 }
 
-forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s,
+forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_tool, double now, double& data_time_s,
                                                 std::int32_t& holding) {
   if (const ProxyState* s = proxy_->take()) {
     proxy_state_ = *s;
@@ -499,7 +499,7 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
                                                   : coupling_.stiffness();
   forcecomp::Wrench w;
   w.force = spring * (proxy.position - world_from_handle_tool.position);
-  if (proxy_state_.active > 0 && !compliances_.empty()) w.force = with_compliance(w.force, spring);
+  if (proxy_state_.active > 0 && !compliances_.empty()) w.force = with_compliance(w.force, spring, now);
   // the torque spring that goes with it, in the solver's metric (K R^2 unless the scene sets one),
   // so that one contact's torque is its r x F; within the rotational passivity bound
   if (component_.options().mode == forcecomp::ForceMode::k6Dof && renders_torque_)
@@ -510,21 +510,27 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
 
 // The proxy rests on soft objects where their last steps left them under the forces they took
 // (F_i, each with its share s_i and its compliance C_i at the contact): pressed with F, each gives
-// C_i (s_i F - F_i) more by its next step. The spring k to the proxy moved so gives
-// F = k e - k sum C_i (s_i F - F_i), that is F = (k e + k sum C_i F_i) / (1 + k sum C_i s_i): between
-// the steps the hand feels the spring in series with the object, k / (1 + k C), and at a step, the
-// object having moved as foreseen, the force does not jump (docs/deformables.md).
-Vec3 ForceController::with_compliance(const Vec3& spring_force, double spring) {
+// C_i (s_i F - F_i) more by its next step, and goes on moving as it moved, into the object at r_i
+// along its normal n_i, for the time tau_i since that step's state came (at most a step). The spring
+// k to the proxy moved so gives F = k (e - sum s_i r_i tau_i n_i) - k sum C_i (s_i F - F_i), that is
+// F = (k e - k sum s_i r_i tau_i n_i + k sum C_i F_i) / (1 + k sum C_i s_i): between the steps the
+// hand feels the spring in series with the object, k / (1 + k C), over a surface that keeps its
+// motion, and at a step, the object having moved as foreseen, the force does not jump
+// (docs/deformables.md).
+Vec3 ForceController::with_compliance(const Vec3& spring_force, double spring, double now) {
   double give = 0.0;
-  Vec3 taken{};
-  for (LatestValue<ContactCompliance>* source : compliances_) {
-    source->update();
+  Vec3 taken{}, receded{};
+  for (std::size_t i = 0; i < compliances_.size(); ++i) {
+    LatestValue<ContactCompliance>* source = compliances_[i];
+    if (source->update()) compliance_since_s_[i] = now;
     if (!source->has_value()) continue;
     const ContactCompliance& c = source->read_buffer();
     give += c.compliance_m_per_n * c.share;
     taken += c.compliance_m_per_n * c.force_world;
+    const double tau = std::clamp(now - compliance_since_s_[i], 0.0, c.period_s);
+    receded += (c.share * c.recede_m_per_s * tau) * c.normal_world;
   }
-  return (spring_force + spring * taken) / (1.0 + spring * give);
+  return (spring_force - spring * receded + spring * taken) / (1.0 + spring * give);
 }
 
 void ForceController::finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,

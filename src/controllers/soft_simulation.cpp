@@ -222,7 +222,7 @@ void SoftSimulation::gather_loads() {
 // loads, through the step's system (CorotationalFem::step_response); the load-weighted mean of the
 // moves along it. Known from the first step in contact, before any force is felt, so the first
 // touch is soft too. Kept beside the tree the step publishes (hand_over_compliance hands it over).
-Status SoftSimulation::find_compliances() {
+Status SoftSimulation::find_compliances(double dt_s) {
   std::vector<ContactCompliance>& beside_tree = tree_compliances_[trees_.write_slot()];
   for (std::size_t t = 0; t < compliances_.size(); ++t) {
     ContactCompliance& out = beside_tree[t];
@@ -233,11 +233,18 @@ Status SoftSimulation::find_compliances() {
       if (Status s = fem_.step_response(unit_loads_, unit_moves_); !s) return s;
       double compliance = 0.0;
       for (std::size_t n = 0; n < unit_loads_.size(); ++n) compliance += unit_loads_[n].dot(unit_moves_[n]);
+      // the unit loads push into the object with weights summing to 1: their work on the nodes'
+      // velocities is the contact's mean speed into the object
+      double recede = 0.0;
+      for (std::size_t n = 0; n < unit_loads_.size(); ++n) recede += unit_loads_[n].dot(fem_.velocities()[n]);
       const Vec3 felt = tool_forces_[t]->has_value() ? tool_forces_[t]->read_buffer() : Vec3{};
       out = {.force_world = felt * contacts.share,
              .share = contacts.share,
              // the haptic thread divides by 1 + k C: never negative, never a NaN
              .compliance_m_per_n = std::isfinite(compliance) ? std::max(compliance, 0.0) : 0.0,
+             .normal_world = contacts.normal_world,
+             .recede_m_per_s = std::isfinite(recede) ? recede : 0.0,
+             .period_s = dt_s,
              .step = steps_ + 1};
     }
   }
@@ -251,7 +258,7 @@ Status SoftSimulation::step(double dt_s) {
   }
   gather_loads();
   if (Status s = fem_.step(dt_s, loads_); !s) return s;
-  if (Status s = find_compliances(); !s) return s;
+  if (Status s = find_compliances(dt_s); !s) return s;
   soft::deform_spheres(*body_, fem_.positions(), spheres_);
   if (Status s = refit_or_rebuild(trees_.write_buffer()); !s) return s;
   trees_.publish();

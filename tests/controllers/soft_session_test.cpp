@@ -41,6 +41,11 @@ struct Press {
   double force_n = 0.0;        // the ball's force at the end [N]
   double indentation_m = 0.0;  // the largest downward displacement of a node of the block [m]
   double largest_step_n = 0.0; // the largest tick-to-tick change of the force [N]
+  // the largest change of the force's tick-to-tick change, over the force, in contact (|F| > 0.3 N):
+  // at a soft step the force rendered from the local model meets the one of the simulation's new
+  // state, so this is how far the model's 1 kHz force was from the next step's (the press's own
+  // steady motion cancels in the second difference)
+  double largest_bend = 0.0;
 };
 
 // The tick of a stepped run of `ticks` ticks on which its soft object (objects[0]) last stepped:
@@ -62,6 +67,10 @@ Press press(double depth_m, bool soft, Path path) {
   Press out;
   out.force_n = norm(forces.at(989));  // the run ends by sending zero: a tick before its end
   for (std::size_t k = 1; k < 990; ++k) out.largest_step_n = std::max(out.largest_step_n, norm(forces[k] - forces[k - 1]));
+  for (std::size_t k = 1; k + 1 < 990; ++k)
+    if (norm(forces[k]) > 0.3)
+      out.largest_bend =
+          std::max(out.largest_bend, norm(forces[k + 1] - 2.0 * forces[k] + forces[k - 1]) / norm(forces[k]));
   const SoftSimulation* sim = (*session)->soft_simulation(0);
   if (sim == nullptr) return out;
   const auto& rest = sim->body().mesh.nodes;
@@ -119,10 +128,17 @@ void expect_the_block_gives(Path path, const char* name) {
   // its steps: the force does not step at the simulation's rate (through the proxy 0.077 N without
   // it, 2.7 times the rigid block's largest; on the penalty path 0.100 N against 0.022 N)
   EXPECT_LT(deep.largest_step_n, 1.5 * rigid.largest_step_n);
+  // the 1 kHz force from the local model within a few per cent of the next step's (through the
+  // proxy 6.5 % and 9.5 % without the contact's own motion carried on between the steps: a 200 Hz
+  // sawtooth as the force rose between steps and fell at each)
+  EXPECT_LT(shallow.largest_bend, 0.03);
+  EXPECT_LT(deep.largest_bend, 0.03);
   std::printf("%s: shallow %.3f N %.3f mm, deep %.3f N %.3f mm, rigid %.3f N; largest tick-to-tick step %.3f N "
-              "soft, %.3f N rigid\n",
+              "soft, %.3f N rigid; the model's force at a step off by %.2f %% (shallow), %.2f %% (deep), %.2f %% "
+              "(rigid)\n",
               name, shallow.force_n, shallow.indentation_m * 1e3, deep.force_n, deep.indentation_m * 1e3, rigid.force_n,
-              deep.largest_step_n, rigid.largest_step_n);
+              deep.largest_step_n, rigid.largest_step_n, 100.0 * shallow.largest_bend, 100.0 * deep.largest_bend,
+              100.0 * rigid.largest_bend);
 }
 
 TEST(SoftSession, TheBlockGivesUnderTheBallAndTakesWhatTheBallFelt) { expect_the_block_gives(Path::kProxy, "proxy"); }
@@ -273,8 +289,10 @@ HandPress hand_press(double told_damping, double haptic_hz) {
 // twice; the proxy rests on a surface that moves (down under the ball, back up on release), the
 // block stores energy and gives it back. Over the closed presses no energy reaches the hand
 // through the handle, and the motors' gain is within the zero-order hold's (K T / 2 per squared
-// speed). Told ten times the device's damping, the clamp lets a spring 9x too stiff through and the
-// same presses put energy into the hand: the measure sees it.
+// speed). Told a hundred times the device's damping, the clamp lets a spring 90x too stiff through
+// and the same presses put energy into the hand: the measure sees it. (Told ten times, 9x too stiff,
+// they put +0.24 J in while the surface moved in steps; with its motion carried on between the
+// steps, the spring in series with the block's compliance and the hand's own damping, -1.4 mJ.)
 TEST(SoftSession, RepeatedPressesOnTheSoftBlockPutNoEnergyIntoAReactingHand) {
   constexpr double kHandDamping = 1.0;  // the sim-hand's, as soft_block_hand_press sets it
   // at 1 and 4 kHz; at 4 kHz (a coupling four times stiffer against a surface that moves at
@@ -296,9 +314,9 @@ TEST(SoftSession, RepeatedPressesOnTheSoftBlockPutNoEnergyIntoAReactingHand) {
     EXPECT_LT(largest_tree_distortion(r), kOrdinaryDistortion) << hz << " Hz";
     EXPECT_LE(r.work_on_hand_j, 0.9 * kHandDamping * r.contact_squared_speed_integral) << hz << " Hz";
   }
-  const HandPress too_stiff = hand_press(10.0 * kHandDamping, 1000.0);
+  const HandPress too_stiff = hand_press(100.0 * kHandDamping, 1000.0);
   const double too_stiff_into_hand = testing::energy_into_hand(too_stiff.report, kHandDamping);
-  std::printf("told 10x the damping: motors' work %+.3f mJ, into the hand %+.3f mJ\n",
+  std::printf("told 100x the damping: motors' work %+.3f mJ, into the hand %+.3f mJ\n",
               too_stiff.report.work_on_hand_j * 1e3, too_stiff_into_hand * 1e3);
   EXPECT_GT(too_stiff_into_hand, 0.0);
 }

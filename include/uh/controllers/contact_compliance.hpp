@@ -19,6 +19,12 @@ struct ContactCompliance {
   /// How far the contact moves per newton more within the next step, along the force [m/N] (0:
   /// unknown, or no contact).
   double compliance_m_per_n = 0.0;
+  /// The contact's normal [world, unit, out of the object] and how fast the contact moved into the
+  /// object over the step [m/s, along -normal]: the motion the next step carries on under the same
+  /// loads, which the haptic thread extrapolates for at most `period_s` [s] (one step).
+  Vec3 normal_world{};
+  double recede_m_per_s = 0.0;
+  double period_s = 0.0;
   /// The simulation step that took the force and published the tree the contact is on (1, 2, ...;
   /// 0: none yet).
   std::uint64_t step = 0;

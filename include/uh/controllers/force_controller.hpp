@@ -117,7 +117,10 @@ class ForceController {
   /// tool's haptic thread) tells how far, so that between the object's steps the spring to the
   /// proxy, or on the penalty path the local model's stiffness along its force, is felt in series
   /// with its compliance (with_compliance). Controlling thread, before bind().
-  void feel_compliance_of(LatestValue<ContactCompliance>* source) { compliances_.push_back(source); }
+  void feel_compliance_of(LatestValue<ContactCompliance>* source) {
+    compliances_.push_back(source);
+    compliance_since_s_.push_back(0.0);
+  }
   /// With a proxy: the proxy the last tick rendered against (slid towards the handle). Haptic thread.
   const Pose& rendered_proxy() const { return rendered_proxy_; }
   /// The coupling (null without one); the BridgingController reads its proxy pose.
@@ -194,8 +197,9 @@ class ForceController {
   void record_model_check(const TickSum& sum);
   // proxy mode: the spring between the handle and the proxy slid towards it; sets the data's time
   // and the constraints holding the proxy
-  forcecomp::Wrench proxy_wrench(const Pose& world_from_handle_tool, double& data_time_s, std::int32_t& holding);
-  Vec3 with_compliance(const Vec3& spring_force, double spring);
+  forcecomp::Wrench proxy_wrench(const Pose& world_from_handle_tool, double now, double& data_time_s,
+                                 std::int32_t& holding);
+  Vec3 with_compliance(const Vec3& spring_force, double spring, double now);
   static double stiffness_along(const forcecomp::WrenchModel& m, const Vec3& force);
   // the end of every tick: statistics, the safety stage, the device frame
   void finish_tick(const forcecomp::Wrench& contact, const forcecomp::Wrench& to_device, double now,
@@ -224,6 +228,7 @@ class ForceController {
   bool have_proxy_state_ = false;
   double contact_spring_n_m_ = 0.0;  // haptic thread: the last holding contact's ProxyContact::stiffness_n_m
   std::vector<LatestValue<ContactCompliance>*> compliances_;  // soft objects the proxy may rest on
+  std::vector<double> compliance_since_s_;  // per source: the tick time its newest value came [s]
 
   // haptic thread state
   double last_tick_s_ = 0.0;

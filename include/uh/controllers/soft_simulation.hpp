@@ -205,7 +205,7 @@ class SoftSimulation {
   std::uint64_t& hierarchy_of(const collette::SphereTree& slot);
   double looseness(const collette::SphereTree& tree) const;
   bool spread_tool_force(std::size_t tool, const Vec3& force_world, std::vector<Eigen::Vector3d>& loads) const;
-  Status find_compliances();
+  Status find_compliances(double dt_s);
   // A pair of a proxy tool's frame, kept by post_contacts until rest_proxy_at weighs it.
   struct ProxyPair {
     Vec3 object_centre_world{};  // the object's sphere at the query's pose [m, world]
