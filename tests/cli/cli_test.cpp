@@ -913,7 +913,7 @@ TEST_F(CliTest, ExploreReadsTheDomesFrictionAndGratingThroughTheProxy) {
 // The grating's period within 5 %: the hand seats and lets go within half a second whatever the
 // spring (at the press speed, 10.6 mm each way took 24 s and the 40 s budget ended before the
 // contour), and the contour's ripple is read along the normal (the force across the motion leans
-// with the soft spring: the wave share was 0.10-0.78 at seeds 1-4, now 0.73-0.89 beyond chance).
+// with the soft spring: the wave share was 0.10-0.78 at seeds 1-4, now 0.74-0.89 beyond chance).
 TEST_F(CliTest, ExploreReadsASoftDomesFrictionAndGratingThroughTheProxy) {
   MaterialsScene scene = materials_scene();
   nlohmann::json dome;
@@ -1072,7 +1072,7 @@ TEST_F(CliTest, ExploreReadsFrictionThroughTheProxyOnAPackedBlock) {
 }
 
 // Through the proxy (the default), which rests on the slab's mesh (scenes/materials_flat.json, packed
-// with 20,000 spheres): friction within 10 % and the grating's period within 5 %; before the proxy
+// with 20,000 spheres): friction within 10 %, the grating's period within 5 % and its whole relief; before the proxy
 // rested on the mesh in `uh explore`, its spheres' grain hid the grating (no period) and a tool
 // starting over a coarse packing began inside the mesh (0.42 N/mm for 1.25).
 TEST_F(CliTest, ExploreReadsFrictionAndAGratingThroughTheProxyOnAFlatPackedSlab) {
@@ -1086,6 +1086,13 @@ TEST_F(CliTest, ExploreReadsFrictionAndAGratingThroughTheProxyOnAFlatPackedSlab)
     const nlohmann::json e = json_of(r)["objects"][0];
     EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << object << ": passive";
     expect_grating_or_friction(scene, e, object);
+    if (object == "ridged") {
+      // the tool rides the whole relief: the device's spring times the grating's RMS height (0.088 N;
+      // 0.080 N measured; 0.037 N when the packing's rows, each raised at its own point, held it up)
+      const double amplitude = scene.material(object)["texture"]["amplitude"].get<double>();
+      const double spring = e["stiffness_n_per_mm"].get<double>() * 1e3;
+      EXPECT_GT(e["texture_ripple_n"].get<double>(), 0.75 * spring * amplitude / std::sqrt(2.0)) << e;
+    }
   }
 }
 
