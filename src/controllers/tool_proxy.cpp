@@ -169,8 +169,9 @@ void ToolProxy::add_section(const ContactFrame& frame, const ContactSection& sec
                                            static_cast<double>(p.normal_world[2])};
     const double rb = static_cast<double>(p.sphere_b_local.radius);
     double gap = distance - static_cast<double>(p.sphere_a_local.radius) - rb + options_.penetration_m;
-    if (textured) {
-      // the relief where the pair touches, on the object's sphere and on the tool's
+    if (textured && !contact.surface) {
+      // the relief where the pair touches, on the object's sphere and on the tool's (an object with
+      // a mesh surface has its relief at one point, on all its rows: texture_rows)
       const Vec3 on_object = a + static_cast<double>(p.sphere_a_local.radius) * n;
       gap -= forcecomp::texture_height(contact.object_texture, transform_point(object_from_world, on_object)) +
              forcecomp::texture_height(contact.tool_texture, transform_point(tool_from_world, b - rb * n));
@@ -255,7 +256,6 @@ void ToolProxy::add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& 
 // there. A centre found on the inner side of the nearest face (it began inside, or a saddle corner)
 // gets no row: the sphere pairs hold it. Textures then raise each object's rows (texture_contact).
 void ToolProxy::append_surface(const Pose& proxy) {
-  const std::int32_t first = constraint_count_;
   for (const SurfaceLeaf& near : near_surface_) {
     const WatchedObject& watched = watched_[static_cast<std::size_t>(near.tag)];
     const Vec3 p = transform_point(inverse(watched.world_from_object), near.centre);
@@ -271,13 +271,15 @@ void ToolProxy::append_surface(const Pose& proxy) {
     TextureContact& t = texture_contact_[static_cast<std::size_t>(near.tag)];
     if (gap < t.gap) t = {.gap = gap, .on_object = q.point, .on_tool = near.centre - near.radius * n};
   }
-  texture_rows({constraints_.data() + first, static_cast<std::size_t>(constraint_count_ - first)});
+  texture_rows({constraints_.data(), static_cast<std::size_t>(constraint_count_)});
 }
 
 // A texture is felt where the contact is, as the penalty path's surface stage feels it: each
 // object's rows are raised by its and the tool's texture heights at its nearest row's contact point
 // (one point per object, so a large tool rides the relief under its contact point rather than
-// bridging it). Clears the contact points for the next step.
+// bridging it). Its sphere pairs' rows too: raised each at its own point, the rows under a valley's
+// neighbours held the tool up and it rode half the relief (a 2 mm grating of 71 um RMS on the
+// packed slab: 30-38 um). Clears the contact points for the next step.
 void ToolProxy::texture_rows(std::span<forcecomp::ProxyConstraint> rows) {
   const Pose tool_from_world = inverse(queried_);
   for (std::size_t tag = 0; tag < watched_.size(); ++tag) {

@@ -15,6 +15,10 @@ constexpr double kFirstContactN = 1e-4;
 constexpr double kForceGain = 0.015;  // normal force loop: speed per newton of error [m / (N s)]
 constexpr double kNormalTauS = 0.02;  // low-pass of the normal estimate [s]
 constexpr double kHoldS = 0.3;        // rest between strokes [s]
+// the hand sits down to the stroke force, and lets go, within this time whatever the surface's
+// spring: at the press speed, faster on a surface so soft that the press speed would take longer
+// (through the proxy on a dome of k = 3e3 N/m^2, 0.19 N/mm: 10.6 mm to 2 N, 2.7 s each way at 4 mm/s)
+constexpr double kSeatS = 0.5;
 constexpr double kClearM = 0.002;     // lift this far past the last contact [m]
 constexpr double kApproachSpeed = 0.01;  // [m/s]
 constexpr double kMoveSpeed = 0.03;      // in the air between presses and strokes [m/s]
@@ -116,8 +120,9 @@ Vec3 ExplorerDevice::press(const Tick& k) {
   update_normal(k.f, {}, k.dt);
   leg_ = press_;
   const Vec3 v = -options_.press_speed_m_per_s * normal_;
-  if (dot(k.f, normal_) >= press_stop_n_ || k.in_phase > 5.0 ||
-      (options_.press_depth_m && dot(touch_ - position_, normal_) >= *options_.press_depth_m)) {
+  const double depth = dot(touch_ - position_, normal_), pressing = dot(k.f, normal_);
+  if (pressing >= press_stop_n_ || k.in_phase > 5.0 || (options_.press_depth_m && depth >= *options_.press_depth_m)) {
+    if (depth > 0.0 && pressing > kTouchN) felt_n_per_m_ = pressing / depth;
     leg_ = -1;
     begin(ExplorePhase::kRelease, k.t);
   }
@@ -125,7 +130,9 @@ Vec3 ExplorerDevice::press(const Tick& k) {
 }
 
 Vec3 ExplorerDevice::release(const Tick& k) {
-  const Vec3 v = options_.press_speed_m_per_s * normal_;
+  // a press's release is read (the damping's loop, at the press's speed); a stroke's is not
+  const bool after_press = after_approach_ == ExplorePhase::kPress;
+  const Vec3 v = (after_press ? options_.press_speed_m_per_s : seat_speed()) * normal_;
   if (k.touching < kFreeN) next_after_release(k.t);
   if (k.in_phase > 5.0) begin(ExplorePhase::kReturn, k.t);
   return v;
@@ -148,9 +155,16 @@ Vec3 ExplorerDevice::move(const Tick& k) {
   return v;
 }
 
+// at the press speed, or faster where the presses felt a spring so soft that reaching the stroke
+// force would take longer than kSeatS
+double ExplorerDevice::seat_speed() const {
+  const double to_stroke_force_m = felt_n_per_m_ > 0.0 ? options_.stroke_force_n / felt_n_per_m_ : 0.0;
+  return std::max(options_.press_speed_m_per_s, to_stroke_force_m / kSeatS);
+}
+
 Vec3 ExplorerDevice::seat(const Tick& k) {
   update_normal(k.f, {}, k.dt);
-  const Vec3 v = -options_.press_speed_m_per_s * normal_;
+  const Vec3 v = -seat_speed() * normal_;
   if (dot(k.f, normal_) >= options_.stroke_force_n) begin(ExplorePhase::kHold, k.t);
   if (k.in_phase > 5.0) begin(ExplorePhase::kReturn, k.t);
   return v;
@@ -219,7 +233,7 @@ Vec3 ExplorerDevice::contour(const Tick& k) {
 }
 
 Vec3 ExplorerDevice::lift(const Tick& k) {
-  const Vec3 v = 2.0 * options_.press_speed_m_per_s * normal_;
+  const Vec3 v = 2.0 * seat_speed() * normal_;
   if (k.touching > kFreeN) free_m_ = 0.0;
   if (k.in_phase > 5.0) begin(ExplorePhase::kReturn, k.t);
   if (free_m_ > kClearM) {

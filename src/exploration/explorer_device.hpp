@@ -61,10 +61,12 @@ class ExplorerDevice final : public haptico::SimulatedDevice {
   void update_normal(const Vec3& force, const Vec3& along, double dt);
   Vec3 slide(const Vec3& force, const Vec3& direction, double speed, double target, double dt, bool track_normal);
   void next_after_release(double t);
+  double seat_speed() const;
 
   ExploreOptions options_;
   ExplorePlan plan_;
   double press_stop_n_;  // a press stops at this normal force [N]
+  double felt_n_per_m_ = 0.0;  // the last press's force over its depth (0: none yet) [N/m]
   std::vector<ExploreSample> trace_;
   controllers::HapticSession* session_ = nullptr;
   Vec3 position_{};

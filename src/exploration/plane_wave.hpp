@@ -10,6 +10,7 @@ namespace uh::exploration {
 struct PlaneWaveFit {
   double share = 0.0;         ///< of the ripple's power (after the circle's slow variation) [0, 1]
   double f1 = 0.0, f2 = 0.0;  ///< the wave vector's spatial frequencies along e1, e2 [1/m]
+  double chance = 0.0;        ///< the share a wave of its period explains in other directions
 };
 
 // The candidates are the strokes' frequencies `f` with either relative sign (a stroke sees |k . e|

@@ -17,7 +17,8 @@
 namespace uh::exploration {
 namespace {
 
-// the share of the contour's ripple a grating's plane wave must explain to count as periodic
+// the share of the contour's ripple a grating's plane wave must explain, beyond what a wave of its
+// period explains in other directions, to count as periodic
 constexpr double kPlaneWaveShare = 0.45;
 constexpr double kResampleM = 2.5e-5;  // resampling step [m]: 40 samples per millimetre
 
@@ -156,8 +157,8 @@ void estimate_texture(const StrokeSlides& slides, const ExploreTrace& trace, Mat
     const double f_low = 2.5 / (0.82 * std::min(leg_length(o, 0), leg_length(o, 2)));
     const PlaneWaveFit fit = fit_plane_wave(slides.contour, trace.stroke_axes, axis_frequency, f_low,
                                             e.stiffness_n_per_mm.value_or(0.0) * 1e3, e.ripple_axis_n);
-    e.texture_wave_share = fit.share;
-    if (fit.share >= kPlaneWaveShare) e.texture_period_m = 1.0 / std::hypot(fit.f1, fit.f2);
+    e.texture_wave_share = fit.share - fit.chance;
+    if (e.texture_wave_share >= kPlaneWaveShare) e.texture_period_m = 1.0 / std::hypot(fit.f1, fit.f2);
   }
 }
 
