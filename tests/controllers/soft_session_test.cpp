@@ -92,7 +92,7 @@ Press press(double depth_m, bool soft, Path path) {
     soft::deform_surface(sim->body(), sim->fem().positions(), xyz);
     double deepest = 0.0;
     for (std::size_t v = 0; v < sim->body().surface.vertices.size(); ++v)
-      deepest = std::max(deepest, sim->body().surface.vertices[v].z() - double{xyz[3 * v + 2]});
+      deepest = std::max(deepest, sim->body().surface.vertices[v].z() - static_cast<double>(xyz[3 * v + 2]));
     EXPECT_NEAR(samples.back().indentation_m, deepest, 1e-9);
     const double distortion = largest_tree_distortion((*session)->report());
     std::printf("pressed %.1f mm: largest tree distortion %.5f, at the end %.5f\n", 1e3 * depth_m, distortion,

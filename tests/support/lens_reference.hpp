@@ -21,7 +21,7 @@ struct LensReference {
 inline LensReference lens_reference(double d_in, double r1_in, double r2_in) {
   using Long = long double;
   const Long pi = 3.14159265358979323846264338327950288L;
-  const Long d = d_in, r1 = r1_in, r2 = r2_in;
+  const Long d = static_cast<Long>(d_in), r1 = static_cast<Long>(r1_in), r2 = static_cast<Long>(r2_in);
   LensReference out;
   if (d >= r1 + r2) {
     out.centroid_offset = static_cast<double>(d * r1 / (r1 + r2));
