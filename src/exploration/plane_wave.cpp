@@ -1,12 +1,10 @@
 #include "plane_wave.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <numeric>
 #include <optional>
-#include <utility>
 #include <vector>
 
 #include "uh/core/least_squares.hpp"
