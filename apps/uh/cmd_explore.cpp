@@ -83,6 +83,7 @@ int explore(const ExploreArgs& args) {
             {e.period_axis_m[0] > 0.0 ? nlohmann::json(e.period_axis_m[0]) : nlohmann::json(nullptr),
              e.period_axis_m[1] > 0.0 ? nlohmann::json(e.period_axis_m[1]) : nlohmann::json(nullptr)}},
            {"texture_ripple_along_strokes_n", {e.ripple_axis_n[0], e.ripple_axis_n[1]}},
+           {"texture_sine_share_along_strokes", {e.sine_share_axis[0], e.sine_share_axis[1]}},
            {"texture_wave_share", e.texture_wave_share},
            {"work_on_hand_j", o.work_on_hand_j},
            {"simulated_s", o.simulated_s},

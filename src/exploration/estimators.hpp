@@ -16,8 +16,8 @@ void estimate_damping(const ExploreTrace& trace, MaterialEstimate& e);
 // friction_static, friction_dynamic: from the strokes and the contour
 void estimate_friction(const StrokeSlides& slides, const ExploreOptions& o, MaterialEstimate& e);
 
-// texture_ripple_n, ripple_axis_n, period_axis_m, texture_wave_share, texture_period_m: from the
-// strokes' and the contour's normal force ripple (reads e.stiffness_n_per_mm)
+// texture_ripple_n, ripple_axis_n, period_axis_m, sine_share_axis, texture_wave_share, texture_period_m: from
+// the strokes' and the contour's normal force ripple (reads e.stiffness_n_per_mm)
 void estimate_texture(const StrokeSlides& slides, const ExploreTrace& trace, MaterialEstimate& e);
 
 }  // namespace uh::exploration

@@ -1,11 +1,10 @@
 #include "plane_wave.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <numeric>
-#include <utility>
+#include <optional>
 #include <vector>
 
 #include "uh/core/least_squares.hpp"
@@ -13,8 +12,6 @@
 namespace uh::exploration {
 namespace {
 
-// an axis whose strokes ripple less than this share of the other's may see the texture's slow component only
-constexpr double kSlowAxisRipple = 0.6;
 constexpr std::size_t kSlowTerms = 6;  // the contour's slow part: a mean, two harmonics, a drift
 
 // The contour's ripple as the fit reads it: per sample past the seat's transient, the slow terms'
@@ -81,67 +78,92 @@ double wave_share(const ContourRipple& r, double slow_residual, double g1, doubl
   return full.coefficients.empty() ? 0.0 : 1.0 - full.residual / slow_residual;
 }
 
-// What a wave of the best's period explains by chance: the median share of that wave turned by 30
-// to 150 degrees (in steps of 15) in the stroke plane. A grating's wave explains its contour in its
-// own direction only; a random texture's slow components (periods of 4-7 mm for l = 1 mm) fit the
-// 5 mm circle's ripple in any direction, more so when the relief is rendered whole, as through the
-// proxy (a median of 0.10-0.21 there, 0.04-0.11 on the penalty path, whose passivity controller
-// cuts the texture force on alternate ticks)
+// A wave vector in the stroke plane: its spatial frequencies along e1, e2 [1/m]
+struct Wave {
+  double g1 = 0.0, g2 = 0.0;
+};
+
+Wave turned(const Wave& w, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * w.g1 - s * w.g2, s * w.g1 + c * w.g2};
+}
+
+// the angle between two waves' fronts [rad], in [0, pi / 2] (k and -k are one wave)
+double front_angle(const Wave& a, const Wave& b) {
+  return std::fabs(std::remainder(std::atan2(a.g2, a.g1) - std::atan2(b.g2, b.g1), kPi));
+}
+
+// a wave turned this little from the one found is the same wave to the contour: over a circle of
+// radius R two waves of frequency f turned by a correlate as J0(4 pi f R sin(a / 2)), past its first
+// zero at 30 degrees for periods up to 6.8 mm at R = 5 mm
+constexpr double kSameWaveRad = kPi / 6.0;
+
+// The candidates the strokes' frequencies `f` give (either relative sign; an axis's frequency alone
+// with the other component searched within (-f_low, f_low) in steps of `step`), all turned by `turn`
+// [rad] in the stroke plane, those that land within kSameWaveRad of `avoid` (when given) left out;
+// the best of them on the contour
 template <class ShareOf>
-double chance_share(const ShareOf& share_of, const PlaneWaveFit& best) {
-  const double magnitude = std::hypot(best.f1, best.f2), angle = std::atan2(best.f2, best.f1);
-  if (!(magnitude > 0.0)) return 0.0;
-  std::array<double, 9> turned{};
-  for (std::size_t k = 0; k < turned.size(); ++k) {
-    const double a = angle + kPi * static_cast<double>(k + 2) / 12.0;
-    turned[k] = share_of(magnitude * std::cos(a), magnitude * std::sin(a));
+PlaneWaveFit best_candidate(const ShareOf& share_of, const double (&f)[2], double f_low, double step,
+                            double turn, const Wave* avoid) {
+  PlaneWaveFit best;
+  const auto share_at = [&](const Wave& candidate) -> std::optional<double> {
+    const Wave w = turned(candidate, turn);
+    if (avoid != nullptr && front_angle(w, *avoid) < kSameWaveRad) return std::nullopt;
+    return share_of(w.g1, w.g2);
+  };
+  const auto consider = [&](const Wave& candidate) {
+    const std::optional<double> share = share_at(candidate);
+    if (share && *share > best.share) {
+      const Wave w = turned(candidate, turn);
+      best = {*share, w.g1, w.g2};
+    }
+  };
+  if (f[0] > 0.0 && f[1] > 0.0) {
+    consider({f[0], f[1]});
+    consider({f[0], -f[1]});
   }
-  std::nth_element(turned.begin(), turned.begin() + static_cast<std::ptrdiff_t>(turned.size() / 2), turned.end());
-  return turned[turned.size() / 2];
+  // an axis may see no period because its apparent period is too long for a stroke (the
+  // component lies within (-f_low, f_low)), and then show a slow leftover or a packing's grain
+  // instead: with each axis's frequency alone, the other component is searched within
+  // (-f_low, f_low), in steps that keep the phase error over the circle's radius under half a
+  // radian, then finer around the best
+  for (int axis = 0; axis < 2; ++axis) {
+    if (!(f[axis] > 0.0)) continue;
+    const auto at = [&](double g) { return axis == 0 ? Wave{f[0], g} : Wave{g, f[1]}; };
+    std::optional<double> coarse;
+    double found = 0.0;
+    for (double g = -f_low; g <= f_low; g += step) {
+      const std::optional<double> share = share_at(at(g));
+      if (share && (!coarse || *share > *coarse)) coarse = share, found = g;
+    }
+    if (!coarse) continue;
+    for (double g = found - step; g <= found + step; g += step / 8.0) consider(at(g));
+  }
+  return best;
 }
 
 }  // namespace
 
 PlaneWaveFit fit_plane_wave(const Slide& contour, const Vec3 (&axes)[2], const double (&f)[2], double f_low,
-                            double stiffness, const double (&ripple)[2]) {
+                            double stiffness) {
   PlaneWaveFit best;
   if (contour.position.size() < 32) return best;
   const ContourRipple r = contour_ripple(contour, axes, stiffness);
   const core::LeastSquaresFit base = core::least_squares(r.slow, kSlowTerms, r.y);
   if (base.coefficients.empty() || !(base.residual > 0.0)) return best;
   const auto share_of = [&](double g1, double g2) { return wave_share(r, base.residual, g1, g2); };
-  const auto consider = [&](double g1, double g2) {
-    const double share = share_of(g1, g2);
-    if (share > best.share) best = {share, g1, g2};
-  };
-  if (f[0] > 0.0 && f[1] > 0.0) {
-    consider(f[0], f[1]);
-    consider(f[0], -f[1]);
-  }
-  // an axis may see no period because its apparent period is too long for a stroke (the
-  // component lies within (-f_low, f_low)), and then show a packing's grain instead: with each
-  // axis's frequency trusted alone, the other component is searched within (-f_low, f_low), in
-  // steps that keep the phase error over the circle's radius under half a radian, then finer
-  // around the best (a search over all frequencies would fit a random texture's contour by
-  // chance: the best of a hundred candidates)
-  const double radius = r.circle / (2.0 * kPi);
-  const double step = 0.5 / (2.0 * kPi * radius);
-  for (int axis = 0; axis < 2; ++axis) {
-    if (!(f[axis] > 0.0) || !(ripple[1 - axis] <= kSlowAxisRipple * ripple[axis])) continue;
-    const auto at = [&](double g) { return axis == 0 ? std::pair{f[0], g} : std::pair{g, f[1]}; };
-    PlaneWaveFit coarse;
-    for (double g = -f_low; g <= f_low; g += step) {
-      const auto [g1, g2] = at(g);
-      const double share = share_of(g1, g2);
-      if (share > coarse.share) coarse = {share, g1, g2};
-    }
-    const double found = axis == 0 ? coarse.f2 : coarse.f1;
-    for (double g = found - step; g <= found + step; g += step / 8.0) {
-      const auto [g1, g2] = at(g);
-      consider(g1, g2);
-    }
-  }
-  best.chance = chance_share(share_of, best);
+  const double step = 0.5 / r.circle;  // a phase error of 0.5 rad over the circle's radius
+  best = best_candidate(share_of, f, f_low, step, 0.0, nullptr);
+  if (!(best.share > 0.0)) return best;
+  // chance: what the same search finds with its candidates turned by 30 to 150 degrees (in steps
+  // of 10), away from the wave found; its best over the turns. A random texture's candidate is one
+  // draw among these (its slow waves fit the 5 mm circle in any direction, more so when the relief
+  // is rendered whole, as through the proxy); a grating's wave explains its contour in its own
+  // direction only. The same search, so that the searched component's choice is paid for too.
+  const Wave found{best.f1, best.f2};
+  for (int degrees = 30; degrees <= 150; degrees += 10)
+    best.chance =
+        std::max(best.chance, best_candidate(share_of, f, f_low, step, kPi * degrees / 180.0, &found).share);
   return best;
 }
 

@@ -10,24 +10,20 @@ namespace uh::exploration {
 struct PlaneWaveFit {
   double share = 0.0;         ///< of the ripple's power (after the circle's slow variation) [0, 1]
   double f1 = 0.0, f2 = 0.0;  ///< the wave vector's spatial frequencies along e1, e2 [1/m]
-  double chance = 0.0;        ///< the share a wave of its period explains in other directions
+  /// the best share the same search finds with its candidates turned to other directions (chance)
+  double chance = 0.0;
 };
 
-// The candidates are the strokes' frequencies `f` with either relative sign (a stroke sees |k . e|
-// only); an axis without a peak (its apparent period too long for a stroke) has its component
-// searched below the strokes' lowest frequency `f_low`
+// The candidates are the strokes' frequencies `f` (0: the axis saw no wave) with either relative
+// sign (a stroke sees |k . e| only), and each axis's alone with the other component searched below
+// the strokes' lowest frequency `f_low` (its apparent period too long for a stroke).
 //
 // The hand holds its force with a loop that follows slow bumps, so part of a texture shows in the
 // hand's height rather than in the force: the ripple fitted is the force plus the contact's
 // stiffness `stiffness` [N/m] times the hand's height along the normal (what the force would have
 // been had the hand not moved), averaged over a quarter millimetre (the passivity controller's
 // tick-to-tick cuts are no texture).
-//
-// The search trusts an axis only when the other axis's strokes ripple clearly less (`ripple`, the
-// strokes' RMS ripple per axis: a slow component is mostly taken out with the strokes' drift; a
-// random texture ripples alike along both axes, and searching its contour would find some wave
-// that fits by chance).
 PlaneWaveFit fit_plane_wave(const Slide& contour, const Vec3 (&axes)[2], const double (&f)[2], double f_low,
-                            double stiffness, const double (&ripple)[2]);
+                            double stiffness);
 
 }  // namespace uh::exploration

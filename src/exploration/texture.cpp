@@ -1,10 +1,13 @@
 // Texture: the spectrum of the normal force ripple along each stroke axis (both strokes of the
 // axis), after the breakaway (past 15 % of the stroke); the dominant spatial frequencies of the two
 // axes are the components of the texture's wave vector in the stroke plane, so period = 1 / |(f_1,
-// f_2)|, reported only where one plane wave also explains the contour's ripple (plane_wave.hpp).
+// f_2)|, reported only where an axis's strokes see one sinusoid and one plane wave also explains
+// the contour's ripple (plane_wave.hpp).
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -17,9 +20,12 @@
 namespace uh::exploration {
 namespace {
 
-// the share of the contour's ripple a grating's plane wave must explain, beyond what a wave of its
-// period explains in other directions, to count as periodic
-constexpr double kPlaneWaveShare = 0.45;
+// the share of the contour's ripple a grating's plane wave must explain beyond the best the same
+// search finds in other directions (chance), to count as periodic
+constexpr double kPlaneWaveShare = 0.25;
+// an axis sees a wave when one sinusoid at its peak explains more than this share of its strokes'
+// ripple: a grating's ripple along a line is one sinusoid, a random texture's a sum of several
+constexpr double kOneWaveShare = 0.5;
 constexpr double kResampleM = 2.5e-5;  // resampling step [m]: 40 samples per millimetre
 
 // Power of the detrended, Hann-windowed signal y(s) (uniformly resampled) at spatial frequency f [1/m]
@@ -83,8 +89,9 @@ std::vector<double> ripple_of(const Slide& s, double from_m, double to_m, double
   return out;
 }
 
-// Both strokes of one axis: the summed spectrum of their ripples and the ripple's sum of squares
+// Both strokes of one axis: their ripples, the summed spectrum and the ripple's sum of squares
 struct AxisRipple {
+  std::vector<std::vector<double>> ripples;
   Spectrum spectrum;
   double span = 0.0;  // the window's length [m]
   double sum_sq = 0.0;
@@ -104,8 +111,37 @@ AxisRipple axis_ripple(const StrokeSlides& slides, const ExploreOptions& o, int 
     for (double v : r) a.sum_sq += v * v;
     a.count += r.size();
     add_spectrum(r, kResampleM, a.spectrum);
+    a.ripples.push_back(r);
   }
   return a;
+}
+
+// The share of the strokes' ripple (averaged over a quarter millimetre: the passivity controller's
+// tick-to-tick cuts are no texture) that one sinusoid of frequency `f` [1/m] explains, its phase
+// fitted stroke by stroke
+double sine_share(const AxisRipple& a, double f) {
+  constexpr std::size_t kHalfWidth = 5;  // samples: 0.25 mm in all
+  double explained = 0.0, total = 0.0;
+  for (const std::vector<double>& r : a.ripples) {
+    std::vector<double> smooth(r.size()), rows;
+    rows.reserve(2 * r.size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const std::size_t from = i >= kHalfWidth ? i - kHalfWidth : 0,
+                        to = std::min(r.size() - 1, i + kHalfWidth);
+      smooth[i] = std::accumulate(r.begin() + static_cast<std::ptrdiff_t>(from),
+                                  r.begin() + static_cast<std::ptrdiff_t>(to) + 1, 0.0) /
+                  static_cast<double>(to - from + 1);
+      const double phase = 2.0 * kPi * f * kResampleM * static_cast<double>(i);
+      rows.insert(rows.end(), {std::cos(phase), std::sin(phase)});
+    }
+    const core::LeastSquaresFit sine = core::least_squares(rows, 2, smooth);
+    if (sine.coefficients.empty()) continue;
+    double sum_sq = 0.0;
+    for (double v : smooth) sum_sq += v * v;
+    explained += sum_sq - sine.residual;
+    total += sum_sq;
+  }
+  return total > 0.0 ? explained / total : 0.0;
 }
 
 // The strongest local maximum with at least 2.5 periods in the window (slower variation left over
@@ -146,17 +182,19 @@ void estimate_texture(const StrokeSlides& slides, const ExploreTrace& trace, Mat
     if (std::sqrt(a.sum_sq / static_cast<double>(a.count)) < 0.005 * o.stroke_force_n) continue;
     if (const auto f = spectral_peak(a.spectrum, a.span)) {
       e.period_axis_m[axis] = 1.0 / *f;
-      axis_frequency[axis] = *f;
+      e.sine_share_axis[axis] = sine_share(a, *f);
+      if (e.sine_share_axis[axis] > kOneWaveShare) axis_frequency[axis] = *f;
     }
   }
   if (count > 0) e.texture_ripple_n = std::sqrt(sum_sq / static_cast<double>(count));
   if (axis_frequency[0] > 0.0 || axis_frequency[1] > 0.0) {
     // a grating is one plane wave over the whole surface: the wave vector the strokes found must
-    // also explain the ripple along the contour, a third path; a random texture (or a packing's
-    // grain) has its strongest component differ from path to path, and then has no period
+    // also explain the ripple along the contour, a third path, better than the same search does
+    // in any other direction; a random texture (or a packing's grain) has its strongest component
+    // differ from path to path, and then has no period
     const double f_low = 2.5 / (0.82 * std::min(leg_length(o, 0), leg_length(o, 2)));
     const PlaneWaveFit fit = fit_plane_wave(slides.contour, trace.stroke_axes, axis_frequency, f_low,
-                                            e.stiffness_n_per_mm.value_or(0.0) * 1e3, e.ripple_axis_n);
+                                            e.stiffness_n_per_mm.value_or(0.0) * 1e3);
     e.texture_wave_share = fit.share - fit.chance;
     if (e.texture_wave_share >= kPlaneWaveShare) e.texture_period_m = 1.0 / std::hypot(fit.f1, fit.f2);
   }

@@ -940,15 +940,15 @@ TEST_F(CliTest, ExploreReadsASoftDomesFrictionAndGratingThroughTheProxy) {
 }
 
 // A random texture (l = 1 mm) read through the proxy has no period, as on the penalty path: the
-// relief rendered whole lets its slow waves fit the contour in any direction (a median share of 0.2
-// at seed 2), and the best of the strokes' candidates explained 0.62 (3.77 mm on the 1 m ball, 6.27
-// mm on the flat slab) until the share a wave of that period explains in other directions was taken
-// from it.
+// relief rendered whole lets its slow waves fit the contour in any direction, and the best of the
+// strokes' candidates explained 0.62 of it at seed 2 (3.77 mm on the 1 m ball, 6.27 mm on the flat
+// slab). Its decision measure, the wave share beyond the best the same search finds turned to
+// other directions, stays 0.1 or more under the 0.25 a period needs (measured at most 0.11 at seeds
+// 1-8; with the median of single turned waves as the chance it reached 0.40-0.41 at seed 2).
 TEST_F(CliTest, ExploreReadsNoPeriodInARandomTextureThroughTheProxy) {
   const fs::path flat = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_flat.json";
-  for (const auto& [path, seeds] : {std::pair{materials_scene_path(), std::vector{1, 2, 3, 4}},
-                                    std::pair{flat, std::vector{1, 2}}}) {
-    for (const int seed : seeds) {
+  for (const fs::path& path : {materials_scene_path(), flat}) {
+    for (const int seed : {1, 2, 3, 4}) {
       const CommandRun r = uh(fmt::format("explore '{}' --object rough --seed {} --json", path.string(), seed),
                               fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
       ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -956,7 +956,42 @@ TEST_F(CliTest, ExploreReadsNoPeriodInARandomTextureThroughTheProxy) {
       ASSERT_TRUE(e["rendered_stiffness_limit_n_per_mm"].is_number()) << "explored through the proxy";
       EXPECT_GT(e["texture_ripple_n"].get<double>(), 0.01) << path << " seed " << seed << ": it ripples";
       EXPECT_TRUE(e["texture_period_m"].is_null()) << path << " seed " << seed << ": " << e;
+      EXPECT_LT(e["texture_wave_share"].get<double>(), 0.15) << path << " seed " << seed << ": the margin";
     }
+  }
+}
+
+// The flat slab's 2 mm grating at the softest stiffness the docs explore (k = 3e3: the device's
+// spring 0.19 N/mm, the grating's ripple 0.013 N), through the proxy: its period within 5 % at every
+// seed with a wave share 0.1 or more above the 0.25 needed (measured 0.63-0.83 at seeds 1-8). At
+// seed 2 one axis runs nearly along the ridges and its strokes ripple 0.78 as much as the other's
+// (0.010 N: the grating's slow component the cubic leaves); the axis's component was searched on the
+// contour only under 0.6, and the pair of peaks (2.03 and 4.59 mm) gave 1.86 mm: no period. Each
+// axis whose strokes' ripple is mostly one sinusoid now has its other component searched.
+TEST_F(CliTest, ExploreReadsASoftFlatSlabsGratingAtEverySeedThroughTheProxy) {
+  const fs::path flat = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes" / "materials_flat.json";
+  std::ifstream in(flat);
+  MaterialsScene scene{nlohmann::json::parse(in)};
+  nlohmann::json ridged;
+  for (const auto& o : scene.scene["objects"])
+    if (o["name"] == "ridged") ridged = o;
+  ridged["mesh"] = (flat.parent_path() / ridged["mesh"].get<std::string>()).string();
+  ridged["material"]["stiffness"] = 3000.0;
+  scene.scene["objects"] = nlohmann::json::array({ridged});
+  const std::string tool_mesh = scene.scene["tool"]["mesh"].get<std::string>();
+  scene.scene["tool"]["mesh"] = (flat.parent_path() / tool_mesh).string();
+  const fs::path path = dir_ / "soft_slab.json";
+  std::ofstream(path) << scene.scene.dump(1);
+  const double period = ridged["material"]["texture"]["period"].get<double>();
+  for (const int seed : {1, 2, 3, 4, 5, 6}) {
+    const CommandRun r = uh(fmt::format("explore '{}' --seed {} --json", path.string(), seed),
+                            fmt::format("UH_CACHE_DIR='{}' ", (dir_ / "cache").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json e = json_of(r)["objects"][0];
+    ASSERT_TRUE(e["texture_period_m"].is_number()) << "seed " << seed << ": " << e;
+    EXPECT_NEAR(e["texture_period_m"].get<double>(), period, 0.05 * period) << "seed " << seed;
+    EXPECT_GT(e["texture_wave_share"].get<double>(), 0.35) << "seed " << seed << ": the margin";
+    EXPECT_LT(e["work_on_hand_j"].get<double>(), 1e-3) << "seed " << seed << ": passive";
   }
 }
 

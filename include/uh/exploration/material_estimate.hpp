@@ -34,10 +34,13 @@ struct MaterialEstimate {
   std::optional<double> texture_period_m;    ///< dominant spatial period of the normal force ripple
   double texture_ripple_n = 0.0;             ///< RMS of the normal force ripple while sliding [N]
   double period_axis_m[2] = {0.0, 0.0};      ///< dominant apparent period along each stroke axis, 0 = none
-  /// The share of the contour's ripple explained by the plane wave the strokes found, less the share
-  /// a wave of its period explains turned to other directions (chance; a grating explains much of
-  /// it in its own direction only; a random texture or a packing's grain little): texture_period_m
-  /// is reported only above 0.45.
+  /// Per axis, the share of its strokes' ripple one sinusoid at its peak explains (0 = no peak): a
+  /// grating's ripple along a line is one sinusoid; an axis counts as seeing a wave above 0.5.
+  double sine_share_axis[2] = {0.0, 0.0};
+  /// The share of the contour's ripple explained by the plane wave the strokes found, less the best
+  /// share the same search finds with its candidates turned to other directions (chance: a grating
+  /// explains much of it in its own direction only, a random texture or a packing's grain as much
+  /// in others): texture_period_m is reported only from 0.25.
   double texture_wave_share = 0.0;
   double ripple_axis_n[2] = {0.0, 0.0};  ///< RMS ripple of the strokes along each axis [N]
 };
