@@ -490,7 +490,9 @@ forcecomp::Wrench ForceController::proxy_wrench(const Pose& world_from_handle_to
   }
   data_time_s = proxy_state_.time_s;
   holding = proxy_state_.active;
-  const Pose proxy = proxy_->slide(proxy_state_, world_from_handle_tool);
+  const Pose slid = proxy_->slide(proxy_state_, world_from_handle_tool);
+  const Pose proxy =
+      proxy_state_.follows_handle ? slid : proxy_->towards(rendered_proxy_, slid, proxy_state_.reach_m);
   rendered_proxy_ = proxy;
   // the spring of the contact holding it (kept after release, so the spring does not stiffen
   // while the proxy catches up with the handle), never stiffer than the passivity-clamped coupling

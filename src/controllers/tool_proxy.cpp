@@ -470,6 +470,15 @@ Pose ToolProxy::slide(const ProxyState& state, const Pose& world_from_handle_too
   return out;
 }
 
+Pose ToolProxy::towards(const Pose& from, const Pose& to, double reach_m) const {
+  Vec3 t, w;
+  const double limit = reach_m / std::sqrt(2.0);
+  // within reach: `to` itself (rebuilt from the step, its turn would be off by rounding, and a torque
+  // sent where none is)
+  if (wanted_step(from, to, limit, t, w) <= limit) return to;
+  return {.rotation = normalized(quat_from_rotation_vector(w) * from.rotation), .position = from.position + t};
+}
+
 void ToolProxy::on_step(double time_s) {
   const bool fresh = target_.update();
   if (!fresh && !placed_) return;
@@ -479,12 +488,14 @@ void ToolProxy::on_step(double time_s) {
   ProxyState& out = state_.write_buffer();
   out.active = 0;
   out.reach_m = options_.step_m;
+  out.follows_handle = false;
   // the tool appears where the handle is, as without a proxy; if that is inside an object it has no
   // side to keep, so it follows the handle freely (zero force) until it is out of every object
   const bool inside = inside_;
   inside_ = false;
   if (!placed_ || (!seated_ && inside)) {
     proxy_ = target;
+    out.follows_handle = true;
     if (placed_) free_updates_.fetch_add(1, std::memory_order_relaxed);
     placed_ = true;
   } else {

@@ -625,5 +625,60 @@ TEST(ToolProxy, AMaterialFeelsAsStiffThroughTheProxyAsThroughThePenaltyPath) {
   std::filesystem::remove_all(cache);
 }
 
+// The default scene's bunny and stylus through the proxy, run stepped at 1 kHz with the raster's
+// device swapped for `line` when it is given (start, end, seconds each way) and a hard material, so
+// that the spring rendered is the coupling's clamp, 1.5 kN/m; returns the session's report.
+SessionReport run_bunny_sweep(const std::filesystem::path& cache, double seconds, const Vec3* line = nullptr,
+                              double line_s = 0.0) {
+  auto scene = load_scene(testing::test_assets().parent_path() / "scenes" / "bunny_sweep.json");
+  EXPECT_TRUE(scene) << scene.error().message;
+  if (!scene) return {};
+  scene->tool().force.stiffness = 1e6;
+  if (line != nullptr) {
+    scene->tool().device.driver = "sim-line";
+    scene->tool().device.config = {};
+    scene->tool().device.config.set("start", line[0]).set("end", line[1]).set("duration_s", line_s);
+    scene->tool().device.config.set("dof_actuated", 6.0).set("max_force_n", 8.0);
+  }
+  SessionOptions options;
+  options.cache_dir = cache;
+  options.proxy = true;
+  auto session = HapticSession::create(*scene, options);
+  EXPECT_TRUE(session) << session.error().message;
+  if (!session) return {};
+  EXPECT_TRUE((*session)->run_stepped(seconds, 1).has_value());
+  return (*session)->report();
+}
+
+// Force continuity through the proxy as the device gets it (the contact force before the limit
+// chain), K the spring rendered, v the handle's speed (5 cm/s), T the haptic period (1 ms).
+// Pressed 5 mm straight down onto the bunny's back and pulled out (landing, release), the force
+// changes by at most 2 K v T a tick. Dragged by the default raster through the bunny's head, the
+// stylus is held on an ear while the handle goes on up to 4 cm, and slips off the ear's end with the
+// spring stretched 14 mm: the force then falls as fast as the proxy may move towards the handle, a
+// slide's reach a tick (step_m / sqrt 2, in the solver's metric), and no faster: K (reach + v T).
+// Before the rendered proxy's move was capped (ToolProxy::towards) it fell by half as much again
+// in the tick that freed the proxy: the step's move and a whole free slide on top of the last
+// tick's slide, which a row held (2.5 N for a bound of 2.2 N; 0.83 N on the scene's own material).
+TEST(ToolProxy, TheForceStepsByKvTAtLandingAndReleaseAndNoFasterThanTheProxyMovesOffAnEdge) {
+  const std::filesystem::path cache = testing::fresh_cache("proxy_continuity");
+  const double spring = forcecomp::VirtualCoupling().stiffness(), speed = 0.05, period = 1e-3;
+  const double kvt = spring * speed * period;
+  const Vec3 press[2] = {{0.01, 0.0, 0.08}, {0.01, 0.0, 0.058}};  // the back's top is at 6.3 cm
+  const SessionReport pressed = run_bunny_sweep(cache, 1.76, press, norm(press[1] - press[0]) / speed);
+  std::printf("landing and release: largest step %.4f N (K v T %.4f N), largest force %.3f N\n",
+              pressed.force_max_raw_step_n, kvt, pressed.force_max_n);
+  EXPECT_GT(pressed.force_max_n, 3.0);  // pressed (about 3 mm under the proxy at 1.5 N/mm)
+  EXPECT_LE(pressed.force_max_raw_step_n, 2.0 * kvt);
+
+  const SessionReport swept = run_bunny_sweep(cache, 8.1);
+  const double reach = ToolProxyOptions{}.step_m / std::sqrt(2.0);
+  std::printf("slipping off the ear: largest step %.3f N (K (reach + v T) %.3f N)\n", swept.force_max_raw_step_n,
+              spring * (reach + speed * period));
+  EXPECT_GT(swept.force_max_raw_step_n, 10.0 * kvt);  // it slipped off
+  EXPECT_LE(swept.force_max_raw_step_n, spring * (reach + speed * period));
+  std::filesystem::remove_all(cache);
+}
+
 }  // namespace
 }  // namespace uh::controllers

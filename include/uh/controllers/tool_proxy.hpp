@@ -80,6 +80,8 @@ struct ProxyState {
   std::int32_t active = 0;
   forcecomp::ProxyConstraint holding[6] = {};
   double reach_m = 0.0;          ///< how far a point may move from the proxy before the next step [m]
+  /// Placed at the handle, which began inside an object: no side to keep, and no force.
+  bool follows_handle = false;
   /// Coulomb friction of the contact holding it (the object's and the tool's materials combined):
   /// the proxy keeps its place along the surface until the handle pulls it sideways by more than
   /// friction_static times how deep it presses, then trails it at friction_dynamic.
@@ -134,6 +136,13 @@ class ToolProxy {
   /// its reach: what the device renders against between collision steps, so that the force
   /// follows the handle at the haptic rate (zero in free space). Haptic thread; real-time safe.
   Pose slide(const ProxyState& state, const Pose& world_from_handle_tool);
+  /// `to`, or the pose one slide's reach (`reach_m`, ProxyState::reach_m) from `from` towards it:
+  /// the rendered proxy, `from` the one rendered last tick, moves no farther a tick than a slide
+  /// may move it (unless it follows the handle freely). At the step that frees the proxy (it slips
+  /// off an edge with the spring stretched), the step's own move and a whole free slide otherwise
+  /// add up on top of the last tick's slide, which a row held: the force fell by half as much
+  /// again in that tick. Real-time safe.
+  Pose towards(const Pose& from, const Pose& to, double reach_m) const;
 
   /// The objects watched, in watch() order, and how many of the last step's constraint rows with
   /// each are in contact at the proxy's new pose (0: apart). Collision thread, after on_step (an
