@@ -1391,5 +1391,38 @@ TEST_F(CliTest, RunOnOpenHapticsNamedOnTheCommandLine) {
       << named.err;
 }
 
+// Every scene in scenes/ (whatever is added later), two simulated seconds each: it runs, touches
+// something, sends only finite forces within its device's limit, and renders on the path it asks
+// for: the proxy by default (every step solved, the tool never sunk into a surface, no net energy
+// into the hand), the penalty path where it enables the virtual coupling.
+TEST_F(CliTest, EveryShippedSceneRunsWithinItsLimitsOnItsPath) {
+  const fs::path scenes = fs::path(UH_TEST_DATA_DIR).parent_path() / "scenes";
+  std::set<fs::path> files;
+  for (const auto& e : fs::directory_iterator(scenes))
+    if (e.path().extension() == ".json") files.insert(e.path());
+  ASSERT_GE(files.size(), 10u) << scenes;
+  const std::string cache = fmt::format("UH_CACHE_DIR='{}' ", UH_TEST_CACHE_DIR);
+  for (const fs::path& file : files) {
+    SCOPED_TRACE(file.filename().string());
+    std::ifstream in(file);
+    const nlohmann::json scene = nlohmann::json::parse(in);
+    const bool coupling = scene.value(nlohmann::json::json_pointer("/force/coupling/enabled"), false);
+    const bool proxy = !coupling && scene.value(nlohmann::json::json_pointer("/force/proxy/enabled"), true);
+    const CommandRun r = uh(fmt::format("run '{}' --stepped --seconds 2 --json", file.string()), cache);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json out = json_of(r);
+    const nlohmann::json& force = out["force"];
+    EXPECT_GT(out["contact"]["ticks"].get<int>(), 0) << "every shipped scene is about touching something";
+    EXPECT_EQ(force["nonfinite"].get<int>(), 0);
+    EXPECT_LE(force["max_n"].get<double>(), out["device"]["max_force_n"].get<double>() + 1e-9);
+    ASSERT_EQ(force.value("proxy", nlohmann::json{}).is_object(), proxy) << "rendered on the path the scene asks for";
+    if (!proxy) continue;
+    EXPECT_GT(force["proxy"]["contact_updates"].get<int>(), 0);
+    EXPECT_EQ(force["proxy"]["unsolved"].get<int>(), 0);
+    EXPECT_LT(force["proxy"]["deepest_m"].get<double>(), 0.5e-3) << "the tool stays on the surface";
+    EXPECT_LE(out["energy"]["work_on_hand_j"].get<double>(), 1e-3) << "the proxy puts no net energy in";
+  }
+}
+
 }  // namespace
 }  // namespace uh
