@@ -18,6 +18,11 @@ Result<std::uint64_t> hash_file(const std::filesystem::path& path) {
   return ist_hash_bytes(std::as_bytes(std::span<const char>(*bytes)));
 }
 
+std::optional<TriangleMesh> ist_surface_of(const TriangleMesh& mesh) {
+  if (mesh.report.assumed_open) return std::nullopt;
+  return mesh;
+}
+
 SphereTree scale_sphere_tree(const SphereTree& tree, double factor) {
   const auto f = static_cast<float>(factor);
   const auto f3 = static_cast<float>(factor * factor * factor);
@@ -88,6 +93,7 @@ Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t s
                                   .mesh_volume = packing->report.mesh_volume,
                                   .max_gap = packing->report.max_gap,
                                   .build_seconds = std::chrono::duration<double>(end - start).count()};
+  result.asset.surface = ist_surface_of(mesh);
   return result;
 }
 

@@ -7,11 +7,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <tuple>
 
+#include "uh/collette/mesh_import.hpp"
 #include "uh/core/atomic_file_writer.hpp"
 #include "uh/core/regular_file.hpp"
 
@@ -21,6 +23,14 @@ namespace {
 constexpr std::array<unsigned char, 8> kMagic{'U', 'H', 'I', 'S', 'T', '\r', '\n', 0x1a};
 constexpr std::size_t kNodeBytes = 32;
 constexpr std::size_t kLeafBytes = 16;
+// surface section: u32 vertex count, u32 triangle count, the vertices (3 f64), the triangles
+// (3 i32), then the CRC-32 of all the section's bytes before it
+constexpr std::size_t kSurfaceCountBytes = 8, kSurfaceCrcBytes = 4, kVertexBytes = 24, kTriangleBytes = 12;
+// a closed surface has at least a tetrahedron's 4 vertices and 4 triangles
+constexpr std::uint64_t kMinSurfaceCount = 4;
+// the volume a stored surface encloses against IstMetadata::mesh_volume (the same mesh summed
+// again, maybe scaled)
+constexpr double kSurfaceVolumeTolerance = 1e-6;
 // header field offsets [bytes]
 constexpr std::size_t kOffVersion = 8, kOffHeaderSize = 12, kOffNodes = 16, kOffLeaves = 20, kOffDepth = 24,
                       kOffArity = 28, kOffMetersPerUnit = 32, kOffMeshHash = 40, kOffCoverage = 48,
@@ -158,8 +168,108 @@ Status check_leaves_disjoint(std::span<const Sphere> leaves, double tol) {
   return Ok{};
 }
 
+// The surface a packing's spheres lie in: closed, 2-manifold and outward as stored (the mesh
+// validator, with no welding and no repair, drops nothing and turns nothing), enclosing the
+// metadata's volume, with the leaves inside its bounding box.
+Status check_surface(const TriangleMesh& surface, const IstAsset& asset) {
+  TriangleMesh named = surface;
+  named.source_name = "invalid surface section";
+  auto valid = validate_mesh(std::move(named), {.weld_tolerance = 0.0, .repair = false});
+  if (!valid) return valid.error();
+  if (valid->report.winding_flipped)
+    return Error{"invalid surface section: it is wound inside out (a .ist holds its surface wound outward)"};
+  // with no welding and no repair the validator only merges bit-identical vertices and drops unused
+  // ones (and numbers the rest by first use, which is no fault)
+  if (valid->vertices.size() != surface.vertices.size())
+    return Error{"invalid surface section: it repeats a vertex or has one no triangle uses (" +
+                 std::to_string(surface.vertices.size()) + " stored, " + std::to_string(valid->vertices.size()) +
+                 " distinct and used)"};
+  const double volume = mesh_volume(surface);
+  if (!(std::abs(volume - asset.meta.mesh_volume) <= kSurfaceVolumeTolerance * asset.meta.mesh_volume))
+    return Error{"invalid surface section: it encloses " + approx(volume) + ", but mesh_volume is " +
+                 approx(asset.meta.mesh_volume)};
+  const Aabb box = mesh_bounds(surface);
+  const auto leaves = asset.tree.leaves();
+  const double tol = 1e-5 * static_cast<double>(asset.tree.root().radius);
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Sphere& s = leaves[i];
+    const Vec3 c{static_cast<double>(s.x), static_cast<double>(s.y), static_cast<double>(s.z)};
+    const Vec3 r{static_cast<double>(s.radius) - tol, static_cast<double>(s.radius) - tol,
+                 static_cast<double>(s.radius) - tol};
+    const Vec3 lo = c - r, hi = c + r;
+    if (lo.x < box.min.x || lo.y < box.min.y || lo.z < box.min.z || hi.x > box.max.x || hi.y > box.max.y ||
+        hi.z > box.max.z)
+      return Error{"invalid surface section: leaf sphere " + std::to_string(i) +
+                   " reaches outside the surface's bounding box (the spheres were packed inside it)"};
+  }
+  return Ok{};
+}
+
 Error meta_error(const char* field, double value, const std::string& expected) {
   return Error{std::string("invalid metadata: ") + field + " is " + num(value) + ", expected " + expected};
+}
+
+std::size_t surface_section_bytes(const TriangleMesh& surface) {
+  return kSurfaceCountBytes + surface.vertices.size() * kVertexBytes + surface.triangles.size() * kTriangleBytes +
+         kSurfaceCrcBytes;
+}
+
+// writes the surface section at `p` (surface_section_bytes(surface) bytes)
+void put_surface_section(std::byte* p, const TriangleMesh& surface) {
+  std::byte* const start = p;
+  put_u32(p, static_cast<std::uint32_t>(surface.vertices.size()));
+  put_u32(p + 4, static_cast<std::uint32_t>(surface.triangles.size()));
+  p += kSurfaceCountBytes;
+  for (const Vec3& v : surface.vertices) {
+    put_f64(p + 0, v.x);
+    put_f64(p + 8, v.y);
+    put_f64(p + 16, v.z);
+    p += kVertexBytes;
+  }
+  for (const auto& t : surface.triangles) {
+    for (int k = 0; k < 3; ++k) put_i32(p + 4 * k, t[static_cast<std::size_t>(k)]);
+    p += kTriangleBytes;
+  }
+  put_u32(p, ist_crc32({start, static_cast<std::size_t>(p - start)}));
+}
+
+// Reads the surface section `section` (the bytes after the leaves), checking its counts against
+// its size before allocating and its checksum; `size` is the whole file's, for messages.
+Result<TriangleMesh> get_surface_section(std::span<const std::byte> section, std::size_t size) {
+  const std::size_t before = size - section.size();
+  if (section.size() < kSurfaceCountBytes + kSurfaceCrcBytes)
+    return Error{"truncated: " + std::to_string(size) + " bytes, but the surface section's counts and checksum need " +
+                 std::to_string(before + kSurfaceCountBytes + kSurfaceCrcBytes)};
+  const std::byte* p = section.data();
+  const std::uint64_t vertices = get_u32(p), triangles = get_u32(p + 4);
+  if (triangles < kMinSurfaceCount || triangles > kIstMaxSurfaceTriangles || vertices < kMinSurfaceCount ||
+      vertices > triangles)
+    return Error{"corrupted: a surface section of " + std::to_string(vertices) + " vertices and " +
+                 std::to_string(triangles) + " triangles (a closed surface has 4 .. " +
+                 std::to_string(kIstMaxSurfaceTriangles) + " triangles and 4 .. as many vertices)"};
+  const std::uint64_t expected =
+      kSurfaceCountBytes + vertices * kVertexBytes + triangles * kTriangleBytes + kSurfaceCrcBytes;
+  if (section.size() < expected)
+    return Error{"truncated: " + std::to_string(size) + " bytes, the header and the surface section announce " +
+                 std::to_string(before + expected)};
+  if (section.size() > expected)
+    return Error{"corrupted: " + std::to_string(section.size() - expected) +
+                 " unexpected bytes after the surface section"};
+  const std::size_t checked = section.size() - kSurfaceCrcBytes;
+  if (get_u32(p + checked) != ist_crc32({p, checked})) return Error{"corrupted: surface section checksum mismatch"};
+  TriangleMesh surface;
+  surface.vertices.resize(static_cast<std::size_t>(vertices));
+  surface.triangles.resize(static_cast<std::size_t>(triangles));
+  p += kSurfaceCountBytes;
+  for (Vec3& v : surface.vertices) {
+    v = {get_f64(p + 0), get_f64(p + 8), get_f64(p + 16)};
+    p += kVertexBytes;
+  }
+  for (auto& t : surface.triangles) {
+    t = {get_i32(p + 0), get_i32(p + 4), get_i32(p + 8)};
+    p += kTriangleBytes;
+  }
+  return surface;
 }
 
 }  // namespace
@@ -214,18 +324,22 @@ Status validate(const IstAsset& asset) {
                    approx(static_cast<double>(s.radius)) + ", below 1e-9 of its centre's coordinate " +
                    approx(static_cast<double>(far)) + " (a float centre is not that precise)"};
   }
-  return check_leaves_disjoint(leaves, 1e-5 * static_cast<double>(tree.root().radius));
+  if (Status ok = check_leaves_disjoint(leaves, 1e-5 * static_cast<double>(tree.root().radius)); !ok) return ok;
+  if (asset.surface) return check_surface(*asset.surface, asset);
+  return Ok{};
 }
 
 std::vector<std::byte> encode_ist(const IstAsset& asset) {
   const auto nodes = asset.tree.nodes();
   const auto leaves = asset.tree.leaves();
   const std::size_t payload = nodes.size() * kNodeBytes + leaves.size() * kLeafBytes;
+  const std::size_t section = asset.surface ? surface_section_bytes(*asset.surface) : 0;
   std::array<std::byte, kIstHeaderSize> header{};
-  std::vector<std::byte> body(payload, std::byte{0});
+  std::vector<std::byte> body(payload + section, std::byte{0});
   std::byte* h = header.data();
   std::memcpy(h, kMagic.data(), kMagic.size());
-  put_u32(h + kOffVersion, kIstFormatVersion);
+  // the oldest version that holds the asset: older builds read a file without a surface
+  put_u32(h + kOffVersion, asset.surface ? 2u : 1u);
   put_u32(h + kOffHeaderSize, static_cast<std::uint32_t>(kIstHeaderSize));
   put_u32(h + kOffNodes, static_cast<std::uint32_t>(nodes.size()));
   put_u32(h + kOffLeaves, static_cast<std::uint32_t>(leaves.size()));
@@ -238,7 +352,7 @@ std::vector<std::byte> encode_ist(const IstAsset& asset) {
   put_f64(h + kOffMaxGap, asset.meta.max_gap);
   put_f64(h + kOffBuildSeconds, asset.meta.build_seconds);
   put_u32(h + kOffSphereCount, static_cast<std::uint32_t>(leaves.size()));
-  put_u32(h + kOffFlags, 0);
+  put_u32(h + kOffFlags, asset.surface ? kIstFlagSurface : 0u);
   put_u64(h + kOffPayloadBytes, payload);
   std::byte* p = body.data();
   for (const SphereTreeNode& n : nodes) {
@@ -259,11 +373,10 @@ std::vector<std::byte> encode_ist(const IstAsset& asset) {
     put_f32(p + 12, s.radius);
     p += kLeafBytes;
   }
-  put_u32(h + kOffPayloadCrc, ist_crc32(body));
+  if (asset.surface) put_surface_section(p, *asset.surface);
+  put_u32(h + kOffPayloadCrc, ist_crc32({body.data(), payload}));
   put_u32(h + kOffHeaderCrc, ist_crc32({h, kOffHeaderCrc}));
-  body.resize(kIstHeaderSize + payload);
-  std::memmove(body.data() + kIstHeaderSize, body.data(), payload);
-  std::memcpy(body.data(), header.data(), kIstHeaderSize);
+  body.insert(body.begin(), header.begin(), header.end());
   return body;
 }
 
@@ -278,18 +391,22 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
     return Error{who + "truncated: " + std::to_string(size) + " bytes, but the .ist header alone has " +
                  std::to_string(kIstHeaderSize)};
   const std::uint32_t version = get_u32(h + kOffVersion);
-  if (version != kIstFormatVersion)
+  if (version < 1 || version > kIstFormatVersion)
     return Error{who + "unsupported .ist format version " + std::to_string(version) +
-                 " (this build reads version " + std::to_string(kIstFormatVersion) +
+                 " (this build reads versions 1 to " + std::to_string(kIstFormatVersion) +
                  "; rebuild the file with this version)"};
   if (get_u32(h + kOffHeaderCrc) != ist_crc32({h, kOffHeaderCrc}))
     return Error{who + "corrupted: header checksum mismatch"};
   if (get_u32(h + kOffHeaderSize) != kIstHeaderSize)
     return Error{who + "corrupted: header size " + std::to_string(get_u32(h + kOffHeaderSize)) +
                  ", expected " + std::to_string(kIstHeaderSize)};
-  if (get_u32(h + kOffFlags) != 0)
-    return Error{who + "corrupted: flags " + std::to_string(get_u32(h + kOffFlags)) +
-                 " (format version 1 defines none; expected 0)"};
+  // version 1 defines no section; version 2 the surface, which a version 2 file holds
+  const std::uint32_t flags = get_u32(h + kOffFlags);
+  if (version == 1 && flags != 0)
+    return Error{who + "corrupted: flags " + std::to_string(flags) + " (format version 1 defines none; expected 0)"};
+  if (version == 2 && flags != kIstFlagSurface)
+    return Error{who + "corrupted: flags " + std::to_string(flags) + " (format version 2 expects " +
+                 std::to_string(kIstFlagSurface) + ", its surface section)"};
   // the reserved bytes are outside the header checksum, so they are checked here
   for (std::size_t i = kOffReserved; i < kIstHeaderSize; ++i)
     if (h[i] != std::byte{0})
@@ -310,11 +427,18 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
   if (size - kIstHeaderSize < payload)
     return Error{who + "truncated: " + std::to_string(size) + " bytes, the header announces " +
                  std::to_string(kIstHeaderSize + payload)};
-  if (size - kIstHeaderSize > payload)
+  if (flags == 0 && size - kIstHeaderSize > payload)
     return Error{who + "corrupted: " + std::to_string(size - kIstHeaderSize - payload) +
                  " unexpected bytes after the payload"};
   if (get_u32(h + kOffPayloadCrc) != ist_crc32({h + kIstHeaderSize, static_cast<std::size_t>(payload)}))
     return Error{who + "corrupted: payload checksum mismatch"};
+  std::optional<TriangleMesh> surface;
+  if (flags & kIstFlagSurface) {
+    const std::size_t tree_end = kIstHeaderSize + static_cast<std::size_t>(payload);
+    auto section = get_surface_section(bytes.subspan(tree_end), size);
+    if (!section) return Error{who + section.error().message};
+    surface = std::move(*section);
+  }
 
   std::vector<SphereTreeNode> nodes(static_cast<std::size_t>(node_count));
   std::vector<Sphere> leaves(static_cast<std::size_t>(leaf_count));
@@ -341,6 +465,7 @@ Result<IstAsset> load_ist_from_memory(std::span<const std::byte> bytes, std::str
   asset.meta.mesh_volume = get_f64(h + kOffMeshVolume);
   asset.meta.max_gap = get_f64(h + kOffMaxGap);
   asset.meta.build_seconds = get_f64(h + kOffBuildSeconds);
+  asset.surface = std::move(surface);
   if (const Status ok = validate(asset); !ok) return Error{who + ok.error().message};
   return asset;
 }

@@ -126,10 +126,10 @@ TEST_F(IstFile, RejectsCorruptedForeignAndWrongVersion) {
   EXPECT_NE(load_error(obj).find("not a .ist"), std::string::npos) << load_error(obj);
   // a newer format version
   auto newer = bytes;
-  newer[8] = std::byte{2};
+  newer[8] = std::byte{3};
   const std::string msg = load_error(newer);
-  EXPECT_NE(msg.find("format version 2"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("version 1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("format version 3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("versions 1 to 2"), std::string::npos) << msg;
   // trailing garbage
   auto longer = bytes;
   longer.push_back(std::byte{0});

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 
 #include "uh/collette/ist_file.hpp"
 #include "uh/collette/mesh_import.hpp"
@@ -36,7 +37,8 @@ struct IstBuildResult {
   double tree_seconds = 0.0;  ///< time to build the hierarchy [s]
 };
 
-/// Loads `mesh_path` (with options.mesh), packs it and builds the tree. Errors name the file and
+/// Loads `mesh_path` (with options.mesh), packs it and builds the tree; the asset keeps the mesh
+/// as its surface (ist_surface_of). Errors name the file and
 /// say what is wrong. Nothing is written to disk. Not real-time safe; any thread.
 Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path,
                                        const IstBuildOptions& options = {});
@@ -47,6 +49,10 @@ Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path,
 /// messages name mesh.source_name. Not real-time safe; any thread.
 Result<IstBuildResult> build_ist_asset(const TriangleMesh& mesh, std::uint64_t source_mesh_hash,
                                        const IstBuildOptions& options = {});
+
+/// The surface an asset keeps of the mesh it was packed from (IstAsset::surface): the validated
+/// mesh as it is, or none for a mesh accepted open (its holes are capped only inside the packing).
+std::optional<TriangleMesh> ist_surface_of(const TriangleMesh& mesh);
 
 /// A copy of `tree` with every length multiplied by `factor` (> 0) and every volume by factor^3,
 /// e.g. to bring a tree in mesh units into metres. Not real-time safe.
