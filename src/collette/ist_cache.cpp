@@ -13,8 +13,25 @@ namespace uh::collette {
 namespace {
 
 CachedTree in_metres(const IstAsset& asset, double meters_per_unit) {
-  return CachedTree{std::make_shared<const SphereTree>(scale_sphere_tree(asset.tree, meters_per_unit)),
-                    asset.meta.coverage, asset.meta.max_gap * meters_per_unit};
+  CachedTree tree{std::make_shared<const SphereTree>(scale_sphere_tree(asset.tree, meters_per_unit)),
+                  asset.meta.coverage, asset.meta.max_gap * meters_per_unit};
+  if (asset.surface) {
+    TriangleMesh surface = *asset.surface;
+    for (Vec3& v : surface.vertices) v = v * meters_per_unit;
+    tree.surface = std::make_shared<const MeshInside>(surface);
+  }
+  return tree;
+}
+
+// A cache file of an older format keeps its spheres and gains the surface they were packed in:
+// the mesh file's (the file's hash is the one packed), read again rather than packed again, and
+// written back for the next run (a cache folder that cannot be written keeps working without).
+Status add_mesh_surface(const std::filesystem::path& mesh, const std::filesystem::path& cached, IstAsset& asset) {
+  auto surface = load_mesh(mesh);
+  if (!surface) return surface.error();
+  asset.surface = ist_surface_of(*surface);
+  static_cast<void>(save_ist(cached, asset));
+  return Ok{};
 }
 
 }  // namespace
@@ -64,6 +81,8 @@ Result<CachedTree> IstCache::mesh_tree(const std::filesystem::path& mesh, const 
   auto loaded = load_ist(cached);
   if (loaded && loaded->meta.source_mesh_hash == *hash) {
     asset = std::move(loaded).value();
+    if (!asset.surface)
+      if (Status upgraded = add_mesh_surface(mesh, cached, asset); !upgraded) return upgraded.error();
   } else {
     // absent, unreadable or stale: build it again (only the cache file is replaced)
     const std::string what = fmt::format("packing {} ({} spheres)", mesh.filename().string(), packing.spheres);

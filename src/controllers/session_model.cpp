@@ -10,13 +10,17 @@
 namespace uh::controllers {
 namespace {
 
-// One mesh's surface per (file, scale), shared by the objects that repeat it.
+// A shape's surface: the one its .ist holds (a .ist file's, a packed mesh's cache file's), else its
+// mesh file's (a tree given beside its mesh), one per (file, scale) shared by the objects that
+// repeat it.
 class SurfaceLoader {
  public:
   SurfaceLoader(bool any, bool beside_given_tree) : any_(any), beside_given_tree_(beside_given_tree) {}
 
-  Result<std::shared_ptr<const collette::MeshInside>> load(const SceneShape& shape) {
-    if (!any_ || shape.mesh.empty() || (shape.tree && !beside_given_tree_)) return std::shared_ptr<const collette::MeshInside>{};
+  Result<std::shared_ptr<const collette::MeshInside>> load(const SceneShape& shape, const ShapeTree& tree) {
+    if (!any_) return std::shared_ptr<const collette::MeshInside>{};
+    if (tree.surface) return tree.surface;
+    if (shape.mesh.empty() || (shape.tree && !beside_given_tree_)) return std::shared_ptr<const collette::MeshInside>{};
     const auto key = std::make_pair(shape.mesh.string(), shape.meters_per_unit);
     if (const auto it = loaded_.find(key); it != loaded_.end()) return it->second;
     auto surface = load_shape_surface(shape);
@@ -80,7 +84,7 @@ Status compile_objects(collette::IstCache& cache, const CompileOptions& options,
     const std::string part = fmt::format("object '{}'", object.name);
     auto tree = tree_of(object.shape, cache, options.progress);
     if (!tree) return named(scene, part, tree.error());
-    auto surface = surfaces.load(object.shape);
+    auto surface = surfaces.load(object.shape, *tree);
     if (!surface) return named(scene, part, surface.error());
     auto body = compile_soft_body(object, *tree, *surface, options);
     if (!body) return named(scene, part, body.error());

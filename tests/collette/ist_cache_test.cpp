@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <cstring>
 #include <string>
 
 #include <fmt/format.h>
@@ -64,6 +65,56 @@ TEST(IstCache, BuildsOnceAndSharesTheTreeOfOneShape) {
   const auto finer = cache.mesh_tree(kBall, {.spheres = 200, .meters_per_unit = 0.01});
   ASSERT_TRUE(finer.has_value());
   EXPECT_EQ(files_in(dir), 2u);
+  std::filesystem::remove_all(dir);
+}
+
+// A cache file written before the surface section (format 1) keeps its spheres and gains the mesh's
+// surface on its next use, without packing again; the surface comes in metres, like the tree.
+TEST(IstCache, AFormat1CacheFileGainsItsSurfaceWithoutPackingAgain) {
+  const auto dir = fresh_dir("format1");
+  const MeshPacking packing{.spheres = 120, .meters_per_unit = 0.01};
+  {
+    IstCache cache(dir);
+    const auto built = cache.mesh_tree(kBall, packing);
+    ASSERT_TRUE(built.has_value()) << built.error().message;
+    EXPECT_NE(built->surface, nullptr) << "a packed mesh's cache file holds its surface";
+  }
+  ASSERT_EQ(files_in(dir), 1u);
+  const std::filesystem::path cached = std::filesystem::directory_iterator(dir)->path();
+  auto asset = load_ist(cached);
+  ASSERT_TRUE(asset.has_value()) << asset.error().message;
+  ASSERT_TRUE(asset->surface.has_value());
+  asset->surface.reset();
+  ASSERT_TRUE(save_ist(cached, *asset));  // as an older build wrote it: format 1
+
+  IstCache cache(dir);
+  int progress_calls = 0;
+  const auto upgraded = cache.mesh_tree(kBall, packing, [&](const std::string&, double) { ++progress_calls; });
+  ASSERT_TRUE(upgraded.has_value()) << upgraded.error().message;
+  EXPECT_EQ(progress_calls, 0) << "not packed again";
+  ASSERT_NE(upgraded->surface, nullptr);
+  // in metres: the ball's surface lies around its spheres, within the packing's gap of them
+  const SphereTreeNode& root = upgraded->tree->root();
+  const Vec3 centre{static_cast<double>(root.x), static_cast<double>(root.y), static_cast<double>(root.z)};
+  EXPECT_LT(upgraded->surface->signed_distance(centre), 0.0);
+  EXPECT_LT(upgraded->surface->distance(centre), static_cast<double>(root.radius) + upgraded->max_gap_m + 1e-6);
+  const auto rewritten = load_ist(cached);
+  ASSERT_TRUE(rewritten.has_value()) << rewritten.error().message;
+  EXPECT_TRUE(rewritten->surface.has_value()) << "written back with its surface";
+  const auto now = rewritten->tree.leaves();
+  const auto before = asset->tree.leaves();
+  ASSERT_EQ(now.size(), before.size());
+  EXPECT_EQ(std::memcmp(now.data(), before.data(), now.size_bytes()), 0) << "the same spheres";
+
+  // a .ist file with a surface hands it out; one without, none
+  const auto with = cache.ist_tree(cached);
+  ASSERT_TRUE(with.has_value()) << with.error().message;
+  EXPECT_NE(with->surface, nullptr);
+  const auto bare = dir / "bare.ist";
+  ASSERT_TRUE(save_ist(bare, *asset));
+  const auto without = cache.ist_tree(bare);
+  ASSERT_TRUE(without.has_value()) << without.error().message;
+  EXPECT_EQ(without->surface, nullptr);
   std::filesystem::remove_all(dir);
 }
 

@@ -18,10 +18,15 @@
 #include <string>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "hand_energy_support.hpp"
 #include "proxy_test_support.hpp"
 #include "scene_test_support.hpp"
 #include "uh/collette/collision_world.hpp"
+#include "uh/collette/ist_builder.hpp"
+#include "uh/collette/ist_file.hpp"
+#include "uh/controllers/session_model.hpp"
 #include "uh/controllers/haptic_session.hpp"
 #include "uh/collette/mesh_import.hpp"
 #include "uh/collette/mesh_inside.hpp"
@@ -262,6 +267,59 @@ TEST(ToolProxy, RestsOnTheMeshSoAPackedFlatFaceDoesNotRipple) {
     // the handle is press below where the ball rests (the face, less the allowed penetration)
     EXPECT_NEAR(ripple.normal_n, 1500.0 * (press - ToolProxyOptions{}.penetration_m), 0.02) << spheres << " spheres";
   }
+}
+
+// A packed slab given only as a .ist (the scene's `ist`, no mesh file) rests the proxy on the surface
+// the .ist holds, as a meshed object does: the bound, a ripple of at most 1 % of the normal
+// force, at 2,000, 10,000 and 50,000 spheres. The references: the same face given as a mesh (the same
+// force) and the face itself (the ball's lowest point within the allowed penetration of z = 0, the
+// force the spring's stiffness times how far the handle is below the ball resting there). The same
+// packing in format 1 (no surface) rests on the spheres, smoothed: the grain the surface takes out.
+TEST(ToolProxy, AnIstAloneRestsOnTheSurfaceItHolds) {
+  const auto dir = testing::fresh_cache("ist-surface");
+  collette::IstCache cache(dir / "cache");
+  const auto object_of = [&](const std::filesystem::path& ist) -> CompiledShape {
+    auto scene = parse_scene(testing::small_scene_json(), "small.json", testing::test_assets());
+    EXPECT_TRUE(scene) << scene.error().message;
+    scene->objects[0].shape = {.ist = ist};
+    auto model = compile(*scene, cache);
+    EXPECT_TRUE(model) << model.error().message;
+    return model ? (*model)->objects[0] : CompiledShape{};
+  };
+  for (const std::int64_t spheres : {2000, 10000, 50000}) {
+    collette::TriangleMesh m = box_mesh({0.1, 0.1, 0.02});
+    for (Vec3& v : m.vertices) v.z -= 0.01;
+    const auto mesh = collette::validate_mesh(m);
+    ASSERT_TRUE(mesh) << mesh.error().message;
+    auto built = collette::build_ist_asset(*mesh, 0, {.sphere_count = spheres});
+    ASSERT_TRUE(built) << built.error().message;
+    const auto with_surface = dir / fmt::format("slab{}.ist", spheres);
+    ASSERT_TRUE(collette::save_ist(with_surface, built->asset));
+    built->asset.surface.reset();
+    const auto format1 = dir / fmt::format("slab{}_format1.ist", spheres);
+    ASSERT_TRUE(collette::save_ist(format1, built->asset));
+
+    const CompiledShape slab = object_of(with_surface);
+    ASSERT_NE(slab.surface, nullptr) << "the .ist's surface";
+    EXPECT_EQ(slab.surface_gap_m, built->packing.max_gap);
+    const Packed packed{slab.tree, slab.surface_gap_m};
+    const double press = 0.0015, smoothing = ToolProxyOptions{}.smoothing_m;
+    double lowest = 1.0;
+    const Ripple on_ist = slide_ripple(packed, smoothing, press, slab.surface, &lowest);
+    const Ripple on_mesh = slide_ripple(packed, smoothing, press, std::make_shared<const collette::MeshInside>(*mesh));
+    const CompiledShape old = object_of(format1);
+    EXPECT_EQ(old.surface, nullptr) << "a format 1 .ist has none";
+    const Ripple on_grain = slide_ripple(Packed{old.tree, old.surface_gap_m}, smoothing, press);
+    std::printf("%lld spheres, a .ist alone: ripple %.3f %% of %.3f N with its surface (the mesh: %.3f %% of %.3f N), "
+                "%.1f %% of %.3f N without (format 1); lowest point %.4f mm\n",
+                static_cast<long long>(spheres), 100 * on_ist.relative, on_ist.normal_n, 100 * on_mesh.relative,
+                on_mesh.normal_n, 100 * on_grain.relative, on_grain.normal_n, lowest * 1e3);
+    EXPECT_LT(on_ist.relative, 0.01) << spheres << " spheres";
+    EXPECT_NEAR(on_ist.normal_n, on_mesh.normal_n, 1e-3) << spheres << " spheres";
+    EXPECT_GT(lowest, -ToolProxyOptions{}.penetration_m - 1e-6) << spheres << " spheres";
+    EXPECT_NEAR(on_ist.normal_n, 1500.0 * (press - ToolProxyOptions{}.penetration_m), 0.02) << spheres << " spheres";
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // Force continuity over an edge: a ball pressed 1.5 mm into a packed slab's top face and drawn at

@@ -13,6 +13,7 @@
 #include <string>
 #include <tuple>
 
+#include "uh/collette/mesh_inside.hpp"
 #include "uh/collette/sphere_tree.hpp"
 #include "uh/core/result.hpp"
 
@@ -24,6 +25,9 @@ struct CachedTree {
   double coverage = 1.0;
   /// The packing's largest gap below the mesh surface (IstMetadata::max_gap) [m]; 0 when unknown.
   double max_gap_m = 0.0;
+  /// The surface the spheres were packed in (IstAsset::surface), in metres in the tree's frame;
+  /// null when the .ist holds none (a version 1 file, a mesh packed open).
+  std::shared_ptr<const MeshInside> surface{};
 };
 
 /// What a mesh is packed with (the key of its cached build, with the mesh file's hash).
@@ -49,14 +53,16 @@ class IstCache {
 
   using Progress = std::function<void(const std::string& what, double fraction)>;
 
-  /// The packing of `mesh` in metres: the cached build (keyed by the mesh file's hash, the sphere
-  /// count, the radius bound in mesh units and kSphereTreeBuilderVersion), else packed now and
-  /// cached (only the cache file is replaced when it is absent, unreadable or stale). `progress`
-  /// gets the packing's progress when a build is needed.
+  /// The packing of `mesh` in metres with its surface: the cached build (keyed by the mesh file's
+  /// hash, the sphere count, the radius bound in mesh units and kSphereTreeBuilderVersion), else
+  /// packed now and cached (only the cache file is replaced when it is absent, unreadable or
+  /// stale). A cached file without a surface (format version 1) gets the mesh's, written back
+  /// without packing again. `progress` gets the packing's progress when a build is needed.
   Result<CachedTree> mesh_tree(const std::filesystem::path& mesh, const MeshPacking& packing,
                                const Progress& progress = {});
 
-  /// A prebuilt .ist file's tree in metres (its own meters_per_unit) with its coverage.
+  /// A prebuilt .ist file's tree in metres (its own meters_per_unit) with its coverage and, when
+  /// the file holds one, its surface.
   Result<CachedTree> ist_tree(const std::filesystem::path& ist);
 
  private:

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
 /// SessionModel: a scene compiled once into everything a session needs (MuJoCo's model between
-/// the description and the data): each object's and tool's tree with its coverage, each meshed
-/// object's surface, the combined contact materials, the rates. Immutable plain data: sessions
+/// the description and the data): each object's and tool's tree with its coverage, each object's
+/// surface (its .ist's or its mesh's), the combined contact materials, the rates. Immutable plain data: sessions
 /// created from one model share it read-only, so a program that compiles once and creates many
 /// sessions loads, packs and reads each mesh once.
 
@@ -21,12 +21,13 @@
 
 namespace uh::controllers {
 
-/// A shape resolved: its tree in metres, its coverage and, when it has a mesh file, the mesh's
-/// surface in metres (the proxy rests on it rather than on the packing's grain).
+/// A shape resolved: its tree in metres, its coverage and its surface in metres (the proxy rests on
+/// it rather than on the packing's grain): the one its .ist holds, else its mesh file's.
 struct CompiledShape {
   std::shared_ptr<const collette::SphereTree> tree;
   double coverage = 1.0;  ///< sphere volume / mesh volume, (0, 1]
-  std::shared_ptr<const collette::MeshInside> surface;  ///< null without a mesh file
+  /// null for a format 1 .ist alone (or a tree in memory) without a mesh file
+  std::shared_ptr<const collette::MeshInside> surface;
   /// How far the packing lies below `surface` at most (the tree's max_gap) [m]; 0 when unknown.
   double surface_gap_m = 0.0;
   /// A deformable object's rest model (`objects[].deformable`): its lattice around the tree's
@@ -51,7 +52,7 @@ struct CompileOptions {
   /// a preloading caller (`uh explore`) renders on the proxy today, the spheres (issue 24: it
   /// compiles its model next).
   bool surface_beside_given_tree = true;
-  /// Load meshed objects' surfaces at all (false: a caller whose proxy rests on the spheres).
+  /// Give objects their surfaces at all (false: a caller whose proxy rests on the spheres).
   bool surfaces = true;
   /// The packing's progress (what, fraction) while a mesh is packed on first use; calling thread.
   std::function<void(const std::string& what, double fraction)> progress{};
@@ -59,7 +60,7 @@ struct CompileOptions {
 
 /// Validates `scene` and resolves it: trees through `cache` (loaded, or packed and cached on first
 /// use; shapes of one packing share one tree; a tree the scene holds is used as it is), every
-/// object's mesh surface where it has a mesh file (objects of one mesh share it), the materials,
+/// object's surface (the one its .ist holds, else its mesh file's; objects of one shape share it), the materials,
 /// and each deformable object's lattice (built here, a progress stage of its own).
 /// The model's scene holds each shape's tree and coverage. Errors name the scene's source and the
 /// object or tool. Setup only.
