@@ -138,7 +138,8 @@ static inline uh_tree_build_def uh_default_tree_build_def(void) {
   return def;
 }
 
-/* Loads a .ist file (checksummed; a damaged file is refused with the reason: UH_ERROR_FILE). */
+/* Loads a .ist file (checksummed; a damaged file is refused with the reason: UH_ERROR_FILE). The
+ * surface a format 2 file holds comes with the tree: a session's proxy rests on it. */
 UH_API uh_status uh_tree_load(const char* ist_path, uh_tree_id* out);
 
 /* Loads a closed mesh (OBJ, STL, PLY, OFF, ...; the Windows build reads OBJ and STL only),
@@ -153,7 +154,8 @@ UH_API uh_status uh_tree_build(const char* mesh_path, const uh_tree_build_def* d
 UH_API uh_status uh_tree_build_from_arrays(const double* vertices, int32_t vertex_count, const int32_t* indices,
                                            int32_t triangle_count, const uh_tree_build_def* def, uh_tree_id* out);
 
-/* Writes the tree as a .ist file (lengths in metres, meters_per_unit 1). */
+/* Writes the tree as a .ist file (lengths in metres, meters_per_unit 1), with the surface it was
+ * built from or loaded with (format 2; format 1 without one). */
 UH_API uh_status uh_tree_save(uh_tree_id tree, const char* ist_path);
 
 /* What a tree holds. */

@@ -84,6 +84,8 @@ Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh
     shape.tree = box->tree;
     // 0 when unknown: the gradient law is then uncalibrated
     if (box->meta.coverage > 0.0 && box->meta.coverage <= 1.0) shape.coverage = box->meta.coverage;
+    shape.surface = box->surface_bvh;
+    shape.surface_gap_m = box->meta.max_gap;
   } else {
     uh_tree_id tree{0};
     const uh_tree_build_def build{.struct_size = sizeof(uh_tree_build_def),
@@ -97,6 +99,8 @@ Result<controllers::SceneShape> shape_from_def(const std::string& what, const uh
     if (!built) return Error{fmt::format("{}: the tree built from the arrays was lost", what)};
     shape.tree = built->tree;
     if (built->meta.coverage > 0.0 && built->meta.coverage <= 1.0) shape.coverage = built->meta.coverage;
+    shape.surface = built->surface_bvh;
+    shape.surface_gap_m = built->meta.max_gap;
   }
   return shape;
 }

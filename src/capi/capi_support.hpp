@@ -6,6 +6,7 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -15,6 +16,7 @@
 
 #include "handle_table.hpp"
 #include "uh/collette/ist_file.hpp"
+#include "uh/collette/mesh_inside.hpp"
 #include "uh/collette/sphere_tree.hpp"
 #include "uh/controllers/scene.hpp"
 #include "uh/core/math.hpp"
@@ -152,10 +154,13 @@ int32_t is_live(const HandleTable<T>& table, std::uint64_t id) noexcept {
 /// non-zero quaternion (it is normalised) and the position finite.
 Result<Pose> pose_from_arrays(const double position[3], const double orientation[4]);
 
-/// An immutable tree with what its .ist said about it (lengths in metres).
+/// An immutable tree with what its .ist said about it and the surface it was packed in, if any
+/// (lengths in metres).
 struct TreeBox {
   std::shared_ptr<const collette::SphereTree> tree;
   collette::IstMetadata meta;
+  std::optional<collette::TriangleMesh> surface;          ///< written back by uh_tree_save
+  std::shared_ptr<const collette::MeshInside> surface_bvh;  ///< what a session's proxy rests on
 };
 
 struct SceneBox {

@@ -12,15 +12,14 @@
 namespace uh::capi {
 namespace {
 
-uh_status add_tree(collette::IstAsset asset, double meters_per_unit, uh_tree_id* out) {
+uh_status add_tree(const collette::IstAsset& asset, double meters_per_unit, uh_tree_id* out) {
+  // everything the box holds is in metres
+  collette::IstAsset metres = collette::ist_asset_in_metres(asset, meters_per_unit);
   auto box = std::make_shared<TreeBox>();
-  box->tree =
-      std::make_shared<const collette::SphereTree>(collette::scale_sphere_tree(asset.tree, meters_per_unit));
-  box->meta = asset.meta;
-  // everything the box holds is in metres from here on
-  box->meta.mesh_volume *= meters_per_unit * meters_per_unit * meters_per_unit;
-  box->meta.max_gap *= meters_per_unit;
-  box->meta.meters_per_unit = 1.0;
+  box->tree = std::make_shared<const collette::SphereTree>(std::move(metres.tree));
+  box->meta = metres.meta;
+  if (metres.surface) box->surface_bvh = std::make_shared<const collette::MeshInside>(*metres.surface);
+  box->surface = std::move(metres.surface);
   const std::uint64_t id = tree_table().insert(std::move(box));
   if (id == 0) return table_full("trees");
   out->bits = id;
@@ -77,7 +76,7 @@ uh_status uh_tree_load(const char* ist_path, uh_tree_id* out) {
     auto asset = collette::load_ist(ist_path);
     if (!asset) return fail(asset.error(), UH_ERROR_FILE);
     const double scale = asset->meta.meters_per_unit;
-    return add_tree(std::move(asset).value(), scale, out);
+    return add_tree(*asset, scale, out);
   });
 }
 
@@ -91,7 +90,7 @@ uh_status uh_tree_build(const char* mesh_path, const uh_tree_build_def* def, uh_
     if (auto s = build_options(fn, def, options); s != UH_OK) return s;
     auto built = collette::build_ist_asset(mesh_path, options);
     if (!built) return fail(built.error(), UH_ERROR_MESH);
-    return add_tree(std::move(built->asset), options.meters_per_unit, out);
+    return add_tree(built->asset, options.meters_per_unit, out);
   });
 }
 
@@ -128,7 +127,7 @@ uh_status uh_tree_build_from_arrays(const double* vertices, int32_t vertex_count
     if (!valid) return fail(valid.error(), UH_ERROR_MESH);
     auto built = collette::build_ist_asset(*valid, hash, options);
     if (!built) return fail(built.error(), UH_ERROR_MESH);
-    return add_tree(std::move(built->asset), options.meters_per_unit, out);
+    return add_tree(built->asset, options.meters_per_unit, out);
   });
 }
 
@@ -138,7 +137,7 @@ uh_status uh_tree_save(uh_tree_id tree, const char* ist_path) {
     if (ist_path == nullptr) return null_argument(fn, "ist_path");
     const auto box = tree_table().find(tree.bits);
     if (!box) return stale(fn, "tree");
-    const collette::IstAsset asset{*box->tree, box->meta};
+    const collette::IstAsset asset{*box->tree, box->meta, box->surface};
     if (auto saved = collette::save_ist(ist_path, asset); !saved) return fail(saved.error(), UH_ERROR_FILE);
     return UH_OK;
   });

@@ -44,6 +44,16 @@ SphereTree scale_sphere_tree(const SphereTree& tree, double factor) {
   return SphereTree(std::move(nodes), std::move(leaves), tree.depth(), tree.arity());
 }
 
+IstAsset ist_asset_in_metres(const IstAsset& asset, double meters_per_unit) {
+  IstAsset metres{scale_sphere_tree(asset.tree, meters_per_unit), asset.meta, asset.surface};
+  metres.meta.mesh_volume *= meters_per_unit * meters_per_unit * meters_per_unit;
+  metres.meta.max_gap *= meters_per_unit;
+  metres.meta.meters_per_unit = 1.0;
+  if (metres.surface)
+    for (Vec3& v : metres.surface->vertices) v = v * meters_per_unit;
+  return metres;
+}
+
 Result<IstBuildResult> build_ist_asset(const std::filesystem::path& mesh_path,
                                        const IstBuildOptions& options) {
   const auto start = std::chrono::steady_clock::now();

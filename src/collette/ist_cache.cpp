@@ -13,13 +13,10 @@ namespace uh::collette {
 namespace {
 
 CachedTree in_metres(const IstAsset& asset, double meters_per_unit) {
-  CachedTree tree{std::make_shared<const SphereTree>(scale_sphere_tree(asset.tree, meters_per_unit)),
-                  asset.meta.coverage, asset.meta.max_gap * meters_per_unit};
-  if (asset.surface) {
-    TriangleMesh surface = *asset.surface;
-    for (Vec3& v : surface.vertices) v = v * meters_per_unit;
-    tree.surface = std::make_shared<const MeshInside>(surface);
-  }
+  IstAsset metres = ist_asset_in_metres(asset, meters_per_unit);
+  CachedTree tree{std::make_shared<const SphereTree>(std::move(metres.tree)), metres.meta.coverage,
+                  metres.meta.max_gap};
+  if (metres.surface) tree.surface = std::make_shared<const MeshInside>(*metres.surface);
   return tree;
 }
 

@@ -8,7 +8,7 @@ std::filesystem::path default_cache_dir() { return collette::IstCache::default_d
 
 Result<ShapeTree> tree_of(const SceneShape& shape, collette::IstCache& cache,
                           const collette::IstCache::Progress& progress) {
-  if (shape.tree) return ShapeTree{shape.tree, shape.coverage};
+  if (shape.tree) return ShapeTree{shape.tree, shape.coverage, shape.surface_gap_m, shape.surface};
   if (!shape.ist.empty()) return cache.ist_tree(shape.ist);
   return cache.mesh_tree(shape.mesh,
                          {.spheres = shape.spheres,

@@ -365,6 +365,17 @@ static const double cube_vertices[8 * 3] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1,
 static const int32_t cube_indices[12 * 3] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
                                              1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
 
+/* The format version of a .ist file (the u32 at byte 8), or -1. */
+static int ist_format_of(const char* path) {
+  unsigned char header[12];
+  FILE* f = fopen(path, "rb");
+  size_t got;
+  if (f == NULL) return -1;
+  got = fread(header, 1, sizeof header, f);
+  fclose(f);
+  return got == sizeof header ? header[8] | header[9] << 8 | header[10] << 16 | header[11] << 24 : -1;
+}
+
 /* Trees from arrays, queried: against itself at the identity every leaf meets itself and no other
  * (the packing does not overlap), so the volume is the packing's own, known from the build. */
 static void test_trees(void) {
@@ -387,7 +398,13 @@ static void test_trees(void) {
 
   snprintf(path, sizeof path, "%s/capi_cube_test.ist", UH_TEST_TMP_DIR);
   REQUIRE_OK(uh_tree_save(a, path));
+  /* the tree keeps the mesh it was built from, and a loaded tree the surface its file holds: both
+   * are saved with it (format 2), so a session's proxy rests on the cube, not on the spheres */
+  CHECK(ist_format_of(path) == 2);
   REQUIRE_OK(uh_tree_load(path, &b));
+  remove(path);
+  REQUIRE_OK(uh_tree_save(b, path));
+  CHECK(ist_format_of(path) == 2);
   remove(path);
 
   r.struct_size = sizeof r;

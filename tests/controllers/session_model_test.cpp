@@ -125,6 +125,28 @@ TEST(SessionModel, ATreeGivenForTheToolOrTheObjectKeepsTheObjectsMeshSurface) {
             (*model)->objects[0].surface->distance(Vec3{0.0, 0.0, 0.1}));
 }
 
+// A tree in memory alone (no mesh file: the C API's and Python's trees, loaded from a .ist or built
+// from arrays) gives the proxy the surface it carries, with its packing's gap; without one, none.
+TEST(SessionModel, ATreeInMemoryAloneBringsItsSurface) {
+  collette::IstCache cache(testing::fresh_cache("model-memory"));
+  Scene scene = small_scene();
+  auto model = compile(scene, cache);
+  ASSERT_TRUE(model.has_value()) << model.error().message;
+  const CompiledShape& bunny = (*model)->objects[0];
+  ASSERT_NE(bunny.surface, nullptr);
+  scene.objects[0].shape = {.tree = bunny.tree, .coverage = bunny.coverage, .surface = bunny.surface,
+                            .surface_gap_m = bunny.surface_gap_m};
+  auto alone = compile(scene, cache);
+  ASSERT_TRUE(alone.has_value()) << alone.error().message;
+  EXPECT_EQ((*alone)->objects[0].surface.get(), bunny.surface.get());
+  EXPECT_EQ((*alone)->objects[0].surface_gap_m, bunny.surface_gap_m);
+  EXPECT_GT(bunny.surface_gap_m, 0.0);
+  scene.objects[0].shape.surface = nullptr;
+  auto bare = compile(scene, cache);
+  ASSERT_TRUE(bare.has_value()) << bare.error().message;
+  EXPECT_EQ((*bare)->objects[0].surface, nullptr) << "a tree without a surface rests the proxy on its spheres";
+}
+
 TEST(SessionModel, CompileRefusesAnInvalidSceneNamingTheField) {
   collette::IstCache cache(testing::fresh_cache("model-invalid"));
   Scene scene = small_scene();

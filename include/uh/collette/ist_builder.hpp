@@ -58,6 +58,10 @@ std::optional<TriangleMesh> ist_surface_of(const TriangleMesh& mesh);
 /// e.g. to bring a tree in mesh units into metres. Not real-time safe.
 SphereTree scale_sphere_tree(const SphereTree& tree, double factor);
 
+/// `asset` in metres, one of its units being `meters_per_unit` (> 0): the tree (scale_sphere_tree),
+/// mesh volume, max gap and surface scaled, meters_per_unit 1. Not real-time safe.
+IstAsset ist_asset_in_metres(const IstAsset& asset, double meters_per_unit);
+
 /// FNV-1a hash of a file's bytes (IstMetadata::source_mesh_hash); an error if it cannot be read.
 Result<std::uint64_t> hash_file(const std::filesystem::path& path);
 

@@ -39,7 +39,8 @@ std::filesystem::path default_cache_dir();
 /// A shape's tree in metres with its packing's coverage (sphere volume / mesh volume, (0, 1]).
 using ShapeTree = collette::CachedTree;
 
-/// The shape's tree in metres: the tree in memory as it is (with SceneShape::coverage), else the
+/// The shape's tree in metres: the tree in memory as it is (with SceneShape::coverage and
+/// SceneShape::surface), else the
 /// .ist file's or the mesh's packing through `cache` (collette::IstCache: built and cached on
 /// first use; a cache shares one tree between the shapes that ask for the same). Setup only.
 Result<ShapeTree> tree_of(const SceneShape& shape, collette::IstCache& cache,

@@ -24,6 +24,7 @@
 #include "uh/scene/workspace_mapping.hpp"
 
 namespace uh::collette {
+class MeshInside;
 class SphereTree;
 }  // namespace uh::collette
 
@@ -38,6 +39,12 @@ struct SceneShape {
   /// With `tree`: its packing's coverage (sphere volume / mesh volume, (0, 1]), which calibrates the
   /// gradient force law; 1 when unknown. Meshes and .ist files bring their own.
   double coverage = 1.0;
+  /// With `tree`: the surface its spheres were packed in, in metres in the tree's frame (a tree
+  /// loaded from a format 2 .ist or built from a mesh), which the proxy rests on; null: none, the
+  /// proxy rests on the spheres. Meshes and .ist files bring their own.
+  std::shared_ptr<const collette::MeshInside> surface{};
+  /// With `surface`: how far the packing lies below it at most [m] (the .ist's max gap); 0 unknown.
+  double surface_gap_m = 0.0;
   std::int64_t spheres = 10000;      ///< leaf spheres when packing the mesh
   /// Largest sphere radius when packing the mesh [m]; 0 = unbounded (collette::PackingOptions::max_radius).
   double max_sphere_radius = 0.0;
