@@ -167,6 +167,9 @@ int run_info(const IstInfoArgs& args) {
   const auto& tree = asset->tree;
   const auto& m = asset->meta;
   const auto& root = tree.root();
+  // format 2 is format 1 and the surface section
+  const unsigned format = asset->surface ? 2u : 1u;
+  const std::size_t surface_triangles = asset->surface ? asset->surface->triangles.size() : 0;
   double min_r = 1e300, max_r = 0.0;
   for (const Sphere& s : tree.leaves()) {
     min_r = std::min(min_r, static_cast<double>(s.radius));
@@ -174,7 +177,8 @@ int run_info(const IstInfoArgs& args) {
   }
   if (args.json) {
     nlohmann::json j = {{"file", args.file},
-                        {"format_version", collette::kIstFormatVersion},
+                        {"format_version", format},
+                        {"surface_triangles", surface_triangles},
                         {"spheres", tree.leaf_count()},
                         {"nodes", tree.node_count()},
                         {"depth", tree.depth()},
@@ -191,13 +195,18 @@ int run_info(const IstInfoArgs& args) {
                         {"bounding_sphere", {root.x, root.y, root.z, root.radius}}};
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("%s: Inner Sphere Tree, format %u\n", args.file.c_str(), collette::kIstFormatVersion);
+    std::printf("%s: Inner Sphere Tree, format %u\n", args.file.c_str(), format);
     std::printf("  spheres %d (radii %.4g..%.4g), nodes %d, depth %d, arity %d\n", tree.leaf_count(), min_r,
                 max_r, tree.node_count(), tree.depth(), tree.arity());
     std::printf("  coverage %.1f%% (sphere volume %.6g of mesh volume %.6g), max gap %.4g\n",
                 100.0 * m.coverage, tree.total_volume(), m.mesh_volume, m.max_gap);
     std::printf("  units: %g m per unit; source mesh hash %016llx; built in %.2f s\n", m.meters_per_unit,
                 static_cast<unsigned long long>(m.source_mesh_hash), m.build_seconds);
+    if (asset->surface)
+      std::printf("  surface: %zu vertices, %zu triangles (the proxy rests on it)\n", asset->surface->vertices.size(),
+                  surface_triangles);
+    else
+      std::printf("  surface: none (the proxy rests on the spheres, smoothed)\n");
   }
   return 0;
 }

@@ -158,6 +158,11 @@ TEST_F(CliTest, IstBuildPrintsTheDocumentedFieldsAndInfoAgrees) {
   const auto ji = json_of(info);
   EXPECT_EQ(ji.value("spheres", 0), 400) << info.out;
   EXPECT_NEAR(ji.value("coverage", 0.0), j.value("coverage", 0.0), 1e-6);
+  // the build keeps the mesh it packed: format 2, with the surface section
+  ASSERT_TRUE(asset->surface.has_value());
+  EXPECT_EQ(ji.value("format_version", 0), 2) << info.out;
+  EXPECT_EQ(ji.value("surface_triangles", std::size_t{0}), asset->surface->triangles.size()) << info.out;
+  EXPECT_GT(ji.value("surface_triangles", 0), 0) << info.out;
 
   const fs::path section = dir_ / "section.png";
   const CommandRun preview =
