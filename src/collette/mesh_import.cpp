@@ -45,7 +45,9 @@ struct CellHash {
 // first kept), so the result does not depend on hash-table order.
 std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
   std::vector<std::int32_t> map(v.size());
-  if (tol <= 0.0) {
+  // no tolerance (or none a grid can hold: a NaN or infinite one from a huge bounding box) merges
+  // bit-identical vertices only
+  if (!(tol > 0.0) || !std::isfinite(tol)) {
     std::vector<std::int32_t> order(v.size());
     std::iota(order.begin(), order.end(), 0);
     auto less = [&](std::int32_t a, std::int32_t b) {
@@ -81,10 +83,14 @@ std::vector<std::int32_t> weld_map(const std::vector<Vec3>& v, double tol) {
     return s;
   };
   const double tol2 = tol * tol;
+  // far vertices share the outermost cells (the distance test below stays exact), so a cell and
+  // its neighbours' indices never overflow
+  auto cell = [tol](double x) {
+    constexpr double kOutermost = 0x1p60;
+    return static_cast<std::int64_t>(std::clamp(std::floor(x / tol), -kOutermost, kOutermost));
+  };
   for (std::size_t i = 0; i < v.size(); ++i) {
-    const CellKey k{static_cast<std::int64_t>(std::floor(v[i].x / tol)),
-                    static_cast<std::int64_t>(std::floor(v[i].y / tol)),
-                    static_cast<std::int64_t>(std::floor(v[i].z / tol))};
+    const CellKey k{cell(v[i].x), cell(v[i].y), cell(v[i].z)};
     std::int32_t found = -1;
     for (std::int64_t dx = -1; dx <= 1; ++dx) {
       for (std::int64_t dy = -1; dy <= 1; ++dy) {

@@ -86,6 +86,28 @@ TEST(MeshImport, WeldToleranceMergesNearDuplicates) {
   EXPECT_EQ(welded->report.welded_vertices, 1);
 }
 
+// Welding divides coordinates by the tolerance into grid cells: a vertex far from the rest (its
+// cell past any integer) or a bounding box too large for a double (a NaN tolerance) must neither
+// overflow nor stop the near-duplicates from merging. UBSan, in the sanitizer stage, watches the casts.
+TEST(MeshImport, WeldingSurvivesCoordinatesFarBeyondTheTolerancesGrid) {
+  TriangleMesh cube = unit_cube();
+  cube.vertices.push_back({1.0 + 1e-11, 1.0, 1.0});
+  cube.triangles[2] = {4, 5, 8};
+  // used by no triangle, so dropped after welding; the diagonal it makes, 1.7e30, sets the
+  // tolerance to 1.7e-10, and its cell index to 6e39
+  cube.vertices.push_back({1e30, -1e30, 1e30});
+  const auto welded = validate_mesh(cube, {.weld_tolerance = 1e-40, .degenerate_area_tolerance = 0.0});
+  ASSERT_TRUE(welded) << welded.error().message;
+  EXPECT_EQ(welded->vertices.size(), 8u);
+
+  TriangleMesh huge = unit_cube();
+  for (Vec3& v : huge.vertices) v = v * 1.5e308 - Vec3{0.75e308, 0.75e308, 0.75e308};
+  huge.source_name = "huge.obj";
+  const auto result = validate_mesh(huge, {.weld_tolerance = 1e-6});  // its diagonal overflows
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("huge.obj"), std::string::npos) << result.error().message;
+}
+
 TEST(MeshImport, CubeMissingAFaceIsNotClosed) {
   TempDir dir("open");
   TriangleMesh cube = unit_cube();
