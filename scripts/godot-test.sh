@@ -2,7 +2,9 @@
 # The Godot addon's headless tests: the demo project (engines/godot/demo, its addon linked from
 # engines/godot/addons) runs engines/godot/tests/run_tests.gd in godot3-server against the uh
 # program of a build, on a free loopback port. Godot's HOME and XDG folders are kept inside the
-# build folder. A GDScript error does not end Godot, so the run is bounded by a timeout; a uh serve
+# build folder. A GDScript error does not end Godot, so the run is bounded by a timeout, longer than
+# the test's own waits (the soft demo's session may take 2 min to start, packing its block into a
+# cold cache on a loaded machine), so that a check rather than the timeout says what failed; a uh serve
 # the test started is ended by its process id if it outlived Godot.
 # usage: scripts/godot-test.sh BUILD_DIR     (prints "N passed, N failed"; exit status 1 on failure)
 #   UH_PROGRAM (environment): another uh than the build's; UH_GODOT_PROJECT: another copy of the demo
@@ -21,7 +23,7 @@ port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0
 log="$work/godot.log"
 HOME="$work/home" XDG_CONFIG_HOME="$work/config" XDG_DATA_HOME="$work/data" XDG_CACHE_HOME="$work/cache" \
   LANG=en_US.UTF-8 LC_ALL= UH_PROGRAM="$uh" UH_TEST_PORT="$port" UH_CACHE_DIR="${UH_CACHE_DIR:-$build/test-cache}" \
-  timeout -k 5 180 godot3-server --path "$project" -s "$root/engines/godot/tests/run_tests.gd" \
+  timeout -k 5 360 godot3-server --path "$project" -s "$root/engines/godot/tests/run_tests.gd" \
   >"$log" 2>&1
 code=$?
 cat "$log"

@@ -1,5 +1,6 @@
 #include "uh/collette/mesh_inside.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "triangle_bvh.hpp"
@@ -52,6 +53,47 @@ SurfacePoint MeshInside::nearest(const Vec3& p, double max_distance) const {
   out.face_normal = length > 0.0 ? n / length : Vec3{};
   out.distance = std::sqrt(d2);
   return out;
+}
+
+namespace {
+
+// p's foot on the plane of t, when it lies inside t (barycentric, with a sliver of tolerance so a
+// foot on an edge counts for both faces: the caller drops the repeat), and p's height above it.
+bool foot_inside(const Vec3& p, const detail::Triangle& t, Vec3& normal, double& height) {
+  const Vec3 e0 = t.b - t.a, e1 = t.c - t.a;
+  const Vec3 n = cross(e0, e1);
+  const double area2 = dot(n, n);
+  if (!(area2 > 0.0)) return false;
+  const Vec3 ap = p - t.a;
+  // barycentric coordinates of the foot, from the signed areas it makes with each edge
+  const double v = dot(cross(ap, e1), n) / area2;
+  const double w = dot(cross(e0, ap), n) / area2;
+  constexpr double kSliver = -1e-9;
+  if (v < kSliver || w < kSliver || 1.0 - v - w < kSliver) return false;
+  normal = n / std::sqrt(area2);
+  height = dot(ap, normal);
+  return true;
+}
+
+}  // namespace
+
+std::size_t MeshInside::faces_below(const Vec3& p, double max_distance, std::span<SurfacePoint> out) const {
+  std::size_t count = 0;
+  const auto& triangles = impl_->bvh.triangles();
+  impl_->bvh.visit_near(p, max_distance * max_distance, [&](std::int32_t i) {
+    Vec3 normal{};
+    double height = 0.0;
+    if (!foot_inside(p, triangles[static_cast<std::size_t>(i)], normal, height)) return;
+    if (!(height >= 0.0 && height <= max_distance)) return;
+    // insert, nearest first, into the `out.size()` kept so far
+    std::size_t at = count < out.size() ? count : out.size();
+    while (at > 0 && out[at - 1].distance > height) --at;
+    if (at >= out.size()) return;
+    for (std::size_t j = std::min(count, out.size() - 1); j > at; --j) out[j] = out[j - 1];
+    out[at] = {.found = true, .point = p - height * normal, .face_normal = normal, .distance = height};
+    count = std::min(count + 1, out.size());
+  });
+  return count;
 }
 
 }  // namespace uh::collette

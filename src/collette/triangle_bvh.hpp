@@ -2,6 +2,7 @@
 // Private: a binary BVH over a triangle mesh for exact closest-point and ray-crossing queries.
 // Used by MeshInside, the sphere packer and the mesh validation; not part of the public API.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <utility>
@@ -37,6 +38,10 @@ class TriangleBvh {
   /// triangles(); `max_d2` prunes the search (nothing nearer: max_d2, and the outputs untouched).
   double closest(const Vec3& p, Vec3* nearest = nullptr, double max_d2 = 1e300,
                  std::int32_t* triangle = nullptr) const;
+  /// Calls visit(index) for every triangle whose node's box lies within sqrt(max_d2) of p (a
+  /// superset of the triangles that do: the caller measures). No allocation.
+  template <typename Visit>
+  void visit_near(const Vec3& p, double max_d2, Visit&& visit) const;
   /// Crossings of the ray o + t d with 0 < t < t_max, appended as (t, w): w = +1 where the ray
   /// leaves through a triangle (along its outward normal), -1 where it enters.
   void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<std::pair<double, int>>& hits) const;
@@ -61,5 +66,29 @@ class TriangleBvh {
   std::vector<Triangle> tris_;
   std::vector<BvhNode> nodes_;
 };
+
+template <typename Visit>
+void TriangleBvh::visit_near(const Vec3& p, double max_d2, Visit&& visit) const {
+  if (tris_.empty()) return;
+  const auto outside2 = [&p](const BvhNode& n) {
+    const double dx = std::max({n.lo.x - p.x, 0.0, p.x - n.hi.x});
+    const double dy = std::max({n.lo.y - p.y, 0.0, p.y - n.hi.y});
+    const double dz = std::max({n.lo.z - p.z, 0.0, p.z - n.hi.z});
+    return dx * dx + dy * dy + dz * dz;
+  };
+  std::int32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const BvhNode& n = nodes_[static_cast<std::size_t>(stack[--top])];
+    if (outside2(n) > max_d2) continue;
+    if (n.count > 0) {
+      for (std::int32_t i = n.first; i < n.first + n.count; ++i) visit(i);
+    } else {
+      stack[top++] = n.first;
+      stack[top++] = n.first + 1;
+    }
+  }
+}
 
 }  // namespace uh::collette::detail

@@ -108,11 +108,13 @@ ToolProxy::ToolProxy(collette::CollisionWorld& world, collette::ObjectId tool, c
       options_(options),
       solver_({.radius_m = tool_radius(tool_tree),
                .rotate = rotate,
-               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16) + 2 * tool_tree.leaf_count()}),
+               .max_constraints = std::max<std::int32_t>(options.max_constraints, 16) +
+                                  2 * (1 + kCreaseRows) * tool_tree.leaf_count()}),
       slide_solver_({.radius_m = tool_radius(tool_tree), .rotate = rotate, .max_constraints = 6}),
       pair_capacity_(std::max<std::int32_t>(options.max_constraints, 16)),
-      // after the pairs: a smooth or surface row per tool sphere, two where it is near two objects
-      constraints_(static_cast<std::size_t>(pair_capacity_ + 2 * tool_tree.leaf_count())),
+      // after the pairs: a smooth or surface row per tool sphere and object near it (two objects at
+      // most), and a surface's crease rows
+      constraints_(static_cast<std::size_t>(pair_capacity_ + 2 * (1 + kCreaseRows) * tool_tree.leaf_count())),
       smooth_(static_cast<std::size_t>(tool_tree.leaf_count())) {
   touched_.reserve(static_cast<std::size_t>(tool_tree.leaf_count()));
 }
@@ -254,24 +256,61 @@ void ToolProxy::add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& 
 // penetration) away from the surface's nearest point, along the line to it. The distance to a face
 // is linear in the step and to a convex edge or corner convex, so the row is exact or conservative
 // there. A centre found on the inner side of the nearest face (it began inside, or a saddle corner)
-// gets no row: the sphere pairs hold it. Textures then raise each object's rows (texture_contact).
+// gets no row: the sphere pairs hold it. In a concave crease or corner the nearest face is one of
+// two or three the sphere touches, and which one flips as it moves: each face it lies squarely
+// above (crease_rows) adds its own row. Textures then raise each object's rows (texture_contact).
 void ToolProxy::append_surface(const Pose& proxy) {
   for (const SurfaceLeaf& near : near_surface_) {
     const WatchedObject& watched = watched_[static_cast<std::size_t>(near.tag)];
     const Vec3 p = transform_point(inverse(watched.world_from_object), near.centre);
-    const collette::SurfacePoint q =
-        watched.contact.surface->nearest(p, near.radius + options_.step_m + options_.penetration_m);
+    const double reach = near.radius + options_.step_m + options_.penetration_m;
+    const collette::SurfacePoint q = watched.contact.surface->nearest(p, reach);
     if (!q.found || dot(p - q.point, q.face_normal) < 0.0) continue;
     const Vec3 n_object = q.distance > 1e-12 ? (p - q.point) / q.distance : q.face_normal;
+    if (!add_surface_row(near, watched, n_object, q.distance, proxy.position)) break;
+    TextureContact& t = texture_contact_[static_cast<std::size_t>(near.tag)];
     const Vec3 n = rotate(watched.world_from_object.rotation, n_object);
     const double gap = q.distance - near.radius + options_.penetration_m;
-    if (constraint_count_ >= static_cast<std::int32_t>(constraints_.size())) break;
-    constraints_[static_cast<std::size_t>(constraint_count_++)] = {
-        .normal = n, .lever = (near.centre - near.radius * n) - proxy.position, .gap = gap, .tag = near.tag};
-    TextureContact& t = texture_contact_[static_cast<std::size_t>(near.tag)];
     if (gap < t.gap) t = {.gap = gap, .on_object = q.point, .on_tool = near.centre - near.radius * n};
+    if (!crease_rows(near, watched, p, reach, n_object, proxy.position)) break;
   }
   texture_rows({constraints_.data(), static_cast<std::size_t>(constraint_count_)});
+}
+
+// The row keeping a tool sphere `distance` from a surface along `n_object` (the object's frame);
+// false when the rows are full.
+bool ToolProxy::add_surface_row(const SurfaceLeaf& near, const WatchedObject& watched, const Vec3& n_object,
+                                double distance, const Vec3& proxy_position) {
+  if (constraint_count_ >= static_cast<std::int32_t>(constraints_.size())) return false;
+  const Vec3 n = rotate(watched.world_from_object.rotation, n_object);
+  constraints_[static_cast<std::size_t>(constraint_count_++)] = {.normal = n,
+                                                                 .lever = (near.centre - near.radius * n) - proxy_position,
+                                                                 .gap = distance - near.radius + options_.penetration_m,
+                                                                 .tag = near.tag};
+  return true;
+}
+
+// The other faces of a concave crease or corner: each face the sphere's centre lies squarely above
+// (its foot inside the face, so the row is the face's plane, exact) whose normal is more than
+// kCreaseAngle from the rows already there. A face's plane past its edges lies outside the object
+// only at a convex edge, where the centre is not squarely above the far face; a flat face's
+// triangles repeat one plane, so they add nothing. False when the rows are full.
+bool ToolProxy::crease_rows(const SurfaceLeaf& near, const WatchedObject& watched, const Vec3& p, double reach,
+                            const Vec3& nearest_normal, const Vec3& proxy_position) {
+  constexpr double kCosCreaseAngle = 0.9659;  // 15 degrees
+  std::array<collette::SurfacePoint, kCreaseRows + 4> faces{};
+  const std::size_t found = watched.contact.surface->faces_below(p, reach, faces);
+  std::array<Vec3, kCreaseRows + 1> taken{nearest_normal};
+  std::size_t count = 1;
+  for (std::size_t i = 0; i < found && count < taken.size(); ++i) {
+    const Vec3& n = faces[i].face_normal;
+    bool repeat = false;
+    for (std::size_t j = 0; j < count; ++j) repeat = repeat || dot(n, taken[j]) > kCosCreaseAngle;
+    if (repeat) continue;
+    if (!add_surface_row(near, watched, n, faces[i].distance, proxy_position)) return false;
+    taken[count++] = n;
+  }
+  return true;
 }
 
 // A texture is felt where the contact is, as the penalty path's surface stage feels it: each

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <random>
 
 #include "mesh_test_support.hpp"
@@ -70,6 +72,43 @@ TEST(MeshInside, DistanceMatchesBruteForce) {
     EXPECT_NEAR(inside.distance(p), ref, 1e-9 * (1.0 + ref));
     EXPECT_NEAR(norm(inside.closest_point(p) - p), ref, 1e-9 * (1.0 + ref));
     EXPECT_NEAR(std::abs(inside.signed_distance(p)), ref, 1e-9 * (1.0 + ref));
+  }
+}
+
+// faces_below keeps the faces a point lies squarely above, nearest first. The reference measures
+// every triangle another way: p lies squarely above a face when its distance to the triangle (the
+// segment-and-plane formula of the test support) is its height above the triangle's plane.
+TEST(MeshInside, FacesBelowMatchesEveryTriangleMeasuredByBruteForce) {
+  for (const TriangleMesh& m : {bunny(), test::torus(1.0, 0.3, 48, 24)}) {
+    const MeshInside inside(m);
+    const Aabb box = mesh_bounds(m);
+    const double reach = 0.05 * norm(box.max - box.min);
+    std::size_t compared = 0, with_two = 0;
+    for (const Vec3& p : random_points(box, 1000, 5)) {
+      std::vector<double> heights;
+      for (const auto& t : m.triangles) {
+        const Vec3& a = m.vertices[static_cast<std::size_t>(t[0])];
+        const Vec3& b = m.vertices[static_cast<std::size_t>(t[1])];
+        const Vec3& c = m.vertices[static_cast<std::size_t>(t[2])];
+        const double height = dot(p - a, normalized(cross(b - a, c - a)));
+        const double distance = test::triangle_distance(p, a, b, c);
+        if (height >= 0.0 && height <= reach && std::abs(distance - height) <= 1e-12 * (1.0 + reach))
+          heights.push_back(height);
+      }
+      std::sort(heights.begin(), heights.end());
+      std::array<SurfacePoint, 4> out{};
+      const std::size_t found = inside.faces_below(p, reach, out);
+      ASSERT_EQ(found, std::min(heights.size(), out.size())) << p.x << " " << p.y << " " << p.z;
+      for (std::size_t i = 0; i < found; ++i) {
+        EXPECT_NEAR(out[i].distance, heights[i], 1e-12 * (1.0 + reach));
+        EXPECT_NEAR(norm(p - out[i].point), heights[i], 1e-12 * (1.0 + reach));
+        EXPECT_NEAR(dot(p - out[i].point, out[i].face_normal), heights[i], 1e-12 * (1.0 + reach));
+      }
+      compared += found;
+      with_two += found >= 2 ? 1 : 0;
+    }
+    EXPECT_GT(compared, 100u) << m.source_name;  // enough points near the surface to mean something
+    EXPECT_GT(with_two, 0u) << m.source_name;    // and some in a concave part, above two faces
   }
 }
 

@@ -363,6 +363,85 @@ TEST(ToolProxy, TheForceChangesByAtMostKvTPerTickOverAnEdge) {
   EXPECT_GT(proxy.pose().position.z, -0.0055);  // and went over the edge, not through the slab
 }
 
+// An L-shaped block (one closed mesh, its cross-section in x-z extruded 6 cm along y): a floor
+// face at z = 0 for x in [0.02, 0.06] and a wall face at x = 0.02 for z in [0, 0.04] meet in a
+// concave crease along y at (0.02, 0).
+collette::TriangleMesh l_block_mesh() {
+  collette::TriangleMesh m;
+  m.source_name = "l_block";
+  const double section[6][2] = {{0.0, -0.02}, {0.06, -0.02}, {0.06, 0.0}, {0.02, 0.0}, {0.02, 0.04}, {0.0, 0.04}};
+  for (const double y : {-0.03, 0.03})
+    for (const auto& xz : section) m.vertices.push_back({xz[0], y, xz[1]});
+  // the caps: a fan from the corner (0, -0.02), which sees every other corner of the L
+  for (std::int32_t i = 1; i + 1 < 6; ++i) {
+    m.triangles.push_back({0, i, i + 1});          // y = -0.03, facing -y
+    m.triangles.push_back({6, 6 + i + 1, 6 + i});  // y = +0.03, facing +y
+  }
+  for (std::int32_t i = 0; i < 6; ++i) {  // the sides, around the section counter-clockwise seen from -y
+    const std::int32_t j = (i + 1) % 6;
+    m.triangles.push_back({i, 6 + j, j});
+    m.triangles.push_back({i, 6 + i, 6 + j});
+  }
+  return m;
+}
+
+// Force continuity in a concave crease of one mesh: a ball pressed into the L's inner corner along
+// the bisector, and then drawn out of it along the floor, is held by both faces at once. The
+// reference is the geometry: resting in the corner, the ball's centre is its radius (less the
+// allowed penetration) from each face, and the force is the spring's stiffness times the handle's
+// distance from there, so it changes by K v T a tick while the handle moves at v. Before each tool
+// sphere had a row for every face near it, the crease gave the ball one face at a time, and which
+// one flipped from tick to tick.
+TEST(ToolProxy, AConcaveCreaseHoldsTheToolOnBothFacesAtOnce) {
+  const collette::TriangleMesh m = l_block_mesh();
+  const auto valid = collette::validate_mesh(m);
+  ASSERT_TRUE(valid) << valid.error().message;
+  ASSERT_FALSE(valid->report.winding_flipped) << "the L is wound outward";
+  const Packed block = pack(m, 10000);
+  const double radius = 0.005;
+  const auto ball = std::make_shared<const collette::SphereTree>(
+      *collette::build_sphere_tree(std::vector<Sphere>{{0.f, 0.f, 0.f, static_cast<float>(radius)}}));
+  collette::CollisionWorld world({.rate_hz = 0.0, .contact_margin = 0.002});
+  const auto block_id = world.add_object({.tree = block.tree, .is_static = true, .name = "l_block"});
+  const auto tool_id = world.add_object({.tree = ball, .has_initial_pose = false, .name = "ball"});
+  ASSERT_TRUE(world.add_tool_watcher(*tool_id));
+  ToolProxy proxy(world, *tool_id, *ball, {.enabled = true}, true);
+  proxy.watch(*block_id, {.surface = std::make_shared<const collette::MeshInside>(*valid)});
+  proxy.bind();
+  const double stiffness = 1500.0, speed = 0.01, period = 1e-3, allowed = ToolProxyOptions{}.penetration_m;
+  const Vec3 corner{0.02, 0.0, 0.0}, bisector = normalized(Vec3{1.0, 0.0, 1.0});
+  const Vec3 rest = corner + (radius - allowed) * Vec3{1.0, 0.0, 1.0};  // touching both faces
+  Pose handle;
+  ProxyState state{};
+  Vec3 last{};
+  double largest_step = 0.0, largest_force = 0.0, nearest_face = 1.0, farthest_from_rest = 0.0;
+  const int ticks = 5000;
+  for (int i = 0; i < ticks; ++i) {
+    // from 2 cm out along the bisector in, at 1 cm/s, to 2 mm past where the ball rests; held for
+    // half a second; then along the floor, away from the wall, at 1 cm/s
+    const double in = std::min(speed * period * i, 0.02 + 0.002);
+    const double out = std::max(0.0, speed * period * (i - 2700));
+    handle.position = rest + (0.02 - in) * bisector + Vec3{out, 0.0, 0.0};
+    proxy.set_target(handle);
+    world.step(period * i);
+    if (const ProxyState* s = proxy.take()) state = *s;
+    const Vec3 force = stiffness * (proxy.slide(state, handle).position - handle.position);
+    if (i > 0) largest_step = std::max(largest_step, norm(force - last));
+    largest_force = std::max(largest_force, norm(force));
+    const Vec3 c = state.world_from_proxy.position;
+    nearest_face = std::min(nearest_face, std::max(c.x - corner.x, c.z - corner.z) - radius);
+    if (i >= 2300 && i < 2700) farthest_from_rest = std::max(farthest_from_rest, norm(c - rest));
+    last = force;
+  }
+  std::printf("in a concave crease: largest force %.3f N, largest step per tick %.4f N (K v T = %.4f N), "
+              "resting %.4f mm from both faces' rest, nearest a face %.4f mm\n",
+              largest_force, largest_step, stiffness * speed * period, farthest_from_rest * 1e3, nearest_face * 1e3);
+  EXPECT_GT(largest_force, 2.5);  // pressed 2 mm past the rest: 3 N along the bisector
+  EXPECT_LE(largest_step, 2.0 * stiffness * speed * period);
+  EXPECT_LT(farthest_from_rest, 0.1e-3);
+  EXPECT_GT(nearest_face, -allowed - 1e-6);
+}
+
 // A square peg (10 x 10 x 40 mm, packed) lowered, tilted 3 deg and 0.5 mm off centre, into a
 // 12 mm square hole 4 cm deep (four packed walls and a floor, each with its mesh): the 6-DOF proxy
 // slides and turns it down to the floor without snagging on the walls' packing, turning it by at

@@ -2,7 +2,9 @@
 /// \file
 /// MeshInside: exact point-to-surface distance and a robust inside test for a triangle mesh.
 
+#include <cstddef>
 #include <memory>
+#include <span>
 
 #include "uh/collette/triangle_mesh.hpp"
 
@@ -50,6 +52,12 @@ class MeshInside {
   /// wherever the nearest point is inside a face or on a convex edge or corner). Allocation-free;
   /// the search visits only the BVH nodes within `max_distance`.
   SurfacePoint nearest(const Vec3& p, double max_distance) const;
+  /// The faces p lies squarely above: within `max_distance` on the outer side of a triangle's plane,
+  /// its foot on that plane inside the triangle (so the distance to the face is the distance to its
+  /// plane, exact and linear in p). The nearest out.size() of them, nearest first, into `out`;
+  /// returns how many. Where nearest() gives one face, this gives each face of a concave crease or
+  /// corner. Allocation-free.
+  std::size_t faces_below(const Vec3& p, double max_distance, std::span<SurfacePoint> out) const;
 
  private:
   struct Impl;

@@ -177,6 +177,14 @@ class ToolProxy {
   void append_smooth(const Pose& proxy);
   void add_to_surface(std::int32_t leaf, std::int32_t tag, const Vec3& centre_world, double radius);
   void append_surface(const Pose& proxy);
+  struct SurfaceLeaf;
+  struct WatchedObject;
+  bool add_surface_row(const SurfaceLeaf& near, const WatchedObject& watched, const Vec3& n_object, double distance,
+                       const Vec3& proxy_position);
+  bool crease_rows(const SurfaceLeaf& near, const WatchedObject& watched, const Vec3& p, double reach,
+                   const Vec3& nearest_normal, const Vec3& proxy_position);
+  /// The most rows a tool sphere adds past its nearest face's, for the other faces of a crease or corner.
+  static constexpr std::int32_t kCreaseRows = 2;
   void texture_rows(std::span<forcecomp::ProxyConstraint> rows);
   void add_section(const ContactFrame& frame, const ContactSection& section);
   Pose advance(const Pose& from, const Pose& target, ProxyState& out);
