@@ -27,13 +27,18 @@ HOME="$work/home" XDG_CONFIG_HOME="$work/config" XDG_DATA_HOME="$work/data" XDG_
   >"$log" 2>&1
 code=$?
 cat "$log"
-pid=$(grep -oE "^uh serve pid [0-9]+" "$log" | grep -oE "[0-9]+$" | tail -n 1)
-# (an exited child whose parent is gone may stay a zombie where nothing reaps it: not running)
-if [ -n "$pid" ] && [ "$pid" -gt 0 ] && [ "$(ps -o comm= -p "$pid" 2>/dev/null)" = "uh" ] && \
-   [[ "$(ps -o stat= -p "$pid" 2>/dev/null)" != Z* ]]; then
-  echo "godot-test: the uh serve the test started (pid $pid) outlived Godot; ending it"
-  kill -TERM "$pid"
-fi
+# the uh serve processes the test started: those it printed, and one it started on this run's port
+# before it could print it (Godot timed out waiting for its session)
+pids=$( (grep -oE "^uh serve pid [0-9]+" "$log" | grep -oE "[0-9]+$"; \
+         pgrep -f -- "uh serve --host 127.0.0.1 --port $port\$") | sort -u)
+for pid in $pids; do
+  # (an exited child whose parent is gone may stay a zombie where nothing reaps it: not running)
+  if [ "$pid" -gt 0 ] && [ "$(ps -o comm= -p "$pid" 2>/dev/null)" = "uh" ] && \
+     [[ "$(ps -o stat= -p "$pid" 2>/dev/null)" != Z* ]]; then
+    echo "godot-test: the uh serve the test started (pid $pid) outlived Godot; ending it"
+    kill -TERM "$pid"
+  fi
+done
 if ! grep -qE "^[0-9]+ passed, [0-9]+ failed$" "$log"; then
   echo "godot-test: no result line (Godot exited with $code; a GDScript error or the timeout)"
   echo "0 passed, 1 failed"

@@ -77,13 +77,23 @@ bool foot_inside(const Vec3& p, const detail::Triangle& t, Vec3& normal, double&
 
 }  // namespace
 
-std::size_t MeshInside::faces_below(const Vec3& p, double max_distance, std::span<SurfacePoint> out) const {
+std::size_t MeshInside::faces_below(const Vec3& p, double max_distance, std::span<SurfacePoint> out,
+                                    const Vec3& turned_from, double min_turn) const {
   std::size_t count = 0;
   const auto& triangles = impl_->bvh.triangles();
-  impl_->bvh.visit_near(p, max_distance * max_distance, [&](std::int32_t i) {
+  const bool any = !(min_turn > 0.0) || !(norm(turned_from) > 0.0);
+  const double cos_turn = std::cos(min_turn), sin_turn = std::sin(min_turn);
+  // a node whose every normal lies within min_turn of turned_from holds no face wanted: its axis
+  // within min_turn - half_angle of it, cos(min_turn - half_angle) expanded so no node needs acos
+  const auto keep = [&](const detail::NormalCone& cone) {
+    if (any || cone.half_angle >= min_turn) return true;
+    return dot(cone.axis, turned_from) < cos_turn * cone.cos_half + sin_turn * cone.sin_half;
+  };
+  impl_->bvh.visit_near(p, max_distance * max_distance, keep, [&](std::int32_t i) {
     Vec3 normal{};
     double height = 0.0;
     if (!foot_inside(p, triangles[static_cast<std::size_t>(i)], normal, height)) return;
+    if (!any && dot(normal, turned_from) >= cos_turn) return;
     if (!(height >= 0.0 && height <= max_distance)) return;
     // insert, nearest first, into the `out.size()` kept so far
     std::size_t at = count < out.size() ? count : out.size();

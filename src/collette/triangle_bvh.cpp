@@ -79,6 +79,45 @@ TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices,
   std::vector<Triangle> in_leaf_order(tris_.size());
   for (std::size_t i = 0; i < order.size(); ++i) in_leaf_order[i] = tris_[static_cast<std::size_t>(order[i])];
   tris_.swap(in_leaf_order);
+  cones_.resize(nodes_.size());
+  fit_cone(0);
+}
+
+// Bottom-up: a leaf's cone about the mean of its unit normals, an inner node's about the mean of
+// its children's axes, wide enough for both children's cones (not the tightest, always enclosing).
+NormalCone TriangleBvh::fit_cone(std::int32_t node) {
+  const BvhNode& n = nodes_[static_cast<std::size_t>(node)];
+  NormalCone cone;
+  const auto angle = [](const Vec3& a, const Vec3& b) { return std::acos(std::clamp(dot(a, b), -1.0, 1.0)); };
+  if (n.count > 0) {
+    Vec3 sum{};
+    for (std::int32_t i = n.first; i < n.first + n.count; ++i) {
+      const Triangle& t = tris_[static_cast<std::size_t>(i)];
+      const Vec3 normal = cross(t.b - t.a, t.c - t.a);
+      if (norm(normal) > 0.0) sum += normalized(normal);
+    }
+    if (norm(sum) > 1e-9) {
+      cone.axis = normalized(sum);
+      cone.half_angle = 0.0;
+      for (std::int32_t i = n.first; i < n.first + n.count; ++i) {
+        const Triangle& t = tris_[static_cast<std::size_t>(i)];
+        const Vec3 normal = cross(t.b - t.a, t.c - t.a);
+        // a degenerate triangle has no normal to bound: the cone opens fully
+        cone.half_angle = norm(normal) > 0.0 ? std::max(cone.half_angle, angle(normalized(normal), cone.axis)) : kPi;
+      }
+    }
+  } else {
+    const NormalCone l = fit_cone(n.first), r = fit_cone(n.first + 1);
+    const Vec3 sum = l.axis + r.axis;
+    if (l.half_angle < kPi && r.half_angle < kPi && norm(sum) > 1e-9) {
+      cone.axis = normalized(sum);
+      cone.half_angle = std::min(kPi, std::max(angle(l.axis, cone.axis) + l.half_angle, angle(r.axis, cone.axis) + r.half_angle));
+    }
+  }
+  cone.cos_half = std::cos(cone.half_angle);
+  cone.sin_half = std::sin(cone.half_angle);
+  cones_[static_cast<std::size_t>(node)] = cone;
+  return cone;
 }
 
 void TriangleBvh::build(std::int32_t node, std::int32_t first, std::int32_t count,

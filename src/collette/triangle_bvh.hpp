@@ -28,6 +28,13 @@ struct BvhNode {
   std::int32_t count = 0;  // leaf: triangle count (> 0); inner: 0 (right child = left + 1)
 };
 
+/// The normals of a node's triangles all lie within `half_angle` of `axis` (unit) [rad].
+struct NormalCone {
+  Vec3 axis{};
+  double half_angle = kPi;
+  double cos_half = -1.0, sin_half = 0.0;  // of half_angle, for the queries' tests
+};
+
 class TriangleBvh {
  public:
   TriangleBvh() = default;
@@ -38,10 +45,11 @@ class TriangleBvh {
   /// triangles(); `max_d2` prunes the search (nothing nearer: max_d2, and the outputs untouched).
   double closest(const Vec3& p, Vec3* nearest = nullptr, double max_d2 = 1e300,
                  std::int32_t* triangle = nullptr) const;
-  /// Calls visit(index) for every triangle whose node's box lies within sqrt(max_d2) of p (a
-  /// superset of the triangles that do: the caller measures). No allocation.
-  template <typename Visit>
-  void visit_near(const Vec3& p, double max_d2, Visit&& visit) const;
+  /// Calls visit(index) for every triangle whose node's box lies within sqrt(max_d2) of p and whose
+  /// nodes' normal cones keep(cone) accepts (a superset of the triangles the caller wants: it
+  /// measures them). No allocation.
+  template <typename Keep, typename Visit>
+  void visit_near(const Vec3& p, double max_d2, Keep&& keep, Visit&& visit) const;
   /// Crossings of the ray o + t d with 0 < t < t_max, appended as (t, w): w = +1 where the ray
   /// leaves through a triangle (along its outward normal), -1 where it enters.
   void ray_hits(const Vec3& o, const Vec3& d, double t_max, std::vector<std::pair<double, int>>& hits) const;
@@ -63,12 +71,15 @@ class TriangleBvh {
   template <typename Visit>
   void ray_visit(const Vec3& o, const Vec3& d, double t_max, Visit&& visit) const;
 
+  NormalCone fit_cone(std::int32_t node);
+
   std::vector<Triangle> tris_;
   std::vector<BvhNode> nodes_;
+  std::vector<NormalCone> cones_;  // per node
 };
 
-template <typename Visit>
-void TriangleBvh::visit_near(const Vec3& p, double max_d2, Visit&& visit) const {
+template <typename Keep, typename Visit>
+void TriangleBvh::visit_near(const Vec3& p, double max_d2, Keep&& keep, Visit&& visit) const {
   if (tris_.empty()) return;
   const auto outside2 = [&p](const BvhNode& n) {
     const double dx = std::max({n.lo.x - p.x, 0.0, p.x - n.hi.x});
@@ -80,8 +91,9 @@ void TriangleBvh::visit_near(const Vec3& p, double max_d2, Visit&& visit) const 
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
-    const BvhNode& n = nodes_[static_cast<std::size_t>(stack[--top])];
-    if (outside2(n) > max_d2) continue;
+    const auto at = static_cast<std::size_t>(stack[--top]);
+    const BvhNode& n = nodes_[at];
+    if (outside2(n) > max_d2 || !keep(cones_[at])) continue;
     if (n.count > 0) {
       for (std::int32_t i = n.first; i < n.first + n.count; ++i) visit(i);
     } else {

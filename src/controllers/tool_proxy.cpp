@@ -272,7 +272,9 @@ void ToolProxy::append_surface(const Pose& proxy) {
     const Vec3 n = rotate(watched.world_from_object.rotation, n_object);
     const double gap = q.distance - near.radius + options_.penetration_m;
     if (gap < t.gap) t = {.gap = gap, .on_object = q.point, .on_tool = near.centre - near.radius * n};
-    if (!crease_rows(near, watched, p, reach, n_object, proxy.position)) break;
+    // the other faces' rows, once the nearest is within half a step: then they are too (none is
+    // nearer), as a sphere's nearest face gets its row half a step before the sphere reaches it
+    if (gap <= 0.5 * options_.step_m && !crease_rows(near, watched, p, reach, n_object, proxy.position)) break;
   }
   texture_rows({constraints_.data(), static_cast<std::size_t>(constraint_count_)});
 }
@@ -297,15 +299,16 @@ bool ToolProxy::add_surface_row(const SurfaceLeaf& near, const WatchedObject& wa
 // triangles repeat one plane, so they add nothing. False when the rows are full.
 bool ToolProxy::crease_rows(const SurfaceLeaf& near, const WatchedObject& watched, const Vec3& p, double reach,
                             const Vec3& nearest_normal, const Vec3& proxy_position) {
-  constexpr double kCosCreaseAngle = 0.9659;  // 15 degrees
+  constexpr double kCreaseAngle = 15.0 * kPi / 180.0;
+  const double cos_crease = std::cos(kCreaseAngle);
   std::array<collette::SurfacePoint, kCreaseRows + 4> faces{};
-  const std::size_t found = watched.contact.surface->faces_below(p, reach, faces);
+  const std::size_t found = watched.contact.surface->faces_below(p, reach, faces, nearest_normal, kCreaseAngle);
   std::array<Vec3, kCreaseRows + 1> taken{nearest_normal};
   std::size_t count = 1;
   for (std::size_t i = 0; i < found && count < taken.size(); ++i) {
     const Vec3& n = faces[i].face_normal;
     bool repeat = false;
-    for (std::size_t j = 0; j < count; ++j) repeat = repeat || dot(n, taken[j]) > kCosCreaseAngle;
+    for (std::size_t j = 0; j < count; ++j) repeat = repeat || dot(n, taken[j]) >= cos_crease;
     if (repeat) continue;
     if (!add_surface_row(near, watched, n, faces[i].distance, proxy_position)) return false;
     taken[count++] = n;

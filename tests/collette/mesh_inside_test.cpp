@@ -79,6 +79,7 @@ TEST(MeshInside, DistanceMatchesBruteForce) {
 // every triangle another way: p lies squarely above a face when its distance to the triangle (the
 // segment-and-plane formula of the test support) is its height above the triangle's plane.
 TEST(MeshInside, FacesBelowMatchesEveryTriangleMeasuredByBruteForce) {
+  std::size_t with_turned = 0;  // points above faces turned apart (the bunny's creases; the torus has none)
   for (const TriangleMesh& m : {bunny(), test::torus(1.0, 0.3, 48, 24)}) {
     const MeshInside inside(m);
     const Aabb box = mesh_bounds(m);
@@ -106,10 +107,32 @@ TEST(MeshInside, FacesBelowMatchesEveryTriangleMeasuredByBruteForce) {
       }
       compared += found;
       with_two += found >= 2 ? 1 : 0;
+      if (found == 0) continue;
+      // turned more than 15 deg from the nearest face's normal: the BVH's normal cones prune, the
+      // reference filters every face
+      const Vec3 from = out[0].face_normal;
+      const double turn = 15.0 * kPi / 180.0;
+      std::vector<double> turned;
+      for (const auto& t : m.triangles) {
+        const Vec3& a = m.vertices[static_cast<std::size_t>(t[0])];
+        const Vec3& b = m.vertices[static_cast<std::size_t>(t[1])];
+        const Vec3& c = m.vertices[static_cast<std::size_t>(t[2])];
+        const Vec3 n = normalized(cross(b - a, c - a));
+        const double height = dot(p - a, n);
+        if (height >= 0.0 && height <= reach && std::abs(test::triangle_distance(p, a, b, c) - height) <= 1e-12 * (1.0 + reach) &&
+            std::acos(std::clamp(dot(n, from), -1.0, 1.0)) > turn)
+          turned.push_back(height);
+      }
+      std::sort(turned.begin(), turned.end());
+      const std::size_t turned_found = inside.faces_below(p, reach, out, from, turn);
+      ASSERT_EQ(turned_found, std::min(turned.size(), out.size())) << p.x << " " << p.y << " " << p.z;
+      for (std::size_t i = 0; i < turned_found; ++i) EXPECT_NEAR(out[i].distance, turned[i], 1e-12 * (1.0 + reach));
+      with_turned += turned_found > 0 ? 1 : 0;
     }
     EXPECT_GT(compared, 100u) << m.source_name;  // enough points near the surface to mean something
     EXPECT_GT(with_two, 0u) << m.source_name;    // and some in a concave part, above two faces
   }
+  EXPECT_GT(with_turned, 0u);
 }
 
 TEST(MeshInside, OpenMeshUsesTheWindingNumber) {

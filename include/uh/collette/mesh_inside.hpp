@@ -54,10 +54,13 @@ class MeshInside {
   SurfacePoint nearest(const Vec3& p, double max_distance) const;
   /// The faces p lies squarely above: within `max_distance` on the outer side of a triangle's plane,
   /// its foot on that plane inside the triangle (so the distance to the face is the distance to its
-  /// plane, exact and linear in p). The nearest out.size() of them, nearest first, into `out`;
-  /// returns how many. Where nearest() gives one face, this gives each face of a concave crease or
-  /// corner. Allocation-free.
-  std::size_t faces_below(const Vec3& p, double max_distance, std::span<SurfacePoint> out) const;
+  /// plane, exact and linear in p), and its normal turned more than `min_turn` [rad] from
+  /// `turned_from` (unit; a zero vector: any face). The nearest out.size() of them, nearest first,
+  /// into `out`; returns how many. Where nearest() gives one face, this gives the other faces of a
+  /// concave crease or corner; the BVH's normal cones skip the flat and gently curved parts near p
+  /// whole. Allocation-free.
+  std::size_t faces_below(const Vec3& p, double max_distance, std::span<SurfacePoint> out,
+                          const Vec3& turned_from = {}, double min_turn = 0.0) const;
 
  private:
   struct Impl;
