@@ -9,13 +9,6 @@ namespace {
 
 constexpr int kLeafSize = 4;
 
-double box_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
-  const double dy = std::max({lo.y - p.y, 0.0, p.y - hi.y});
-  const double dz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
-  return dx * dx + dy * dy + dz * dz;
-}
-
 double component(const Vec3& v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
 
 }  // namespace

@@ -22,6 +22,14 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Triangle& t);
 /// Solid angle of triangle t seen from p, divided by 4 pi (Van Oosterom & Strackee).
 double triangle_winding(const Vec3& p, const Triangle& t);
 
+/// Squared distance from p to the box [lo, hi] (0 inside).
+inline double box_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x});
+  const double dy = std::max({lo.y - p.y, 0.0, p.y - hi.y});
+  const double dz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+  return dx * dx + dy * dy + dz * dz;
+}
+
 struct BvhNode {
   Vec3 lo, hi;
   std::int32_t first = 0;  // leaf: first triangle in the permuted order; inner: left child index
@@ -81,19 +89,13 @@ class TriangleBvh {
 template <typename Keep, typename Visit>
 void TriangleBvh::visit_near(const Vec3& p, double max_d2, Keep&& keep, Visit&& visit) const {
   if (tris_.empty()) return;
-  const auto outside2 = [&p](const BvhNode& n) {
-    const double dx = std::max({n.lo.x - p.x, 0.0, p.x - n.hi.x});
-    const double dy = std::max({n.lo.y - p.y, 0.0, p.y - n.hi.y});
-    const double dz = std::max({n.lo.z - p.z, 0.0, p.z - n.hi.z});
-    return dx * dx + dy * dy + dz * dz;
-  };
   std::int32_t stack[128];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const auto at = static_cast<std::size_t>(stack[--top]);
     const BvhNode& n = nodes_[at];
-    if (outside2(n) > max_d2 || !keep(cones_[at])) continue;
+    if (box_distance2(p, n.lo, n.hi) > max_d2 || !keep(cones_[at])) continue;
     if (n.count > 0) {
       for (std::int32_t i = n.first; i < n.first + n.count; ++i) visit(i);
     } else {
