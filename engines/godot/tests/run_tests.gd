@@ -124,13 +124,23 @@ func _run_soft():
 		check(vertices.size() > 1000 and at_rest,
 			"drawn: %d vertices, the top under the stylus at z = %.6f m (0 at rest; %d deformed surfaces drawn)"
 			% [vertices.size(), first, updated])
+		# watched for one whole press and release at least (the line's period is 4 s), sampled every
+		# 0.1 s: the frames go on while the deformed surfaces come (they once stopped for minutes)
 		var lowest = first
-		until = OS.get_ticks_msec() + 20000
-		while lowest > rest - 5e-4 and OS.get_ticks_msec() < until:
+		var samples = 0
+		var longest_ms = 0
+		var last = OS.get_ticks_msec()
+		until = last + 20000
+		while (lowest > rest - 5e-4 or samples < 45) and OS.get_ticks_msec() < until:
 			yield(create_timer(0.1), "timeout")
+			samples += 1
+			longest_ms = max(longest_ms, OS.get_ticks_msec() - last)
+			last = OS.get_ticks_msec()
 			lowest = min(lowest, _lowest_under_stylus(instance))
 		check(lowest < rest - 1e-4, "the drawn block's top goes down under the stylus: %.2f mm (%d deformed surfaces drawn)"
 			% [(lowest - rest) * 1000.0, block.soft_updates])
+		check(samples >= 45 and longest_ms < 2000,
+			"the frames go on while deformed surfaces come: %d samples of 0.1 s, the longest %d ms" % [samples, longest_ms])
 	var pid = manager.child_pid
 	soft.queue_free()
 	yield(create_timer(0.2), "timeout")

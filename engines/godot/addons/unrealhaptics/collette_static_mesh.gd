@@ -6,7 +6,8 @@ extends Spatial
 # spheres as a mesh file would be; its pose is this node's global transform, and follows the node
 # while the session runs (follow_node). The object's name in the service is the node's name.
 # With `deformable_json` the object is soft (docs/deformables.md): the service's refined surface
-# (get_mesh) is drawn by a MeshInstance child "SoftMesh" and follows each state's `deformed` vertices.
+# (get_mesh) is drawn by a MeshInstance child "SoftMesh" and follows the states' `deformed` vertices (the
+# newest, once a frame).
 
 const MeshData = preload("mesh_data.gd")
 const Paths = preload("paths.gd")

@@ -64,6 +64,7 @@ var _tool_node = null
 var _volumes = []
 var _sent_poses = {}
 var _soft_nodes = {}  # object name -> the ColletteStaticMesh of a soft object
+var _newest_deformed = {}  # object name -> the newest `deformed` entry not drawn yet
 
 
 func _ready():
@@ -77,6 +78,7 @@ func _process(_delta):
 	if _new_state:
 		_new_state = false
 		emit_signal("move_on_haptic_tick", tool_position(), tool_orientation(), int(state.get("buttons", 0)))
+	_draw_deformed()
 	if running:
 		_send_moved_poses()
 
@@ -338,7 +340,7 @@ func _dispatch(m):
 		_new_state = true
 		for entry in m.get("deformed", []):
 			if _soft_nodes.has(entry.get("object")):
-				_soft_nodes[entry["object"]].on_deformed(entry)
+				_newest_deformed[entry["object"]] = entry
 		for volume in _volumes:
 			volume.on_state(m)
 	elif type == "contact":
@@ -396,6 +398,17 @@ func _wait_blocking(id, timeout_ms):
 		OS.delay_msec(2)
 	_waiting_id = ""
 	return _reply_taken
+
+
+# Each soft object's newest deformed surface, drawn once a frame. Drawing one takes longer than a
+# state takes to come on a slow machine; drawn as each came, within the socket's poll (which reads
+# for as long as data is waiting), the frame would never end while the service sends.
+func _draw_deformed():
+	var entries = _newest_deformed
+	_newest_deformed = {}
+	for name in entries:
+		if _soft_nodes.has(name):
+			_soft_nodes[name].on_deformed(entries[name])
 
 
 func _send_moved_poses():
