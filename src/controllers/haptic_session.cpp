@@ -524,7 +524,8 @@ Status HapticSession::start(std::ostream* trace) {
   if (auto started = world_->start(); !started) return started;
   for (std::size_t i = 0; i < soft_.size(); ++i) {
     if (!soft_[i]) continue;
-    if (auto started = soft_[i]->start(soft_rate_hz(i)); !started) {
+    // a failed step leaves the object frozen under the tool: every device gets zero at its next tick
+    if (auto started = soft_[i]->start(soft_rate_hz(i), [this] { fault_group_.trip(); }); !started) {
       stop_soft();
       world_->stop();
       return started;
@@ -549,6 +550,11 @@ Status HapticSession::start(std::ostream* trace) {
 
 bool HapticSession::any_fault() const {
   return std::any_of(rigs_.begin(), rigs_.end(), [](const auto& rig) { return rig->manager->faulted(); });
+}
+
+bool HapticSession::ended_by_itself() const {
+  return phase_ == Phase::kRunning && (!haptic_threads_running() || !world_->running() || !soft_threads_running() ||
+                                       any_fault() || fault_group_.tripped());
 }
 
 bool HapticSession::soft_threads_running() const {
@@ -718,7 +724,7 @@ Status HapticSession::run(double seconds, const std::function<void(const Session
   // zero already; a soft object's simulation leaves its object frozen), or a device fault (every
   // device gets zero from its next tick on), ends the run
   while (std::chrono::steady_clock::now() < end && !stop_requested_.load(std::memory_order_relaxed) &&
-         haptic_threads_running() && world_->running() && soft_threads_running() && !any_fault()) {
+         !ended_by_itself()) {
     const auto soon = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
     std::this_thread::sleep_until(std::min({end, next_status, soon}));
     if (on_status && std::chrono::steady_clock::now() >= next_status) {

@@ -252,6 +252,8 @@ Status SoftSimulation::find_compliances(double dt_s) {
 }
 
 Status SoftSimulation::step(double dt_s) {
+  if (fail_next_step_.exchange(false, std::memory_order_relaxed))
+    return Error{"the step was made to fail (fail_next_step)", ErrorKind::kThread};
   if (rotation_in_.update()) {  // moved: the world's forces and its down turn into the object's frame anew
     object_from_world_ = conjugate(rotation_in_.read_buffer());
     down_in_object_ = rotate(object_from_world_, Vec3{0.0, 0.0, -1.0});
@@ -422,7 +424,7 @@ std::uint64_t SoftSimulation::read_surface(std::span<float> xyz) {
   return newest.step;
 }
 
-Status SoftSimulation::start(double rate_hz) {
+Status SoftSimulation::start(double rate_hz, std::function<void()> on_failure) {
   // no spinning before each deadline: the simulation shares the machine's cores with the haptic
   // and collision threads, and a millisecond late is nothing at its rate
   // a step is a fixed stretch of the simulation's time: steps late after a slow one (preempted,
@@ -434,9 +436,10 @@ Status SoftSimulation::start(double rate_hz) {
   // a worker the steps go on meanwhile (stepped runs, which must repeat exactly, never start this)
   work_in_background(true);
   const double dt_s = 1.0 / rate_hz;
-  return loop_->start([this, dt_s](const TickInfo&) {
+  return loop_->start([this, dt_s, on_failure = std::move(on_failure)](const TickInfo&) {
     // a fixed step whatever the tick's lateness: the simulation's time is its own
     if (Status s = step(dt_s); !s) {
+      if (on_failure) on_failure();
       failure_ = s;
       loop_->request_stop();
     }

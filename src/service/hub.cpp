@@ -416,17 +416,19 @@ void Hub::build_finished(std::uint64_t generation, Result<std::unique_ptr<contro
         std::chrono::duration<double>(*seconds)));
     stop_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
       if (ec || !slot_ || generation != generation_ || slot_->phase != Phase::kRunning) return;
-      Status status{Ok{}};
-      json state;
-      json report = stop_session(&status, &state);
-      json fields = {{"report", std::move(report)},
-                     {"state", std::move(state)},
-                     {"reason", "the session's seconds elapsed"}};
-      if (!status) fields["error"] = status.error().message;
-      send_to(slot_->controller, reply("stopped", nullptr, std::move(fields)));
-      broadcast_session("stopped");
+      stop_by_itself("the session's seconds elapsed");
     });
   }
+}
+
+void Hub::stop_by_itself(const std::string& reason) {
+  Status status{Ok{}};
+  json state;
+  json report = stop_session(&status, &state);
+  json fields = {{"report", std::move(report)}, {"state", std::move(state)}, {"reason", reason}};
+  if (!status) fields["error"] = status.error().message;
+  send_to(slot_->controller, reply("stopped", nullptr, std::move(fields)));
+  broadcast_session("stopped");
 }
 
 json Hub::stop_session(Status* status_out, json* state_out) {
@@ -567,6 +569,12 @@ void Hub::add_deformed(Client& c, json& state) {
 
 void Hub::poll_events() {
   if (!slot_ || slot_->phase != Phase::kRunning) return;
+  // a thread that ended or a device that faulted has zeroed the force already; the session ends
+  // and its controller learns why (a hosted session's owner sees it itself)
+  if (!slot_->hosted && slot_->session->ended_by_itself()) {
+    stop_by_itself("a thread of the session ended or a device faulted");
+    return;
+  }
   controllers::ContactEvent event;
   const controllers::Scene& scene = slot_->scene();
   while (slot_->session->poll_event(event)) {

@@ -131,6 +131,8 @@ class Hub final : public Endpoint {
   // stops a running session; the report's JSON (or null when nothing ran); `state_out` gets the
   // state after the stop (with the zero force sent)
   json stop_session(Status* status_out = nullptr, json* state_out = nullptr);
+  // stops the running session and sends its controller an unsolicited `stopped` with `reason`
+  void stop_by_itself(const std::string& reason);
   void close_slot();
   void broadcast_session(std::string_view status);
   void send_state(ClientId id);

@@ -25,6 +25,7 @@
 
 #include "mesh_binary.hpp"
 #include "protocol.hpp"
+#include "haply_standin.hpp"
 #include "service_test_support.hpp"
 #include "test_paths.hpp"
 #include "uh/collette/mesh_import.hpp"
@@ -524,6 +525,42 @@ TEST_F(ServerTest, AWatchedSoftBlockStreamsItsDeformedVertices) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - first).count();
   EXPECT_LE(deformed_states, seconds * kDeformedRateHz + 2);
   c.request({{"type", "stop"}}, "stopped");
+}
+
+// The device faults while the session runs (the loopback Inverse Service answers with an error
+// after 300 replies): the device was sent zero, the service ends the session by itself and tells
+// its controller why, unasked, and watchers see it stopped; a new start may follow.
+TEST_F(ServerTest, ASessionWhoseDeviceFaultsEndsByItselfAndItsControllerIsTold) {
+  devices::testing::HaplyStandinScript failing;
+  failing.fault = devices::testing::HaplyFault::kError;
+  failing.fault_after = 300;
+  devices::testing::HaplyStandinService haply(failing);
+  Client c(port());
+  c.hello();
+  Client watcher(port());
+  watcher.hello();
+  c.request({{"type", "open"}, {"scene", scene_.filename().string()}}, "opened");
+  c.request({{"type", "set_device"}, {"device", {{"driver", "haply"}, {"config", {{"url", haply.url()}}}}}},
+            "device_set");
+  watcher.request({{"type", "subscribe"}, {"rate_hz", 50}}, "subscribed");
+  c.request({{"type", "start"}}, "started");
+  const json stopped = c.expect("stopped");
+  EXPECT_FALSE(stopped.contains("id")) << "unasked";
+  EXPECT_EQ(stopped["reason"], "a thread of the session ended or a device faulted");
+  EXPECT_NE(stopped["error"].get<std::string>().find(
+                "device 'haply Inverse3 049D' faulted: the service reported an error: Inverse3 049D: the motors "
+                "are too hot; it was sent zero force"),
+            std::string::npos)
+      << stopped["error"];
+  EXPECT_GT(stopped["report"]["haptic"]["ticks"].get<int>(), 0);
+  EXPECT_EQ(stopped["state"]["force"], json::array({0.0, 0.0, 0.0}));
+  ASSERT_FALSE(haply.received().empty());
+  EXPECT_EQ(haply.received().back(), Vec3{}) << "the last force the device was commanded";
+  for (json m = watcher.expect("session"); m["status"] != "stopped"; m = watcher.expect("session")) {
+  }
+  // the session is open again: it may start anew (the stand-in faults again, and is told again)
+  c.request({{"type", "start"}}, "started");
+  EXPECT_EQ(c.expect("stopped")["reason"], "a thread of the session ended or a device faulted");
 }
 
 TEST_F(ServerTest, OneClientControlsOthersWatchAndItsDisconnectStopsTheSession) {

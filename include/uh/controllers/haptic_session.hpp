@@ -285,10 +285,15 @@ class HapticSession {
 
   /// True from start() until stop(). Owner thread.
   bool running() const { return phase_ == Phase::kRunning; }
+  /// While running: a haptic, the collision or a soft object's simulation thread ended by itself,
+  /// or a device faulted; every device has been sent zero (or gets it at its next tick), and
+  /// stop() returns the cause. A host that runs the session with start() polls this (run() does).
+  /// Owner thread.
+  bool ended_by_itself() const;
 
   /// start(), then calls `on_status` on this thread about every 250 ms for `seconds`, then stop().
-  /// Ends early (within 20 ms) on request_stop(), on a device fault, or when a haptic or the
-  /// collision thread ended by itself (stop() then returns the cause, e.g. what a tick threw). stop() also
+  /// Ends early (within 20 ms) on request_stop() or when the session ended by itself
+  /// (ended_by_itself(); stop() then returns the cause, e.g. what a tick threw). stop() also
   /// runs when `on_status` throws.
   Status run(double seconds, const std::function<void(const SessionState&)>& on_status = {},
              std::ostream* trace = nullptr);
@@ -314,6 +319,7 @@ class HapticSession {
   const SoftSimulation* soft_simulation(std::size_t object) const {
     return object < soft_.size() ? soft_[object].get() : nullptr;
   }
+  SoftSimulation* soft_simulation(std::size_t object) { return object < soft_.size() ? soft_[object].get() : nullptr; }
   /// Scene object `object`'s drawn surface at rest (its mesh refined, load_soft_surface): the
   /// triangles of the deformed vertices. An error naming the object when it is rigid or there is
   /// no such object.

@@ -18,8 +18,10 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -162,10 +164,15 @@ class SoftSimulation {
   /// Controlling thread, while no step runs.
   void work_in_background(bool on);
 
-  /// Runs step() at `rate_hz` on its own thread until stop(), working in the background.
-  /// Controlling thread.
-  Status start(double rate_hz);
+  /// Runs step() at `rate_hz` on its own thread until stop(), working in the background. A step
+  /// that fails ends the thread; `on_failure` is called on it first (the session zeroes every
+  /// device's force there: the object would otherwise stand frozen under the tool). Controlling
+  /// thread.
+  Status start(double rate_hz, std::function<void()> on_failure = {});
   void stop();
+  /// Fault injection, for tests of what a failed step does (a failed solve is hard to cause on
+  /// purpose): the next step fails as a failed solve would. Any thread; real-time safe.
+  void fail_next_step() { fail_next_step_.store(true, std::memory_order_relaxed); }
   /// Whether the simulation thread runs (true before start()): a failed step ends it.
   bool running() const { return !loop_ || loop_->running(); }
   /// The simulation thread's failure (a step that failed ends the thread), once it stopped.
@@ -270,6 +277,7 @@ class SoftSimulation {
   std::vector<SoftSample> record_;
   std::unique_ptr<FixedRateLoop> loop_;  // made by start()
   Status failure_ = Ok{};
+  std::atomic<bool> fail_next_step_{false};
 };
 
 }  // namespace uh::controllers
