@@ -434,6 +434,13 @@ UH_API uh_status uh_session_set_object_pose(uh_session_id s, int32_t object, con
  * start. */
 UH_API uh_status uh_session_set_tick_callback(uh_session_id s, uh_tick_fn fn, void* user);
 
+/* *out = 1 when the running session ended by itself: a device faulted, or a haptic, the collision
+ * or a soft object's simulation thread ended (every device was sent zero at its next tick);
+ * uh_session_stop then returns the cause (UH_ERROR_DEVICE or UH_ERROR_THREAD) and uh_last_error
+ * says it. 0 while it runs as it should, before start and after stop. A host polls it, e.g. once
+ * a frame, and stops the session when it is 1. */
+UH_API uh_status uh_session_ended(uh_session_id s, int32_t* out);
+
 /* Sends zero force at once, stops and joins every thread, completes the report. Idempotent: later
  * calls return what the first returned. UH_ERROR_THREAD if a thread had ended on its own,
  * UH_ERROR_DEVICE if a device faulted (the report is still complete). Before start: UH_OK,

@@ -319,6 +319,15 @@ uh_status uh_session_set_tick_callback(uh_session_id s, uh_tick_fn callback, voi
   });
 }
 
+uh_status uh_session_ended(uh_session_id s, int32_t* out) {
+  const char* const fn = __func__;
+  return with_session(fn, s, [&](SessionBox& box) -> uh_status {
+    if (out == nullptr) return null_argument(fn, "out");
+    *out = box.session->ended_by_itself() ? 1 : 0;
+    return UH_OK;
+  });
+}
+
 uh_status uh_session_stop(uh_session_id s) {
   const char* const fn = __func__;
   return with_session(fn, s, [&](SessionBox& box) -> uh_status {

@@ -192,7 +192,7 @@ static void test_threaded_session(void) {
   uh_session_id s = open_small_session();
   uh_state st;
   uh_contact_event e;
-  int32_t has_event = 0, begins = 0, i;
+  int32_t has_event = 0, begins = 0, i, ended = 1;
   double max_force = 0.0;
   int32_t max_pairs = 0;
   uint64_t last_ticks = 0;
@@ -203,6 +203,8 @@ static void test_threaded_session(void) {
   CHECK_STATUS(uh_session_start(s), UH_ERROR_WRONG_STATE);
   CHECK_STATUS(uh_session_set_tick_callback(s, record_tick, NULL), UH_ERROR_WRONG_STATE);
   for (i = 0; i < 600; ++i) { /* about 1.2 s */
+    REQUIRE_OK(uh_session_ended(s, &ended));
+    CHECK(ended == 0); /* nothing faults here */
     REQUIRE_OK(uh_session_poll(s, &st));
     CHECK(st.haptic_ticks >= last_ticks);
     last_ticks = st.haptic_ticks;
@@ -213,6 +215,9 @@ static void test_threaded_session(void) {
     sleep_ms(2);
   }
   REQUIRE_OK(uh_session_stop(s));
+  ended = 1;
+  REQUIRE_OK(uh_session_ended(s, &ended));
+  CHECK(ended == 0); /* stopped, not ended by itself */
   REQUIRE_OK(uh_session_poll(s, &st));
   CHECK(norm3(st.force) == 0.0); /* the device got zero at stop */
   CHECK(last_ticks > 300);       /* ~1200 at 1 kHz; loose for sanitizer builds */
@@ -288,6 +293,10 @@ static void test_handle_misuse(void) {
   st.struct_size = sizeof st;
   CHECK_STATUS(uh_session_poll(s, NULL), UH_ERROR_INVALID_ARGUMENT);
   CHECK_STATUS(uh_session_poll_event(s, &e, NULL), UH_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(uh_session_ended(s, NULL), UH_ERROR_INVALID_ARGUMENT);
+  count = 1;
+  CHECK_STATUS(uh_session_ended(s, &count), UH_OK);
+  CHECK(count == 0); /* before start */
   CHECK_STATUS(uh_session_object_name(s, 7, &text), UH_ERROR_INVALID_ARGUMENT);
   CHECK_STATUS(uh_session_object_name(s, 0, &text), UH_OK);
   CHECK(text != NULL && strcmp(text, "bunny") == 0);
@@ -314,6 +323,7 @@ static void test_handle_misuse(void) {
   CHECK_STATUS(uh_session_stop(stale_handle), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_poll_event(stale_handle, &e, &has_event), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_object_count(stale_handle, &count), UH_ERROR_STALE_HANDLE);
+  CHECK_STATUS(uh_session_ended(stale_handle, &count), UH_ERROR_STALE_HANDLE);
   CHECK_STATUS(uh_session_start(none), UH_ERROR_STALE_HANDLE);
   {
     const uh_session_id made_up = {0xdeadbeef0ull};

@@ -176,6 +176,7 @@ namespace UnrealHaptics
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_poll_event(uh_session_id session, ref uh_contact_event e, out int has_event);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_set_object_pose(uh_session_id session, int @object, double[] position, double[] orientation);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_set_tick_callback(uh_session_id session, uh_tick_fn fn, IntPtr user);
+        [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_ended(uh_session_id session, out int ended);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_stop(uh_session_id session);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_report_json(uh_session_id session, out IntPtr json);
         [DllImport(Library, CallingConvention = CallingConvention.Cdecl)] public static extern int uh_session_object_count(uh_session_id session, out int count);

@@ -199,6 +199,19 @@ namespace UnrealHaptics
             return Native.Utf8Out(name);
         }
 
+        /// <summary>True when the running session ended by itself: a device faulted, or a libuh
+        /// thread ended (every device was sent zero at its next tick); Stop() then throws the cause.
+        /// False while it runs as it should, before Start() and after Stop(). Owner thread.</summary>
+        public bool EndedByItself
+        {
+            get
+            {
+                int ended;
+                Native.Check(Native.uh_session_ended(Raw, out ended), "uh_session_ended");
+                return ended != 0;
+            }
+        }
+
         /// <summary>Sends zero force at once, stops and joins every thread and returns the report
         /// (the JSON object `uh run --json` prints). Idempotent. Throws if a thread had ended on its
         /// own (the session is stopped all the same).</summary>

@@ -60,6 +60,12 @@ namespace UnrealHaptics.Components
             ContactEvent e;
             while (session_.PollEvent(out e))
                 if (OnContact != null) OnContact(e, session_.ObjectName(e.Object));
+            // a device fault or a libuh thread that ended zeroed the force already: stop, and say why
+            if (session_.EndedByItself)
+            {
+                try { StopHaptics(); }
+                catch (UhException ex) { Debug.LogError("UnrealHaptics: the session ended by itself: " + ex.Message); }
+            }
         }
 
         void OnDisable() { StopHaptics(); }

@@ -116,6 +116,7 @@ static class SessionTests
                 st = s.Poll();
             }
             Expect(st.HapticTicks >= 200, "the haptic thread ticks: " + st.HapticTicks);
+            Expect(!s.EndedByItself, "a session that runs as it should has not ended by itself");
             Expect(Math.Abs(Norm(st.ToolOrientation) - 1.0) < 1e-9, "a unit orientation");
             foreach (var f in st.Force) Expect(!double.IsNaN(f) && !double.IsInfinity(f), "a finite force");
             var report = s.Stop();
@@ -123,6 +124,7 @@ static class SessionTests
             var after = s.Poll();
             Expect(Norm(after.Force) == 0.0 && Norm(after.Torque) == 0.0, "zero force after Stop()");
             Expect(s.Stop() == report, "Stop() is idempotent");
+            Expect(!s.EndedByItself, "stopped, not ended by itself");
         }
     }
 

@@ -219,7 +219,24 @@ void AHapticManager::Tick(float DeltaSeconds)
 		PollState();
 		PollEvents();
 		DrawDebug();
+		StopIfEndedByItself();
 	}
+}
+
+// A device that faulted or a libuh thread that ended has had the force zeroed already: the
+// session is stopped (its report kept, OnSessionStopped) and the cause reported (OnSessionFailed),
+// rather than the level running on with a tool that no longer moves or pushes.
+void AHapticManager::StopIfEndedByItself()
+{
+	const FUhApi* Api = FUhApi::Get();
+	int32 Ended = 0;
+	if (Api->uh_session_ended(AsId(SessionId), &Ended) != UH_OK || Ended == 0)
+	{
+		return;
+	}
+	const FString Why = Api->uh_session_stop(AsId(SessionId)) != UH_OK ? Api->LastError() : FString(TEXT("the session ended by itself"));
+	StopHaptics();
+	Fail(Why);
 }
 
 void AHapticManager::PollState()

@@ -36,6 +36,7 @@
 	X(uh_session_set_object_pose) \
 	X(uh_session_object_count) \
 	X(uh_session_object_name) \
+	X(uh_session_ended) \
 	X(uh_session_stop) \
 	X(uh_session_report_json) \
 	X(uh_session_destroy)

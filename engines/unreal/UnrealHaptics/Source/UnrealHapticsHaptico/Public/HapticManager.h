@@ -119,7 +119,8 @@ public:
 	UPROPERTY(BlueprintAssignable, Category = "Haptics") FUhSessionStarted OnSessionStarted;
 	/** Game thread: the session stopped (StopHaptics, EndPlay); the report as JSON. */
 	UPROPERTY(BlueprintAssignable, Category = "Haptics") FUhSessionStopped OnSessionStopped;
-	/** Game thread: the session could not be made or started; libuh's message. */
+	/** Game thread: the session could not be made or started, or ended by itself (a device fault, a
+	 *  libuh thread that ended: stopped first, OnSessionStopped); libuh's message. */
 	UPROPERTY(BlueprintAssignable, Category = "Haptics") FUhSessionFailed OnSessionFailed;
 	/** Game thread: a contact with a watched object began or ended. */
 	UPROPERTY(BlueprintAssignable, Category = "Haptics") FUhContactDelegate OnContact;
@@ -161,6 +162,7 @@ private:
 	void DiscardPendingBuild();
 	void PollState();
 	void PollEvents();
+	void StopIfEndedByItself();
 	void DrawDebug() const;
 	void CloseSession();
 
