@@ -509,6 +509,12 @@ class Session {
     return report();
   }
 
+  bool ended_by_itself() {
+    std::int32_t ended = 0;
+    check(uh_session_ended(session_, &ended));
+    return ended != 0;
+  }
+
   py::object run_stepped(double seconds, int ticks_per_collision_step) {
     call_released([&] { return uh_session_run_stepped(session_, seconds, ticks_per_collision_step); });
     return report();
@@ -697,6 +703,10 @@ PYBIND11_MODULE(unrealhaptics, m) {
       .def("events", &Session::events, "Contact events queued since the last call, oldest first.")
       .def("set_object_pose", &Session::set_object_pose, py::arg("object"), py::arg("position"),
            py::arg("orientation"))
+      .def_property_readonly("ended_by_itself", &Session::ended_by_itself,
+                             "True when the running session ended by itself: a device faulted or a thread "
+                             "ended (every device was sent zero at its next tick); stop() then raises the "
+                             "cause. False while it runs as it should, before start() and after stop().")
       .def("stop", &Session::stop,
            "Zero force, joins every thread; returns the report (the `uh run --json` object). Idempotent.")
       .def("run_stepped", &Session::run_stepped, py::arg("seconds"), py::arg("ticks_per_collision_step") = 4,

@@ -48,8 +48,10 @@ def test_threaded_session_polls_state_and_stop_returns_the_report(scene):
             assert st.buttons == 0  # the scene's scripted device presses none
             ticks.append(st.haptic_ticks)
             begins += sum(e.kind == "begin" for e in s.events())
+            assert not s.ended_by_itself  # nothing faults here
             time.sleep(0.002)
         report = s.stop()
+        assert not s.ended_by_itself  # stopped, not ended by itself
         assert s.stop() == report  # idempotent: the same report
         after = s.state()
     assert ticks == sorted(ticks) and ticks[-1] > 300
