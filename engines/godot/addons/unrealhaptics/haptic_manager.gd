@@ -348,9 +348,12 @@ func _dispatch(m):
 		for volume in _volumes:
 			volume.on_contact(m)
 	elif type == "stopped":
-		# stopped by the service itself (a start with seconds)
+		# stopped by the service itself: a start with seconds, or the session ended by itself (a
+		# device faulted or a thread ended; the force was zeroed), whose cause is `error`
 		running = false
 		emit_signal("session_stopped", m.get("report"), m.get("state", {}))
+		if m.has("error"):
+			_fail("uh serve: %s: %s" % [m.get("reason", "stopped"), m["error"]])
 	elif type == "error":
 		_fail("uh serve: %s" % m.get("message", ""))
 
