@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "forwarding_device.hpp"
 #include "scene_test_support.hpp"
 
 namespace uh::controllers {
@@ -33,25 +34,20 @@ Status run_until(HapticSession& session, Reached reached, std::ostream* trace = 
 
 // A driver whose read_state() throws on its `throw_at`-th read (a tick that throws), around a
 // simulated line device; it records the last command it got.
-class ThrowingDevice final : public haptico::HapticDevice {
+class ThrowingDevice final : public testing::ForwardingDevice {
  public:
   ThrowingDevice(std::unique_ptr<haptico::HapticDevice> inner, int throw_at, haptico::DeviceCommand* last)
-      : inner_(std::move(inner)), throw_at_(throw_at), last_(last) {}
-  haptico::DeviceInfo info() const override { return inner_->info(); }
-  Status open() override { return inner_->open(); }
-  Status close() override { return inner_->close(); }
+      : ForwardingDevice(std::move(inner)), throw_at_(throw_at), last_(last) {}
   haptico::DeviceState read_state() override {
     if (reads_++ == throw_at_) throw std::runtime_error("USB cable pulled");
-    return inner_->read_state();
+    return inner().read_state();
   }
   void command(const haptico::DeviceCommand& command) override {
     *last_ = command;
-    inner_->command(command);
+    inner().command(command);
   }
-  std::string fault_reason() override { return inner_->fault_reason(); }
 
  private:
-  std::unique_ptr<haptico::HapticDevice> inner_;
   int throw_at_;
   int reads_ = 0;
   haptico::DeviceCommand* last_;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "forwarding_device.hpp"
 #include "scene_test_support.hpp"
 #include "uh/controllers/haptic_session.hpp"
 
@@ -17,29 +18,25 @@ using testing::two_hands_scene_json;
 
 // A sim-line device that faults (kFault, with a reason) from its `fault_after`-th read on, and
 // records every force it was commanded: the test's view of what reached the hand.
-class FaultingDevice : public haptico::HapticDevice {
+class FaultingDevice : public testing::ForwardingDevice {
  public:
   FaultingDevice(std::unique_ptr<haptico::HapticDevice> inner, std::int64_t fault_after,
                  std::vector<Vec3>* commanded)
-      : inner_(std::move(inner)), fault_after_(fault_after), commanded_(commanded) {}
-  haptico::DeviceInfo info() const override { return inner_->info(); }
-  Status open() override { return inner_->open(); }
-  Status close() override { return inner_->close(); }
+      : ForwardingDevice(std::move(inner)), fault_after_(fault_after), commanded_(commanded) {}
   haptico::DeviceState read_state() override {
-    haptico::DeviceState s = inner_->read_state();
+    haptico::DeviceState s = inner().read_state();
     if (fault_after_ >= 0 && ++reads_ > fault_after_) s.status = haptico::DeviceStatus::kFault;
     return s;
   }
   void command(const haptico::DeviceCommand& cmd) override {
     if (commanded_->size() < commanded_->capacity()) commanded_->push_back(cmd.force);
-    inner_->command(cmd);
+    inner().command(cmd);
   }
   std::string fault_reason() override {
     return reads_ > fault_after_ && fault_after_ >= 0 ? "cable pulled" : "";
   }
 
  private:
-  std::unique_ptr<haptico::HapticDevice> inner_;
   std::int64_t fault_after_;
   std::int64_t reads_ = 0;
   std::vector<Vec3>* commanded_;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <thread>
 
+#include "forwarding_device.hpp"
 #include "scene_test_support.hpp"
 #include "soft_block_support.hpp"
 #include "uh/controllers/haptic_session.hpp"
@@ -54,33 +55,27 @@ TEST(SoftSessionThreads, TheSimulationThreadStepsBesideTheHapticAndCollisionThre
   EXPECT_GT(indentation, 1e-4);
 }
 
-
 // A sim-line device that records every force it is commanded, in order (the haptic thread writes,
 // the test reads what the count publishes).
-class RecordingDevice : public haptico::HapticDevice {
+class RecordingDevice final : public testing::ForwardingDevice {
  public:
   static constexpr std::size_t kCapacity = 200000;
   struct Log {
     std::array<Vec3, kCapacity> forces;
     std::atomic<std::size_t> count{0};
   };
-  RecordingDevice(std::unique_ptr<haptico::HapticDevice> inner, Log* log) : inner_(std::move(inner)), log_(log) {}
-  haptico::DeviceInfo info() const override { return inner_->info(); }
-  Status open() override { return inner_->open(); }
-  Status close() override { return inner_->close(); }
-  haptico::DeviceState read_state() override { return inner_->read_state(); }
+  RecordingDevice(std::unique_ptr<haptico::HapticDevice> inner, Log* log)
+      : ForwardingDevice(std::move(inner)), log_(log) {}
   void command(const haptico::DeviceCommand& cmd) override {
     const std::size_t n = log_->count.load(std::memory_order_relaxed);
     if (n < kCapacity) {
       log_->forces[n] = cmd.force;
       log_->count.store(n + 1, std::memory_order_release);
     }
-    inner_->command(cmd);
+    inner().command(cmd);
   }
-  std::string fault_reason() override { return inner_->fault_reason(); }
 
  private:
-  std::unique_ptr<haptico::HapticDevice> inner_;
   Log* log_;
 };
 
